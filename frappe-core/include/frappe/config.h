@@ -1,0 +1,69 @@
+// SPDX-License-Identifier: MIT
+// frappe/config.h: every parameter of the detector, in one place.
+#pragma once
+
+#include <string>
+
+namespace frappe {
+
+/// How the detector chooses the resolution it searches at.
+enum class Mode {
+	/// Every frame at full resolution (the paper's NORMAL).
+	Normal,
+	/// Scale the next frame down so that the smallest marker of the previous
+	/// frame is about `scaled_size` pixels wide (the paper's ASCALE). Faster
+	/// on video with large markers, at the price of missing small markers that
+	/// appear while scaled; every `max_scaled_frames` frames one is at full size.
+	AScale,
+};
+
+/// Detector parameters. Defaults are the paper's Table 1. Each field says what
+/// it trades off. Parameters hold no state: the Detector owns what lives
+/// across frames.
+struct Config {
+	/// Marker family, a name from dictionaryNames() ("aruco_mip_36h12",
+	/// "apriltag_36h11", "6x6_250", ...).
+	std::string dictionary = "aruco_mip_36h12";
+
+	Mode mode = Mode::Normal;
+
+	/// e_thr: Sobel gradient magnitude, for intensities in [0, 1], that an
+	/// edge pixel must exceed after non-maximum suppression. Lower finds
+	/// fainter and blurrier markers but feeds the contour tracer (the most
+	/// expensive stage) more clutter. Range (0, 4].
+	float edge_threshold = 0.27f;
+
+	/// c_thr: Shi-Tomasi minimum eigenvalue of the 3x3 structure tensor
+	/// (summed, same units as edge_threshold squared) that marks an edge pixel
+	/// as a corner. Too high loses the corners of low-contrast or blurred
+	/// markers; too low splits one corner into several clusters.
+	float corner_threshold = 0.19f;
+
+	/// h_thr: the most bit errors corrected when decoding. -1 takes the
+	/// dictionary's safe default, min(5, (dmin - 1) / 2). Higher finds damaged
+	/// markers but raises the chance of a wrong id.
+	int max_hamming = -1;
+
+	/// beta (AScale only): target side in pixels of the smallest marker after
+	/// scaling. Smaller scales more aggressively (faster) but loses markers
+	/// whose cells fall below about 3 pixels.
+	float scaled_size = 28.0f;
+
+	/// n_max_scaled (AScale only): at most this many scaled frames in a row
+	/// before one at full resolution, so small new markers are seen.
+	int max_scaled_frames = 5;
+
+	/// Corner pixels closer than this (pixels, at the traced resolution)
+	/// belong to one corner cluster.
+	float corner_cluster_radius = 4.0f;
+
+	/// Candidates with a side shorter than this (full-resolution pixels) are
+	/// dropped before refinement: below about 1.5 px per cell nothing decodes.
+	float min_marker_side = 10.0f;
+
+	/// Worker threads for the front end (split into row bands). 1 = strictly
+	/// single-threaded; 0 = one per hardware core.
+	int threads = 1;
+};
+
+} // namespace frappe

@@ -1,0 +1,69 @@
+// SPDX-License-Identifier: MIT
+// frappe/edge_map.h: what the front end hands the back end, and the
+// interface every front-end implementation (CPU, VC4) provides.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "frappe/image.h"
+
+namespace frappe {
+
+/// Integer parameters of the front end, derived from Config so that every
+/// implementation compares exactly the same integers.
+struct FrontEndParams {
+	/// An edge pixel's squared Sobel magnitude (8-bit intensities, kernel
+	/// weights 1-2-1) must be greater than this.
+	std::int64_t edge_threshold_sq = 0;
+	/// An edge pixel is a corner when the minimum eigenvalue of its 3x3
+	/// summed structure tensor (8-bit intensity units squared) exceeds this.
+	std::int64_t corner_threshold = 0;
+};
+
+/// The output of the front end for one frame, at the traced resolution.
+struct EdgeMap {
+	static constexpr std::uint8_t kEdge = 1;
+	static constexpr std::uint8_t kCorner = 2;
+	static constexpr int kTile = 16; ///< side of an empty-tile mask block
+
+	int width = 0;
+	int height = 0;
+	/// Traced resolution / full resolution; 1 when the frame was not scaled.
+	float scale = 1.0f;
+	/// width * height bytes, row-major, kEdge | kCorner bits. The outermost
+	/// row and column on every side are always zero.
+	std::vector<std::uint8_t> pixels;
+	int tiles_x = 0;
+	int tiles_y = 0;
+	/// tiles_x * tiles_y bytes: 1 when the 16x16 block holds an edge pixel.
+	std::vector<std::uint8_t> tiles;
+
+	/// Sizes the buffers; reuses their storage when the size is unchanged.
+	void resize(int w, int h);
+	std::uint8_t at(int x, int y) const { return pixels[static_cast<std::size_t>(y) * width + x]; }
+	bool tileEmpty(int tx, int ty) const { return tiles[static_cast<std::size_t>(ty) * tiles_x + tx] == 0; }
+};
+
+/// Scaled frame size for a scale factor: the same rounding everywhere.
+int scaledLength(int full, float scale);
+
+/// A front-end implementation: nearest-neighbour scaling, Sobel gradients,
+/// four-direction non-maximum suppression, the edge threshold, Shi-Tomasi
+/// corners on edge pixels and the empty-tile mask, all in one call.
+/// Implementations must produce byte-identical EdgeMaps.
+class FrontEnd {
+public:
+	virtual ~FrontEnd() = default;
+	virtual const char *name() const = 0;
+	/// Fills `out` (resizing it) for `image` sampled at `scale` (<= 1).
+	virtual void run(const ImageView &image, float scale, const FrontEndParams &params,
+			 EdgeMap &out) = 0;
+};
+
+/// The reference CPU front end. `threads` > 1 splits the frame into row
+/// bands processed in parallel; the output does not depend on it.
+std::unique_ptr<FrontEnd> makeCpuFrontEnd(int threads = 1);
+
+} // namespace frappe

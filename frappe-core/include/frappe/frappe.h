@@ -1,0 +1,11 @@
+// SPDX-License-Identifier: MIT
+// frappe/frappe.h: the whole public API of frappe-core.
+#pragma once
+
+#include "frappe/config.h"
+#include "frappe/detector.h"
+#include "frappe/dictionary.h"
+#include "frappe/edge_map.h"
+#include "frappe/image.h"
+#include "frappe/marker.h"
+#include "frappe/version.h"

@@ -1,0 +1,44 @@
+// SPDX-License-Identifier: MIT
+// frappe/render.h: drawing markers, for printing, tests and sample videos.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "frappe/dictionary.h"
+#include "frappe/image.h"
+
+namespace frappe {
+
+/// A writable 8-bit plane.
+struct MutableImageView {
+	std::uint8_t *data = nullptr;
+	int width = 0;
+	int height = 0;
+	int stride = 0;
+	std::uint8_t *row(int y) const { return data + static_cast<std::ptrdiff_t>(y) * stride; }
+	operator ImageView() const { return { data, width, height, stride }; }
+};
+
+struct RenderOptions {
+	int quiet_cells = 1;      ///< white margin around the black border, in cells
+	int supersample = 4;      ///< samples per pixel side (anti-aliasing)
+	std::uint8_t black = 0;
+	std::uint8_t white = 255;
+};
+
+/// Draws marker `id` so that the outer corners of its black border land on
+/// `corners` (top-left, top-right, bottom-right, bottom-left in the marker's
+/// canonical orientation; pixel centres at integers), through the
+/// homography those corners define. Pixels are area-averaged, so edges fall
+/// at their exact sub-pixel place. Throws std::out_of_range for a bad id.
+void renderMarker(MutableImageView image, const Dictionary &dict, int id,
+		  const std::array<Point2f, 4> &corners, const RenderOptions &options = {});
+
+/// An upright marker image, `cell_px` pixels a cell, with its quiet zone:
+/// side = (bits + 2 + 2 * quiet_cells) * cell_px.
+std::vector<std::uint8_t> markerImage(const Dictionary &dict, int id, int cell_px,
+				      int quiet_cells, int &side);
+
+} // namespace frappe

@@ -1,0 +1,325 @@
+// SPDX-License-Identifier: MIT
+// Suzuki & Abe (1985) border following, list mode: every border of the
+// 8-connected edge pixels is followed exactly once. Label values:
+//   0 background, 1 edge not yet on a followed border,
+//   2 on a followed border, 3 on a followed border whose right neighbour
+//   (examined while following) is background: the paper's -NBD, which stops
+//   a second hole border from starting at the same place.
+// Empty 16x16 tiles hold no edge pixel, so the raster scan jumps over them.
+#include "contour_trace.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+namespace frappe::detail {
+
+namespace {
+
+/* Neighbour offsets, counter-clockwise on screen starting at the right. */
+constexpr int kDx[8] = { 1, 1, 0, -1, -1, -1, 0, 1 };
+constexpr int kDy[8] = { 0, -1, -1, -1, 0, 1, 1, 1 };
+
+float cross(Point2f o, Point2f a, Point2f b)
+{
+	return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x);
+}
+
+/* More corner clusters than this on one border: clutter, not a marker. */
+constexpr std::size_t kMaxClusters = 12;
+
+float dist2(Point2f a, Point2f b)
+{
+	const float dx = a.x - b.x, dy = a.y - b.y;
+	return dx * dx + dy * dy;
+}
+
+} // namespace
+
+void ContourTracer::trace(const EdgeMap &edges, const TraceParams &params, std::vector<Quad> &out)
+{
+	out.clear();
+	borders_ = 0;
+	const int w = edges.width, h = edges.height;
+	if (w < 3 || h < 3)
+		return;
+	stride_ = w;
+	radius2_ = params.cluster_radius * params.cluster_radius;
+	labels_.resize(static_cast<std::size_t>(w) * h);
+	const std::uint8_t *src = edges.pixels.data();
+	for (std::size_t i = 0; i < labels_.size(); ++i)
+		labels_[i] = src[i] & EdgeMap::kEdge;
+
+	constexpr int T = EdgeMap::kTile;
+	for (int y = 1; y < h - 1; ++y) {
+		const std::uint8_t *tileRow = edges.tiles.data() + static_cast<std::size_t>(y / T) * edges.tiles_x;
+		std::uint8_t *row = labels_.data() + static_cast<std::size_t>(y) * w;
+		for (int x = 1; x < w - 1; ++x) {
+			if (tileRow[x / T] == 0) {
+				x = (x / T + 1) * T - 1; /* the loop's ++x lands on the next tile */
+				continue;
+			}
+			const std::uint8_t f = row[x];
+			if (f == 0)
+				continue;
+			int fromDir;
+			if (f == 1 && row[x - 1] == 0)
+				fromDir = 4; /* outer border: came from the left */
+			else if ((f == 1 || f == 2) && row[x + 1] == 0)
+				fromDir = 0; /* hole border: the hole is to the right */
+			else
+				continue;
+
+			++borders_;
+			follow(x, y, fromDir, edges);
+			/* A marker outline is at least four sides of min_side pixels. */
+			if (static_cast<float>(steps_) < 2.8f * params.min_side)
+				continue;
+			Quad quad;
+			const bool found = (!tooManyClusters_ && clusters_.size() >= 4 && quadFromClusters(quad)) ||
+					   quadFromOutline(quad);
+			if (found && acceptQuad(params, w, h, quad))
+				out.push_back(quad);
+		}
+	}
+}
+
+/* Follows one border from (x, y); (x, y) + kD[fromDir] is the background
+ * pixel the scan came from. Collects the corner clusters on the way. */
+void ContourTracer::follow(int x0, int y0, int fromDir, const EdgeMap &edges)
+{
+	clusters_.clear();
+	tooManyClusters_ = false;
+	steps_ = 0;
+	std::uint8_t *L = labels_.data();
+	const std::uint8_t *E = edges.pixels.data();
+	const int w = stride_;
+	auto at = [&](int x, int y) -> std::uint8_t & { return L[static_cast<std::size_t>(y) * w + x]; };
+
+	points_.clear();
+	auto visit = [&](int x, int y) {
+		++steps_;
+		points_.push_back({ x, y });
+		if (!(E[static_cast<std::size_t>(y) * w + x] & EdgeMap::kCorner) || tooManyClusters_)
+			return;
+		const float fx = static_cast<float>(x), fy = static_cast<float>(y);
+		for (Cluster &c : clusters_) {
+			const float dx = fx - static_cast<float>(c.fx), dy = fy - static_cast<float>(c.fy);
+			if (dx * dx + dy * dy <= radius2_) {
+				c.sx += fx;
+				c.sy += fy;
+				++c.n;
+				return;
+			}
+		}
+		if (clusters_.size() >= kMaxClusters) {
+			tooManyClusters_ = true;
+			return;
+		}
+		clusters_.push_back({ fx, fy, 1, x, y });
+	};
+
+	/* 3.1: clockwise from fromDir, find the first non-zero neighbour. */
+	int d1 = -1;
+	for (int k = 0; k < 8; ++k) {
+		const int d = (fromDir - k + 8) & 7;
+		if (at(x0 + kDx[d], y0 + kDy[d]) != 0) {
+			d1 = d;
+			break;
+		}
+	}
+	if (d1 < 0) {
+		at(x0, y0) = 3; /* isolated pixel */
+		visit(x0, y0);
+		return;
+	}
+	const int x1 = x0 + kDx[d1], y1 = y0 + kDy[d1];
+	int x3 = x0, y3 = y0;
+	int back = d1; /* direction from (x3, y3) to the previous border pixel */
+	for (;;) {
+		/* 3.3: counter-clockwise from the pixel after `back`. */
+		int d4 = -1;
+		bool rightExamined = false;
+		for (int k = 1; k <= 8; ++k) {
+			const int d = (back + k) & 7;
+			if (at(x3 + kDx[d], y3 + kDy[d]) != 0) {
+				d4 = d;
+				break;
+			}
+			if (d == 0)
+				rightExamined = true;
+		}
+		/* 3.4: mark the current pixel. */
+		std::uint8_t &cur = at(x3, y3);
+		if (rightExamined)
+			cur = 3;
+		else if (cur == 1)
+			cur = 2;
+		visit(x3, y3);
+		const int x4 = x3 + kDx[d4], y4 = y3 + kDy[d4];
+		/* 3.5: back at the start, about to repeat the first move. */
+		if (x4 == x0 && y4 == y0 && x3 == x1 && y3 == y1)
+			return;
+		back = (d4 + 4) & 7;
+		x3 = x4;
+		y3 = y4;
+		if (static_cast<std::size_t>(steps_) > 4 * labels_.size()) /* only on a corrupt label image */
+			return;
+	}
+}
+
+/* The paper's rule is "exactly four corner clusters". Noise adds clusters
+ * part-way along a side, so with more than four the four spanning the
+ * largest quadrilateral are taken: a side's stray cluster adds no area. */
+bool ContourTracer::quadFromClusters(Quad &quad) const
+{
+	const int n = static_cast<int>(clusters_.size());
+	Point2f c[kMaxClusters];
+	for (int i = 0; i < n; ++i)
+		c[i] = { clusters_[i].sx / static_cast<float>(clusters_[i].n),
+			 clusters_[i].sy / static_cast<float>(clusters_[i].n) };
+	float bestArea = 0.0f;
+	for (int a = 0; a < n; ++a)
+		for (int b = a + 1; b < n; ++b)
+			for (int cc = b + 1; cc < n; ++cc)
+				for (int d = cc + 1; d < n; ++d) {
+					/* Clusters are in border order, so a-b-c-d is a simple polygon. */
+					const float area = 0.5f * std::abs(cross(c[a], c[b], c[cc]) + cross(c[a], c[cc], c[d]));
+					if (area > bestArea) {
+						bestArea = area;
+						quad.corners = { c[a], c[b], c[cc], c[d] };
+					}
+				}
+	return bestArea > 0.0f;
+}
+
+/* When the corner pixels do not give four corners (a faint or blurred
+ * corner), the outline itself does: the point farthest from the centroid,
+ * the point farthest from that one, and the farthest on either side of the
+ * diagonal they span. */
+bool ContourTracer::quadFromOutline(Quad &quad) const
+{
+	const std::size_t n = points_.size();
+	if (n < 8)
+		return false;
+	double mx = 0, my = 0;
+	for (const Pixel &p : points_) {
+		mx += p.x;
+		my += p.y;
+	}
+	mx /= static_cast<double>(n);
+	my /= static_cast<double>(n);
+	auto farthestFrom = [&](double x, double y) {
+		std::size_t best = 0;
+		double bd = -1;
+		for (std::size_t i = 0; i < n; ++i) {
+			const double dx = points_[i].x - x, dy = points_[i].y - y;
+			if (dx * dx + dy * dy > bd) {
+				bd = dx * dx + dy * dy;
+				best = i;
+			}
+		}
+		return best;
+	};
+	const std::size_t i0 = farthestFrom(mx, my);
+	const std::size_t i2 = farthestFrom(points_[i0].x, points_[i0].y);
+	const Point2f p0{ static_cast<float>(points_[i0].x), static_cast<float>(points_[i0].y) };
+	const Point2f p2{ static_cast<float>(points_[i2].x), static_cast<float>(points_[i2].y) };
+	float most = 0.0f, least = 0.0f;
+	Point2f p1{}, p3{};
+	for (const Pixel &q : points_) {
+		const Point2f p{ static_cast<float>(q.x), static_cast<float>(q.y) };
+		const float c = cross(p0, p2, p);
+		if (c > most) {
+			most = c;
+			p1 = p;
+		} else if (c < least) {
+			least = c;
+			p3 = p;
+		}
+	}
+	if (most <= 0.0f || least >= 0.0f)
+		return false;
+	quad.corners = { p0, p1, p2, p3 };
+	return true;
+}
+
+bool ContourTracer::acceptQuad(const TraceParams &params, int w, int h, Quad &quad) const
+{
+	auto &q = quad.corners;
+	/* Convex, and oriented clockwise on screen (positive cross in y-down). */
+	float sign = 0.0f;
+	for (int i = 0; i < 4; ++i) {
+		const float c = cross(q[i], q[(i + 1) & 3], q[(i + 2) & 3]);
+		if (c == 0.0f)
+			return false;
+		if (sign == 0.0f)
+			sign = c;
+		else if ((c > 0.0f) != (sign > 0.0f))
+			return false;
+	}
+	if (sign < 0.0f)
+		std::swap(q[1], q[3]);
+
+	float perimeter = 0.0f, shortest = 1e30f;
+	const float minSide2 = params.min_side * params.min_side;
+	for (int i = 0; i < 4; ++i) {
+		const float s2 = dist2(q[i], q[(i + 1) & 3]);
+		if (s2 < minSide2)
+			return false;
+		shortest = std::min(shortest, s2);
+		perimeter += std::sqrt(s2);
+		const float m = params.border_margin;
+		if (q[i].x < m || q[i].y < m || q[i].x > static_cast<float>(w - 1) - m ||
+		    q[i].y > static_cast<float>(h - 1) - m)
+			return false;
+	}
+	/* A closed outline is followed in about one step per pixel of perimeter
+	 * (8-connected steps are 0.71 to 1 px). An open curve, or one with spurs,
+	 * is walked out and back: far more steps than its corners explain. */
+	if (static_cast<float>(steps_) > 1.25f * perimeter + 8.0f ||
+	    static_cast<float>(steps_) < 0.6f * perimeter)
+		return false;
+
+	/* Every border pixel must lie close to one of the four sides. */
+	float nx[4], ny[4], nc[4];
+	for (int i = 0; i < 4; ++i) {
+		const Point2f a = q[i], b = q[(i + 1) & 3];
+		const float len = std::sqrt(dist2(a, b));
+		nx[i] = -(b.y - a.y) / len;
+		ny[i] = (b.x - a.x) / len;
+		nc[i] = nx[i] * a.x + ny[i] * a.y;
+	}
+	const float tol = std::max(2.0f, 0.08f * std::sqrt(shortest));
+	int off = 0;
+	for (const Pixel &p : points_) {
+		float best = 1e30f;
+		for (int i = 0; i < 4; ++i)
+			best = std::min(best, std::abs(nx[i] * static_cast<float>(p.x) + ny[i] * static_cast<float>(p.y) - nc[i]));
+		off += best > tol;
+	}
+	/* A few pixels of a rounded corner may stray; a side that bulges may not. */
+	return off * 20 <= static_cast<int>(points_.size());
+}
+
+void removeDuplicateQuads(std::vector<Quad> &quads, float tolerance)
+{
+	const float tol2 = tolerance * tolerance;
+	std::size_t kept = 0;
+	for (std::size_t i = 0; i < quads.size(); ++i) {
+		bool dup = false;
+		for (std::size_t j = 0; j < kept && !dup; ++j) {
+			for (int shift = 0; shift < 4 && !dup; ++shift) {
+				bool all = true;
+				for (int k = 0; k < 4 && all; ++k)
+					all = dist2(quads[i].corners[k], quads[j].corners[(k + shift) & 3]) <= tol2;
+				dup = all;
+			}
+		}
+		if (!dup)
+			quads[kept++] = quads[i];
+	}
+	quads.resize(kept);
+}
+
+} // namespace frappe::detail

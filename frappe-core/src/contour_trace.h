@@ -1,0 +1,67 @@
+// SPDX-License-Identifier: MIT
+// TRACE_CONTOUR and GOOD_CANDIDATE: Suzuki border following over the edge
+// image, collecting the corner pixels met along each border.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "frappe/edge_map.h"
+#include "frappe/image.h"
+
+namespace frappe::detail {
+
+/// A quadrilateral found by the tracer, at the traced resolution, corners
+/// clockwise on screen starting anywhere.
+struct Quad {
+	std::array<Point2f, 4> corners;
+};
+
+struct TraceParams {
+	float cluster_radius = 4.0f; ///< corner pixels closer than this form one corner
+	float min_side = 8.0f;       ///< shortest acceptable side, traced pixels
+	float border_margin = 1.0f;  ///< corners must lie this far inside the frame
+};
+
+/// Follows every border of the edge image once, keeps the closed ones with
+/// exactly four corner clusters that make a plausible marker outline, and
+/// drops the duplicate that the inner and outer borders of one ring give.
+class ContourTracer
+{
+public:
+	/// Appends the accepted quads to `out` (cleared first).
+	void trace(const EdgeMap &edges, const TraceParams &params, std::vector<Quad> &out);
+
+	/// Borders followed in the last call, for statistics.
+	int bordersFollowed() const { return borders_; }
+
+private:
+	struct Pixel {
+		int x, y;
+	};
+	struct Cluster {
+		float sx, sy; ///< sums of member coordinates
+		int n;
+		int fx, fy;   ///< first member, the cluster's anchor
+	};
+	void follow(int x, int y, int fromDir, const EdgeMap &edges);
+	bool quadFromClusters(Quad &quad) const;
+	bool quadFromOutline(Quad &quad) const;
+	bool acceptQuad(const TraceParams &params, int w, int h, Quad &quad) const;
+
+	std::vector<std::uint8_t> labels_;
+	std::vector<Cluster> clusters_;
+	std::vector<Pixel> points_;
+	int steps_ = 0;
+	bool tooManyClusters_ = false;
+	int borders_ = 0;
+	int stride_ = 0;
+	float radius2_ = 16.0f;
+};
+
+/// Drops quads whose corners all lie within `tolerance` of an earlier quad's
+/// (under the best cyclic alignment); returns the number kept.
+void removeDuplicateQuads(std::vector<Quad> &quads, float tolerance);
+
+} // namespace frappe::detail

@@ -1,0 +1,142 @@
+// SPDX-License-Identifier: MIT
+#include "corner_refine.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "sampling.h"
+
+namespace frappe::detail {
+
+namespace {
+
+struct Line {
+	/* Points p with n . p = c, |n| = 1. */
+	double nx, ny, c;
+};
+
+constexpr int kMaxSamples = 48;  /* edge points per side */
+constexpr int kMaxProfile = 64;  /* samples along one normal */
+constexpr float kProfileStep = 0.5f;
+
+/* Measures one side from a to b (clockwise quad, so the marker interior is
+ * on the right of a->b on screen). */
+bool fitSide(const ImageView &img, Point2f a, Point2f b, float search, Line &line)
+{
+	const float dx = b.x - a.x, dy = b.y - a.y;
+	const float len = std::sqrt(dx * dx + dy * dy);
+	if (len < 2.0f)
+		return false;
+	const float ux = dx / len, uy = dy / len;
+	const float nx = -uy, ny = ux; /* inward normal */
+
+	/* Stay clear of the corners, where the neighbouring side interferes. */
+	const float margin = std::max(1.5f, 0.12f * len);
+	const float usable = len - 2.0f * margin;
+	if (usable <= 0.0f)
+		return false;
+	const int nSamples = std::clamp(static_cast<int>(usable / 1.5f), 3, kMaxSamples);
+	const int half = std::min(kMaxProfile / 2 - 1, static_cast<int>(std::ceil(search / kProfileStep)) + 1);
+
+	double sw = 0, sx = 0, sy = 0, sxx = 0, syy = 0, sxy = 0;
+	int used = 0;
+	float profile[kMaxProfile];
+	for (int i = 0; i < nSamples; ++i) {
+		const float t = margin + usable * (static_cast<float>(i) + 0.5f) / static_cast<float>(nSamples);
+		const float px = a.x + ux * t, py = a.y + uy * t;
+		const int n = 2 * half + 1;
+		for (int k = 0; k < n; ++k) {
+			const float s = static_cast<float>(k - half) * kProfileStep;
+			profile[k] = sampleBilinear(img, px + nx * s, py + ny * s);
+		}
+		/* Strongest drop in intensity going inwards (white border outside,
+		 * black frame inside); steps of the other sign belong to other edges. */
+		int best = -1;
+		float bestDrop = 0.0f;
+		for (int k = 1; k < n - 1; ++k) {
+			const float drop = profile[k - 1] - profile[k + 1];
+			if (drop > bestDrop) {
+				bestDrop = drop;
+				best = k;
+			}
+		}
+		/* Below ~4 grey levels per pixel it is noise, not an edge. */
+		if (best < 2 || best > n - 3 || bestDrop < 4.0f)
+			continue;
+		const float dm = profile[best - 2] - profile[best];
+		const float dp = profile[best] - profile[best + 2];
+		const float denom = dm - 2.0f * bestDrop + dp;
+		float off = 0.0f;
+		if (denom < 0.0f)
+			off = std::clamp(0.5f * (dm - dp) / denom, -0.5f, 0.5f);
+		const float s = (static_cast<float>(best - half) + off) * kProfileStep;
+		if (std::abs(s) > search)
+			continue;
+		const double ex = px + nx * s, ey = py + ny * s;
+		const double wgt = bestDrop;
+		sw += wgt;
+		sx += wgt * ex;
+		sy += wgt * ey;
+		sxx += wgt * ex * ex;
+		syy += wgt * ey * ey;
+		sxy += wgt * ex * ey;
+		++used;
+	}
+	if (used < 3 || used * 2 < nSamples)
+		return false;
+	/* Weighted total least squares: the normal is the covariance's
+	 * eigenvector of the smaller eigenvalue. */
+	const double mx = sx / sw, my = sy / sw;
+	const double cxx = sxx / sw - mx * mx, cyy = syy / sw - my * my, cxy = sxy / sw - mx * my;
+	const double theta = 0.5 * std::atan2(2.0 * cxy, cxx - cyy); /* major axis */
+	line.nx = -std::sin(theta);
+	line.ny = std::cos(theta);
+	line.c = line.nx * mx + line.ny * my;
+	return true;
+}
+
+bool intersect(const Line &l1, const Line &l2, Point2f &p)
+{
+	const double det = l1.nx * l2.ny - l1.ny * l2.nx;
+	if (std::abs(det) < 1e-6)
+		return false;
+	p.x = static_cast<float>((l1.c * l2.ny - l1.ny * l2.c) / det);
+	p.y = static_cast<float>((l1.nx * l2.c - l1.c * l2.nx) / det);
+	return true;
+}
+
+bool refineOnce(const ImageView &img, std::array<Point2f, 4> &q, float search)
+{
+	Line lines[4];
+	for (int i = 0; i < 4; ++i) {
+		if (!fitSide(img, q[i], q[(i + 1) & 3], search, lines[i]))
+			return false;
+	}
+	std::array<Point2f, 4> r;
+	for (int i = 0; i < 4; ++i) {
+		/* Corner i joins side i-1 (ending at it) and side i (starting at it). */
+		if (!intersect(lines[(i + 3) & 3], lines[i], r[i]))
+			return false;
+		const float dx = r[i].x - q[i].x, dy = r[i].y - q[i].y;
+		if (dx * dx + dy * dy > 4.0f * search * search + 4.0f)
+			return false;
+	}
+	q = r;
+	return true;
+}
+
+} // namespace
+
+bool refineCorners(const ImageView &image, std::array<Point2f, 4> &corners, float search)
+{
+	std::array<Point2f, 4> q = corners;
+	if (!refineOnce(image, q, search))
+		return false;
+	/* A second, narrow pass: the sides are now well placed, so the
+	 * measurement points avoid the corners exactly and the window shrinks. */
+	refineOnce(image, q, std::min(search, 1.5f));
+	corners = q;
+	return true;
+}
+
+} // namespace frappe::detail

@@ -1,0 +1,102 @@
+// SPDX-License-Identifier: MIT
+#include "decode.h"
+
+#include <algorithm>
+#include <bit>
+
+#include "frappe/homography.h"
+#include "sampling.h"
+
+namespace frappe::detail {
+
+bool warpMarker(const ImageView &image, const std::array<Point2f, 4> &corners, int bits,
+		WarpedMarker &out)
+{
+	const auto H = Homography::fromUnitSquare(corners);
+	if (!H)
+		return false;
+	const int side = (bits + 2) * kSamplesPerCell;
+	out.side = side;
+	const double step = 1.0 / side;
+	for (int j = 0; j < side; ++j) {
+		const double v = (j + 0.5) * step;
+		for (int i = 0; i < side; ++i) {
+			const Point2f p = H->map((i + 0.5) * step, v);
+			out.samples[static_cast<std::size_t>(j) * side + i] = sampleBilinear(image, p.x, p.y);
+		}
+	}
+	return true;
+}
+
+Binarised binarise(const WarpedMarker &w, int bits)
+{
+	const int cells = bits + 2;
+	const int k = kSamplesPerCell;
+	float lo = 1e9f, hi = -1e9f;
+	for (int y = k; y < (bits + 1) * k; ++y) {
+		for (int x = k; x < (bits + 1) * k; ++x) {
+			lo = std::min(lo, w.at(x, y));
+			hi = std::max(hi, w.at(x, y));
+		}
+	}
+	const float thr = lo + 0.5f * (hi - lo);
+	auto cellMean = [&](int cx, int cy) {
+		float s = 0.0f;
+		for (int y = 0; y < k; ++y)
+			for (int x = 0; x < k; ++x)
+				s += w.at(cx * k + x, cy * k + y);
+		return s / static_cast<float>(k * k);
+	};
+	Binarised out;
+	out.contrast = hi - lo;
+	for (int cy = 1; cy <= bits; ++cy) {
+		for (int cx = 1; cx <= bits; ++cx)
+			out.code = (out.code << 1) | (cellMean(cx, cy) > thr ? 1u : 0u);
+	}
+	for (int c = 0; c < cells; ++c) {
+		out.border_errors += cellMean(c, 0) > thr;
+		out.border_errors += cellMean(c, cells - 1) > thr;
+	}
+	for (int c = 1; c < cells - 1; ++c) {
+		out.border_errors += cellMean(0, c) > thr;
+		out.border_errors += cellMean(cells - 1, c) > thr;
+	}
+	return out;
+}
+
+Decoded decode(const Dictionary &dict, std::uint64_t code, int maxHamming)
+{
+	/* rotations[r]: the code as read with quad corner r as the top-left.
+	 * Reading from corner 1 sees the grid turned a quarter anticlockwise,
+	 * i.e. three quarter turns clockwise. */
+	std::uint64_t rotations[4];
+	rotations[0] = code;
+	for (int r = 1; r < 4; ++r) {
+		std::uint64_t c = rotations[r - 1];
+		for (int t = 0; t < 3; ++t)
+			c = rotateCode(c, dict.bits);
+		rotations[r] = c;
+	}
+	Decoded best;
+	int bestDist = maxHamming + 1;
+	bool ambiguous = false;
+	const int n = dict.size();
+	for (int id = 0; id < n; ++id) {
+		const std::uint64_t word = dict.codes[id];
+		for (int r = 0; r < 4; ++r) {
+			const int d = std::popcount(word ^ rotations[r]);
+			if (d < bestDist) {
+				bestDist = d;
+				best = { id, d, r };
+				ambiguous = false;
+			} else if (d == bestDist && best.id != id) {
+				ambiguous = true;
+			}
+		}
+	}
+	if (best.id < 0 || ambiguous)
+		return {};
+	return best;
+}
+
+} // namespace frappe::detail

@@ -1,0 +1,54 @@
+// SPDX-License-Identifier: MIT
+// PERSPECTIVE_WARP and BINARISE_DECODE.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "frappe/dictionary.h"
+#include "frappe/image.h"
+
+namespace frappe::detail {
+
+/// Samples per cell side: each bit is the mean of 2x2 samples.
+constexpr int kSamplesPerCell = 2;
+
+/// The warped samples of one candidate: (bits + 2) cells a side, 2x2 samples
+/// a cell (16x16 for 6x6 codes), row-major, sample (i, j) at cell
+/// coordinates ((i + 0.5) / 2, (j + 0.5) / 2).
+struct WarpedMarker {
+	int side = 0; ///< samples per side
+	std::array<float, 20 * 20> samples{};
+	float at(int x, int y) const { return samples[static_cast<std::size_t>(y) * side + x]; }
+};
+
+/// Warps the quad (clockwise, corners[0] mapped to the grid's top-left) into
+/// the sample grid of a marker with `bits` bits a side. False when the quad
+/// is degenerate.
+bool warpMarker(const ImageView &image, const std::array<Point2f, 4> &corners, int bits,
+		WarpedMarker &out);
+
+/// The bits of a warped marker, read as in the dictionary files with the
+/// grid's top-left cell first.
+struct Binarised {
+	std::uint64_t code = 0;
+	int border_errors = 0; ///< border cells that read white
+	float contrast = 0.0f; ///< max - min sample over the payload
+};
+
+/// Thresholds the payload at the mid-point of its darkest and brightest
+/// samples, averages 2x2 samples per cell, and checks the border cells.
+Binarised binarise(const WarpedMarker &warped, int bits);
+
+struct Decoded {
+	int id = -1;
+	int hamming = 0;
+	int rotation = 0; ///< the quad's corner that is the marker's top-left
+};
+
+/// Hamming-nearest codeword over the four rotations; id = -1 when none is
+/// within maxHamming or the nearest is ambiguous.
+Decoded decode(const Dictionary &dict, std::uint64_t code, int maxHamming);
+
+} // namespace frappe::detail

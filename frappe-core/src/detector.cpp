@@ -1,0 +1,274 @@
+// SPDX-License-Identifier: MIT
+// The Detector: runs the stages of Algorithm 1 in order and times each.
+#include "frappe/detector.h"
+
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "adaptive_scale.h"
+#include "contour_trace.h"
+#include "corner_refine.h"
+#include "decode.h"
+
+namespace frappe {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double msSince(Clock::time_point t0)
+{
+	return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+void validate(const Config &c, const Dictionary &d)
+{
+	auto fail = [](const std::string &what) { throw std::invalid_argument("frappe::Config: " + what); };
+	if (!(c.edge_threshold > 0.0f && c.edge_threshold <= 4.0f))
+		fail("edge_threshold must be in (0, 4], got " + std::to_string(c.edge_threshold));
+	if (!(c.corner_threshold >= 0.0f && c.corner_threshold <= 100.0f))
+		fail("corner_threshold must be in [0, 100], got " + std::to_string(c.corner_threshold));
+	if (c.max_hamming < -1 || c.max_hamming > d.bits * d.bits / 2)
+		fail("max_hamming must be -1 (dictionary default) or 0.." + std::to_string(d.bits * d.bits / 2) +
+		     " for " + std::string(d.name) + ", got " + std::to_string(c.max_hamming));
+	if (!(c.scaled_size >= 8.0f && c.scaled_size <= 1000.0f))
+		fail("scaled_size must be in [8, 1000] pixels, got " + std::to_string(c.scaled_size));
+	if (c.max_scaled_frames < 0 || c.max_scaled_frames > 1000)
+		fail("max_scaled_frames must be in [0, 1000], got " + std::to_string(c.max_scaled_frames));
+	if (!(c.corner_cluster_radius >= 1.0f && c.corner_cluster_radius <= 32.0f))
+		fail("corner_cluster_radius must be in [1, 32], got " + std::to_string(c.corner_cluster_radius));
+	if (!(c.min_marker_side >= 4.0f))
+		fail("min_marker_side must be at least 4 pixels, got " + std::to_string(c.min_marker_side));
+	if (c.threads < 0 || c.threads > 256)
+		fail("threads must be in [0, 256], got " + std::to_string(c.threads));
+}
+
+/* Border cells that may read white before a candidate is rejected: blur
+ * and small cells brighten the frame next to the quiet zone. */
+int allowedBorderErrors(int bits)
+{
+	return (4 * (bits + 1)) / 8;
+}
+
+/* Largest image side accepted: contour coordinates are ints and buffers are
+ * sized from width * height. */
+constexpr int kMaxSide = 1 << 15;
+
+} // namespace
+
+std::string_view stageName(Stage stage)
+{
+	switch (stage) {
+	case Stage::AdaptiveScale: return "adaptive_scale";
+	case Stage::FrontEnd: return "front_end";
+	case Stage::Trace: return "trace";
+	case Stage::Refine: return "refine";
+	case Stage::Warp: return "warp";
+	case Stage::Decode: return "decode";
+	case Stage::Count: break;
+	}
+	return "?";
+}
+
+struct Detector::Impl {
+	Config config;
+	const Dictionary *dict = nullptr;
+	int maxHamming = 0;
+	FrontEndParams params;
+	std::unique_ptr<FrontEnd> frontEnd;
+	detail::AdaptiveScale adaptive;
+
+	struct Slot {
+		EdgeMap edges;
+		Result result;
+	};
+	Slot slots[2];
+
+	detail::ContourTracer tracer;
+	std::vector<detail::Quad> quads;
+	detail::WarpedMarker warped;
+
+	void checkImage(const ImageView &image) const;
+	void backEnd(const ImageView &image, Slot &slot);
+};
+
+void Detector::Impl::checkImage(const ImageView &image) const
+{
+	auto fail = [](const std::string &what) { throw std::invalid_argument("frappe::Detector: " + what); };
+	if (image.width <= 0 || image.height <= 0)
+		fail("image size must be positive, got " + std::to_string(image.width) + "x" +
+		     std::to_string(image.height));
+	if (image.width > kMaxSide || image.height > kMaxSide)
+		fail("image side must be at most " + std::to_string(kMaxSide) + " pixels");
+	if (image.stride < image.width)
+		fail("stride (" + std::to_string(image.stride) + ") is smaller than the width (" +
+		     std::to_string(image.width) + ")");
+	if (!image.data)
+		fail("image data is null");
+}
+
+void Detector::Impl::backEnd(const ImageView &image, Slot &slot)
+{
+	Result &res = slot.result;
+	const EdgeMap &edges = slot.edges;
+	const float scale = edges.scale;
+	res.markers.clear();
+	res.candidates = 0;
+
+	auto t = Clock::now();
+	detail::TraceParams tp;
+	tp.cluster_radius = config.corner_cluster_radius;
+	tp.min_side = std::max(4.0f, config.min_marker_side * scale);
+	tp.border_margin = 1.0f;
+	tracer.trace(edges, tp, quads);
+	detail::removeDuplicateQuads(quads, 2.5f);
+	res.times[Stage::Trace] = msSince(t);
+
+	const float search = 2.5f / scale;
+	const float minSide2 = config.min_marker_side * config.min_marker_side;
+	const int bits = dict->bits;
+	const int borderAllowance = allowedBorderErrors(bits);
+	double refineMs = 0, warpMs = 0, decodeMs = 0;
+	for (detail::Quad &q : quads) {
+		t = Clock::now();
+		for (Point2f &p : q.corners) {
+			p.x = (p.x + 0.5f) / scale - 0.5f;
+			p.y = (p.y + 0.5f) / scale - 0.5f;
+		}
+		const bool refined = detail::refineCorners(image, q.corners, search);
+		refineMs += msSince(t);
+		if (!refined)
+			continue;
+		bool big = true;
+		for (int i = 0; i < 4; ++i) {
+			const float dx = q.corners[i].x - q.corners[(i + 1) & 3].x;
+			const float dy = q.corners[i].y - q.corners[(i + 1) & 3].y;
+			big = big && dx * dx + dy * dy >= minSide2;
+		}
+		if (!big)
+			continue;
+
+		++res.candidates;
+		t = Clock::now();
+		const bool warpedOk = detail::warpMarker(image, q.corners, bits, warped);
+		warpMs += msSince(t);
+		if (!warpedOk)
+			continue;
+
+		t = Clock::now();
+		const detail::Binarised b = detail::binarise(warped, bits);
+		detail::Decoded d;
+		if (b.contrast >= 10.0f && b.border_errors <= borderAllowance)
+			d = detail::decode(*dict, b.code, maxHamming);
+		decodeMs += msSince(t);
+		if (d.id < 0)
+			continue;
+
+		Marker m;
+		m.id = d.id;
+		m.hamming = d.hamming;
+		for (int i = 0; i < 4; ++i)
+			m.corners[i] = q.corners[(i + d.rotation) & 3];
+
+		/* The same marker reached twice (e.g. through two nested borders):
+		 * keep the better decode. */
+		bool duplicate = false;
+		for (Marker &other : res.markers) {
+			if (other.id != m.id)
+				continue;
+			const float dx = other.corners[0].x - m.corners[0].x;
+			const float dy = other.corners[0].y - m.corners[0].y;
+			const float sx = m.corners[1].x - m.corners[0].x, sy = m.corners[1].y - m.corners[0].y;
+			if (dx * dx + dy * dy < 0.25f * (sx * sx + sy * sy)) {
+				duplicate = true;
+				if (m.hamming < other.hamming)
+					other = m;
+				break;
+			}
+		}
+		if (!duplicate)
+			res.markers.push_back(m);
+	}
+	res.times[Stage::Refine] = refineMs;
+	res.times[Stage::Warp] = warpMs;
+	res.times[Stage::Decode] = decodeMs;
+}
+
+Detector::Detector(const Config &config) : impl_(std::make_unique<Impl>())
+{
+	const Dictionary *d = findDictionary(config.dictionary);
+	if (!d)
+		throw std::invalid_argument("frappe::Config: unknown dictionary '" + config.dictionary +
+					    "'; known: " + dictionaryNames());
+	validate(config, *d);
+	impl_->config = config;
+	impl_->dict = d;
+	impl_->maxHamming = config.max_hamming >= 0 ? config.max_hamming : d->defaultMaxHamming();
+	const double e = static_cast<double>(config.edge_threshold) * 255.0;
+	impl_->params.edge_threshold_sq = static_cast<std::int64_t>(std::floor(e * e));
+	impl_->params.corner_threshold =
+		static_cast<std::int64_t>(std::floor(static_cast<double>(config.corner_threshold) * 255.0 * 255.0));
+	impl_->frontEnd = makeCpuFrontEnd(config.threads);
+}
+
+Detector::~Detector() = default;
+Detector::Detector(Detector &&) noexcept = default;
+Detector &Detector::operator=(Detector &&) noexcept = default;
+
+const Result &Detector::detect(const ImageView &image)
+{
+	runFrontEnd(image, 0);
+	return runBackEnd(image, 0);
+}
+
+void Detector::runFrontEnd(const ImageView &image, int slot)
+{
+	Impl &d = *impl_;
+	d.checkImage(image);
+	Impl::Slot &s = d.slots[slot & 1];
+	const auto t0 = Clock::now();
+	float scale = d.adaptive.next(d.config);
+	/* Never scale a frame so small that a marker could not survive it. */
+	if (scaledLength(image.width, scale) < 32 || scaledLength(image.height, scale) < 32)
+		scale = 1.0f;
+	s.result.times = {};
+	s.result.times[Stage::AdaptiveScale] = msSince(t0);
+	const auto t1 = Clock::now();
+	d.frontEnd->run(image, scale, d.params, s.edges);
+	s.result.times[Stage::FrontEnd] = msSince(t1);
+	s.result.scale = s.edges.scale;
+}
+
+const Result &Detector::runBackEnd(const ImageView &image, int slot)
+{
+	Impl &d = *impl_;
+	Impl::Slot &s = d.slots[slot & 1];
+	d.backEnd(image, s);
+	d.adaptive.update(s.result.markers);
+	double total = 0;
+	for (double ms : s.result.times.ms)
+		total += ms;
+	s.result.times.total_ms = total;
+	return s.result;
+}
+
+void Detector::setFrontEnd(std::unique_ptr<FrontEnd> frontEnd)
+{
+	if (!frontEnd)
+		throw std::invalid_argument("frappe::Detector: null front end");
+	impl_->frontEnd = std::move(frontEnd);
+}
+
+const FrontEnd &Detector::frontEnd() const { return *impl_->frontEnd; }
+const EdgeMap &Detector::edgeMap(int slot) const { return impl_->slots[slot & 1].edges; }
+void Detector::reset() { impl_->adaptive.reset(); }
+const Config &Detector::config() const { return impl_->config; }
+const Dictionary &Detector::dictionary() const { return *impl_->dict; }
+int Detector::maxHamming() const { return impl_->maxHamming; }
+FrontEndParams Detector::frontEndParams() const { return impl_->params; }
+
+const char *version() { return FRAPPE_VERSION; }
+
+} // namespace frappe

@@ -1,0 +1,88 @@
+// SPDX-License-Identifier: MIT
+#include "frappe/dictionary.h"
+
+#include <algorithm>
+#include <cctype>
+
+#include "dictionary_table.h"
+
+namespace frappe {
+
+int Dictionary::defaultMaxHamming() const
+{
+	return std::clamp((min_hamming - 1) / 2, 0, 5);
+}
+
+std::span<const Dictionary> dictionaries()
+{
+	return { detail::kDictionaries, detail::kDictionaryCount };
+}
+
+namespace {
+
+std::string lower(std::string_view s)
+{
+	std::string out(s);
+	for (char &c : out)
+		c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+	return out;
+}
+
+/* Maps the names other libraries use onto ours: opencv_6x6_250 and
+ * DICT_6X6_250 -> 6x6_250, DICT_APRILTAG_36h11 and tag36h11 ->
+ * apriltag_36h11, DICT_ARUCO_ORIGINAL -> aruco_original. */
+std::string canonicalName(std::string_view name)
+{
+	std::string n = lower(name);
+	for (std::string_view prefix : { "opencv_", "dict_", "cv2.aruco.dict_" }) {
+		if (n.starts_with(prefix))
+			n.erase(0, prefix.size());
+	}
+	if (n.starts_with("tag") && n.size() > 3 && std::isdigit(static_cast<unsigned char>(n[3])))
+		n = "apriltag_" + n.substr(3);
+	if (n == "aruco_mip_36h12" || n == "mip_36h12" || n == "arucomip36h12")
+		n = "aruco_mip_36h12";
+	return n;
+}
+
+} // namespace
+
+const Dictionary *findDictionary(std::string_view name)
+{
+	const std::string wanted = canonicalName(name);
+	for (const Dictionary &d : dictionaries()) {
+		if (d.name == wanted)
+			return &d;
+	}
+	return nullptr;
+}
+
+std::string dictionaryNames(std::string_view separator)
+{
+	std::string out;
+	for (const Dictionary &d : dictionaries()) {
+		if (!out.empty())
+			out += separator;
+		out += d.name;
+	}
+	return out;
+}
+
+std::uint64_t rotateCode(std::uint64_t code, int bits)
+{
+	/* Bit index of cell (row r, col c) is n*n-1 - (r*n + c). After a
+	 * quarter turn clockwise, the cell at (r, c) comes from (n-1-c, r). */
+	const int n = bits;
+	const int top = n * n - 1;
+	std::uint64_t out = 0;
+	for (int r = 0; r < n; ++r) {
+		for (int c = 0; c < n; ++c) {
+			const int sr = n - 1 - c, sc = r;
+			const std::uint64_t bit = (code >> (top - (sr * n + sc))) & 1u;
+			out |= bit << (top - (r * n + c));
+		}
+	}
+	return out;
+}
+
+} // namespace frappe

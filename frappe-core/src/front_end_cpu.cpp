@@ -1,0 +1,162 @@
+// SPDX-License-Identifier: MIT
+// The CPU front end: nearest-neighbour scaling, Sobel, non-maximum
+// suppression, the edge threshold, Shi-Tomasi corners and the empty-tile
+// mask, streamed over rows so the working set stays in cache.
+//
+// All arithmetic is integer and exactly specified, so that other front ends
+// (the QPU kernels) can reproduce the EdgeMap byte for byte:
+//   gx = (p[y-1][x+1] + 2 p[y][x+1] + p[y+1][x+1]) - (same at x-1)
+//   gy = (p[y+1][x-1] + 2 p[y+1][x] + p[y+1][x+1]) - (same at y-1)
+//   m  = gx^2 + gy^2, zero on the outermost row and column
+//   direction: horizontal when 256|gy| <= 106|gx|, vertical when
+//   256|gx| <= 106|gy| (106/256 ~ tan 22.5 deg), else the diagonal with the
+//   sign of gx*gy
+//   edge: m > edge_threshold_sq and m > m(previous neighbour) and
+//   m >= m(next neighbour) along the direction (previous = left/up)
+//   corner: edge and the minimum eigenvalue of the 3x3 sum of
+//   [gx^2 gxgy; gxgy gy^2] > corner_threshold, decided without a root:
+//   S - 2T > 0 and (S - 2T)^2 > (Sxx - Syy)^2 + 4 Sxy^2, S = Sxx + Syy.
+#include <algorithm>
+#include <cstdlib>
+#include <thread>
+#include <vector>
+
+#include "frappe/edge_map.h"
+#include "front_end_rows.h"
+
+namespace frappe {
+
+int scaledLength(int full, float scale)
+{
+	if (scale >= 1.0f)
+		return full;
+	return std::max(1, static_cast<int>(static_cast<float>(full) * scale + 0.5f));
+}
+
+void EdgeMap::resize(int w, int h)
+{
+	width = w;
+	height = h;
+	pixels.resize(static_cast<std::size_t>(w) * h);
+	tiles_x = (w + kTile - 1) / kTile;
+	tiles_y = (h + kTile - 1) / kTile;
+	tiles.resize(static_cast<std::size_t>(tiles_x) * tiles_y);
+}
+
+namespace {
+
+class CpuFrontEnd final : public FrontEnd
+{
+public:
+	explicit CpuFrontEnd(int threads) : threads_(threads) {}
+	const char *name() const override { return "cpu"; }
+	void run(const ImageView &image, float scale, const FrontEndParams &params,
+		 EdgeMap &out) override;
+
+private:
+	void runBand(const ImageView &src, const FrontEndParams &params, EdgeMap &out,
+		     int y0, int y1, detail::RowScratch &scratch);
+
+	int threads_;
+	std::vector<std::uint8_t> scaled_;
+	std::vector<detail::RowScratch> scratch_;
+};
+
+void CpuFrontEnd::run(const ImageView &image, float scale, const FrontEndParams &params,
+		      EdgeMap &out)
+{
+	ImageView src = image;
+	if (scale < 1.0f) {
+		const int w = scaledLength(image.width, scale);
+		const int h = scaledLength(image.height, scale);
+		scaled_.resize(static_cast<std::size_t>(w) * h);
+		detail::scaleNearest(image, w, h, scaled_.data());
+		src = ImageView(scaled_.data(), w, h, w);
+	}
+	out.resize(src.width, src.height);
+	out.scale = scale < 1.0f ? scale : 1.0f;
+	std::fill(out.tiles.begin(), out.tiles.end(), 0);
+
+	const int w = src.width, h = src.height;
+	/* Frame rows are never edges: Suzuki's tracer relies on a zero frame. */
+	if (h > 0) {
+		std::fill_n(out.pixels.data(), w, 0);
+		std::fill_n(out.pixels.data() + static_cast<std::size_t>(h - 1) * w, w, 0);
+	}
+	if (w < 3 || h < 3) {
+		std::fill(out.pixels.begin(), out.pixels.end(), 0);
+		return;
+	}
+
+	int bands = threads_ <= 0 ? static_cast<int>(std::max(1u, std::thread::hardware_concurrency()))
+				  : threads_;
+	/* Bands are whole tile rows so that no two threads touch one tile. */
+	const int tileRows = (h + EdgeMap::kTile - 1) / EdgeMap::kTile;
+	bands = std::clamp(bands, 1, std::max(1, tileRows));
+	if (scratch_.size() < static_cast<std::size_t>(bands))
+		scratch_.resize(bands);
+
+	auto bandRows = [&](int b, int &y0, int &y1) {
+		const int t0 = tileRows * b / bands, t1 = tileRows * (b + 1) / bands;
+		y0 = std::max(1, t0 * EdgeMap::kTile);
+		y1 = std::min(h - 1, t1 * EdgeMap::kTile);
+	};
+	if (bands == 1) {
+		runBand(src, params, out, 1, h - 1, scratch_[0]);
+		return;
+	}
+	/* TODO(speed): a persistent worker pool instead of a thread per band. */
+	std::vector<std::thread> workers;
+	workers.reserve(bands - 1);
+	for (int b = 1; b < bands; ++b) {
+		workers.emplace_back([&, b] {
+			int y0, y1;
+			bandRows(b, y0, y1);
+			runBand(src, params, out, y0, y1, scratch_[b]);
+		});
+	}
+	int y0, y1;
+	bandRows(0, y0, y1);
+	runBand(src, params, out, y0, y1, scratch_[0]);
+	for (std::thread &t : workers)
+		t.join();
+}
+
+/* Edge rows y0 .. y1-1 (1 <= y0, y1 <= h-1). */
+void CpuFrontEnd::runBand(const ImageView &src, const FrontEndParams &params, EdgeMap &out,
+			  int y0, int y1, detail::RowScratch &s)
+{
+	const int w = src.width, h = src.height;
+	s.resize(w);
+	/* Ring of three gradient rows: index (row % 3). */
+	for (int r = y0 - 1; r <= y0; ++r)
+		detail::gradientRow(src, r, s.gx[r % 3].data(), s.gy[r % 3].data(), s.mag[r % 3].data());
+
+	for (int y = y0; y < y1; ++y) {
+		const int next = y + 1;
+		detail::gradientRow(src, next, s.gx[next % 3].data(), s.gy[next % 3].data(),
+				    s.mag[next % 3].data());
+		const detail::GradRows rows{
+			{ s.gx[(y - 1) % 3].data(), s.gx[y % 3].data(), s.gx[next % 3].data() },
+			{ s.gy[(y - 1) % 3].data(), s.gy[y % 3].data(), s.gy[next % 3].data() },
+			{ s.mag[(y - 1) % 3].data(), s.mag[y % 3].data(), s.mag[next % 3].data() },
+		};
+		std::uint8_t *edgeRow = out.pixels.data() + static_cast<std::size_t>(y) * w;
+		const bool any = detail::edgeRow(rows, w, params, edgeRow);
+		if (any) {
+			std::uint8_t *tileRow = out.tiles.data() +
+						static_cast<std::size_t>(y / EdgeMap::kTile) * out.tiles_x;
+			detail::markTiles(edgeRow, w, tileRow);
+		}
+	}
+	(void)h;
+}
+
+} // namespace
+
+std::unique_ptr<FrontEnd> makeCpuFrontEnd(int threads)
+{
+	return std::make_unique<CpuFrontEnd>(threads);
+}
+
+} // namespace frappe

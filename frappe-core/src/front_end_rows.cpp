@@ -1,0 +1,125 @@
+// SPDX-License-Identifier: MIT
+#include "front_end_rows.h"
+
+#include <algorithm>
+#include <cstdlib>
+#include <cstring>
+
+namespace frappe::detail {
+
+void scaleNearest(const ImageView &src, int dstW, int dstH, std::uint8_t *dst)
+{
+	const std::uint64_t stepX = (static_cast<std::uint64_t>(src.width) * 65536u + dstW / 2) / dstW;
+	const std::uint64_t stepY = (static_cast<std::uint64_t>(src.height) * 65536u + dstH / 2) / dstH;
+	for (int y = 0; y < dstH; ++y) {
+		const int sy = std::min<int>(src.height - 1, static_cast<int>(((2u * y + 1) * stepY) >> 17));
+		const std::uint8_t *row = src.row(sy);
+		std::uint8_t *out = dst + static_cast<std::size_t>(y) * dstW;
+		for (int x = 0; x < dstW; ++x) {
+			const int sx = std::min<int>(src.width - 1, static_cast<int>(((2u * x + 1) * stepX) >> 17));
+			out[x] = row[sx];
+		}
+	}
+}
+
+void gradientRow(const ImageView &src, int r, std::int16_t *gx, std::int16_t *gy,
+		 std::int32_t *mag)
+{
+	const int w = src.width;
+	if (r <= 0 || r >= src.height - 1) {
+		std::memset(gx, 0, sizeof(*gx) * w);
+		std::memset(gy, 0, sizeof(*gy) * w);
+		std::memset(mag, 0, sizeof(*mag) * w);
+		return;
+	}
+	const std::uint8_t *a = src.row(r - 1);
+	const std::uint8_t *b = src.row(r);
+	const std::uint8_t *c = src.row(r + 1);
+	gx[0] = gy[0] = 0;
+	mag[0] = 0;
+	gx[w - 1] = gy[w - 1] = 0;
+	mag[w - 1] = 0;
+	for (int x = 1; x < w - 1; ++x) {
+		const int sx = (a[x + 1] + 2 * b[x + 1] + c[x + 1]) - (a[x - 1] + 2 * b[x - 1] + c[x - 1]);
+		const int sy = (c[x - 1] + 2 * c[x] + c[x + 1]) - (a[x - 1] + 2 * a[x] + a[x + 1]);
+		gx[x] = static_cast<std::int16_t>(sx);
+		gy[x] = static_cast<std::int16_t>(sy);
+		mag[x] = sx * sx + sy * sy;
+	}
+}
+
+bool isCorner(const GradRows &rows, int x, std::int64_t cornerThreshold)
+{
+	std::int32_t sxx = 0, syy = 0, sxy = 0;
+	for (int r = 0; r < 3; ++r) {
+		for (int dx = -1; dx <= 1; ++dx) {
+			const std::int32_t gx = rows.gx[r][x + dx];
+			const std::int32_t gy = rows.gy[r][x + dx];
+			sxx += gx * gx;
+			syy += gy * gy;
+			sxy += gx * gy;
+		}
+	}
+	const std::int64_t s = static_cast<std::int64_t>(sxx) + syy - 2 * cornerThreshold;
+	if (s <= 0)
+		return false;
+	const std::int64_t d = static_cast<std::int64_t>(sxx) - syy;
+	return s * s > d * d + 4 * static_cast<std::int64_t>(sxy) * sxy;
+}
+
+bool edgeRow(const GradRows &rows, int w, const FrontEndParams &params, std::uint8_t *out)
+{
+	const std::int32_t *up = rows.mag[0];
+	const std::int32_t *mid = rows.mag[1];
+	const std::int32_t *down = rows.mag[2];
+	const std::int16_t *gxr = rows.gx[1];
+	const std::int16_t *gyr = rows.gy[1];
+	const std::int64_t thr = params.edge_threshold_sq;
+	bool any = false;
+	out[0] = 0;
+	out[w - 1] = 0;
+	for (int x = 1; x < w - 1; ++x) {
+		const std::int32_t m = mid[x];
+		std::uint8_t v = 0;
+		if (m > thr) {
+			const int gx = gxr[x], gy = gyr[x];
+			const int ax = std::abs(gx), ay = std::abs(gy);
+			std::int32_t prev, next;
+			if (256 * ay <= 106 * ax) {
+				prev = mid[x - 1];
+				next = mid[x + 1];
+			} else if (256 * ax <= 106 * ay) {
+				prev = up[x];
+				next = down[x];
+			} else if ((gx > 0) == (gy > 0)) {
+				prev = up[x - 1];
+				next = down[x + 1];
+			} else {
+				prev = up[x + 1];
+				next = down[x - 1];
+			}
+			if (m > prev && m >= next) {
+				v = EdgeMap::kEdge;
+				if (isCorner(rows, x, params.corner_threshold))
+					v |= EdgeMap::kCorner;
+				any = true;
+			}
+		}
+		out[x] = v;
+	}
+	return any;
+}
+
+void markTiles(const std::uint8_t *edgeRow, int w, std::uint8_t *tileRow)
+{
+	for (int x0 = 0, t = 0; x0 < w; x0 += EdgeMap::kTile, ++t) {
+		const int x1 = std::min(w, x0 + EdgeMap::kTile);
+		std::uint8_t acc = 0;
+		for (int x = x0; x < x1; ++x)
+			acc |= edgeRow[x];
+		if (acc)
+			tileRow[t] = 1;
+	}
+}
+
+} // namespace frappe::detail

@@ -1,0 +1,53 @@
+// SPDX-License-Identifier: MIT
+// Row kernels of the CPU front end (see front_end_cpu.cpp for the exact
+// arithmetic they implement).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "frappe/edge_map.h"
+#include "frappe/image.h"
+
+namespace frappe::detail {
+
+/// Three consecutive rows (y-1, y, y+1) of gradients and squared magnitudes.
+struct GradRows {
+	const std::int16_t *gx[3];
+	const std::int16_t *gy[3];
+	const std::int32_t *mag[3];
+};
+
+/// Per-thread scratch: a ring of three gradient rows.
+struct RowScratch {
+	std::vector<std::int16_t> gx[3], gy[3];
+	std::vector<std::int32_t> mag[3];
+	void resize(int w)
+	{
+		for (int i = 0; i < 3; ++i) {
+			gx[i].resize(w);
+			gy[i].resize(w);
+			mag[i].resize(w);
+		}
+	}
+};
+
+/// Nearest-neighbour scaling: destination pixel x samples source column
+/// ((2x + 1) * round(65536 * srcW / dstW)) >> 17, clamped; rows likewise.
+void scaleNearest(const ImageView &src, int dstW, int dstH, std::uint8_t *dst);
+
+/// Sobel gradients of row r; all zero on the outermost rows and columns.
+void gradientRow(const ImageView &src, int r, std::int16_t *gx, std::int16_t *gy,
+		 std::int32_t *mag);
+
+/// Non-maximum suppression, edge threshold and corner test of the middle
+/// row. Writes w bytes; returns whether any pixel is an edge.
+bool edgeRow(const GradRows &rows, int w, const FrontEndParams &params, std::uint8_t *out);
+
+/// ORs each 16-pixel run of an edge row into its tile's occupancy byte.
+void markTiles(const std::uint8_t *edgeRow, int w, std::uint8_t *tileRow);
+
+/// The corner decision for one pixel from its 3x3 gradient neighbourhood.
+bool isCorner(const GradRows &rows, int x, std::int64_t cornerThreshold);
+
+} // namespace frappe::detail

@@ -1,0 +1,28 @@
+// SPDX-License-Identifier: MIT
+// Bilinear sampling of an 8-bit image, pixel centres at integers.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+
+#include "frappe/image.h"
+
+namespace frappe::detail {
+
+/// Intensity at (x, y), bilinear, clamped to the image.
+inline float sampleBilinear(const ImageView &img, float x, float y)
+{
+	x = std::clamp(x, 0.0f, static_cast<float>(img.width - 1));
+	y = std::clamp(y, 0.0f, static_cast<float>(img.height - 1));
+	const int x0 = std::min(static_cast<int>(x), img.width - 2 < 0 ? 0 : img.width - 2);
+	const int y0 = std::min(static_cast<int>(y), img.height - 2 < 0 ? 0 : img.height - 2);
+	const int x1 = std::min(x0 + 1, img.width - 1), y1 = std::min(y0 + 1, img.height - 1);
+	const float fx = x - static_cast<float>(x0), fy = y - static_cast<float>(y0);
+	const std::uint8_t *r0 = img.row(y0);
+	const std::uint8_t *r1 = img.row(y1);
+	const float top = static_cast<float>(r0[x0]) + fx * static_cast<float>(r0[x1] - r0[x0]);
+	const float bot = static_cast<float>(r1[x0]) + fx * static_cast<float>(r1[x1] - r1[x0]);
+	return top + fy * (bot - top);
+}
+
+} // namespace frappe::detail
