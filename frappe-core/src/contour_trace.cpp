@@ -11,6 +11,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <cstdio>
+#include <cstdlib>
 
 namespace frappe::detail {
 
@@ -78,7 +80,9 @@ void ContourTracer::trace(const EdgeMap &edges, const TraceParams &params, std::
 			Quad quad;
 			const bool found = (!tooManyClusters_ && clusters_.size() >= 4 && quadFromClusters(quad)) ||
 					   quadFromOutline(quad);
-			if (found && acceptQuad(params, w, h, quad))
+			const bool acc = found && acceptQuad(params, w, h, quad);
+			if (getenv("FRAPPE_DBG") && steps_ > 60) { fprintf(stderr, "border at %d,%d %s steps %d clusters %zu found %d acc %d:", x, y, fromDir?"outer":"hole", steps_, clusters_.size(), found, acc); for (auto&c:clusters_) fprintf(stderr, " (%.0f,%.0f)x%d", c.sx/c.n, c.sy/c.n, c.n); fprintf(stderr, "\n"); }
+			if (acc)
 				out.push_back(quad);
 		}
 	}

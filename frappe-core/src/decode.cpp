@@ -3,8 +3,10 @@
 
 #include <algorithm>
 #include <bit>
+#include <cmath>
 
 #include "frappe/homography.h"
+#include "corner_refine.h"
 #include "sampling.h"
 
 namespace frappe::detail {
@@ -25,6 +27,27 @@ bool warpMarker(const ImageView &image, const std::array<Point2f, 4> &corners, i
 			out.samples[static_cast<std::size_t>(j) * side + i] = sampleBilinear(image, p.x, p.y);
 		}
 	}
+	return true;
+}
+
+bool insetQuad(const ImageView &image, std::array<Point2f, 4> &corners, int bits,
+	       WarpedMarker &out)
+{
+	const auto H = Homography::fromUnitSquare(corners);
+	if (!H)
+		return false;
+	const double m = 1.0 / (bits + 4);
+	std::array<Point2f, 4> inner = { H->map(m, m), H->map(1 - m, m), H->map(1 - m, 1 - m), H->map(m, 1 - m) };
+	float cell = 1e9f;
+	for (int i = 0; i < 4; ++i) {
+		const float dx = inner[i].x - inner[(i + 1) & 3].x, dy = inner[i].y - inner[(i + 1) & 3].y;
+		cell = std::min(cell, std::sqrt(dx * dx + dy * dy) / static_cast<float>(bits + 2));
+	}
+	if (!refineCorners(image, inner, std::max(1.5f, 1.2f * cell)))
+		return false;
+	if (!warpMarker(image, inner, bits, out))
+		return false;
+	corners = inner;
 	return true;
 }
 

@@ -29,6 +29,12 @@ struct WarpedMarker {
 bool warpMarker(const ImageView &image, const std::array<Point2f, 4> &corners, int bits,
 		WarpedMarker &out);
 
+/// Treats `corners` as the outline of a one-cell quiet zone: moves them one
+/// cell inwards, re-measures the sides there and warps the result. False
+/// when the inner outline cannot be measured.
+bool insetQuad(const ImageView &image, std::array<Point2f, 4> &corners, int bits,
+	       WarpedMarker &out);
+
 /// The bits of a warped marker, read as in the dictionary files with the
 /// grid's top-left cell first.
 struct Binarised {

@@ -3,6 +3,7 @@
 #include "frappe/detector.h"
 
 #include <chrono>
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -50,6 +51,16 @@ void validate(const Config &c, const Dictionary &d)
 int allowedBorderErrors(int bits)
 {
 	return (4 * (bits + 1)) / 8;
+}
+
+bool sidesAtLeast(const std::array<Point2f, 4> &q, float side)
+{
+	for (int i = 0; i < 4; ++i) {
+		const float dx = q[i].x - q[(i + 1) & 3].x, dy = q[i].y - q[(i + 1) & 3].y;
+		if (dx * dx + dy * dy < side * side)
+			return false;
+	}
+	return true;
 }
 
 /* Largest image side accepted: contour coordinates are ints and buffers are
@@ -127,9 +138,9 @@ void Detector::Impl::backEnd(const ImageView &image, Slot &slot)
 	res.times[Stage::Trace] = msSince(t);
 
 	const float search = 2.5f / scale;
-	const float minSide2 = config.min_marker_side * config.min_marker_side;
 	const int bits = dict->bits;
 	const int borderAllowance = allowedBorderErrors(bits);
+	const int whiteFrame = 3 * bits + 3; /* three quarters of the 4(n+1) border cells */
 	double refineMs = 0, warpMs = 0, decodeMs = 0;
 	for (detail::Quad &q : quads) {
 		t = Clock::now();
@@ -137,28 +148,37 @@ void Detector::Impl::backEnd(const ImageView &image, Slot &slot)
 			p.x = (p.x + 0.5f) / scale - 0.5f;
 			p.y = (p.y + 0.5f) / scale - 0.5f;
 		}
-		const bool refined = detail::refineCorners(image, q.corners, search);
+		std::array<Point2f, 4> outline = q.corners;
+		bool refined = detail::refineCorners(image, q.corners, search);
 		refineMs += msSince(t);
-		if (!refined)
-			continue;
-		bool big = true;
-		for (int i = 0; i < 4; ++i) {
-			const float dx = q.corners[i].x - q.corners[(i + 1) & 3].x;
-			const float dy = q.corners[i].y - q.corners[(i + 1) & 3].y;
-			big = big && dx * dx + dy * dy >= minSide2;
+		detail::Binarised b;
+		if (refined && sidesAtLeast(q.corners, config.min_marker_side)) {
+			++res.candidates;
+			t = Clock::now();
+			refined = detail::warpMarker(image, q.corners, bits, warped);
+			warpMs += msSince(t);
+			t = Clock::now();
+			if (refined)
+				b = detail::binarise(warped, bits);
+			decodeMs += msSince(t);
 		}
-		if (!big)
-			continue;
-
-		++res.candidates;
+		if (!refined || b.border_errors >= whiteFrame) {
+			/* No dark frame inside the outline, or a white one: this may be
+			 * the outline of the quiet zone (the marker's own outline merged
+			 * with its code's edges, as on small or blurred markers). The
+			 * marker would lie one cell inside. */
+			t = Clock::now();
+			q.corners = outline;
+			const bool inset = detail::insetQuad(image, q.corners, bits, warped);
+			refineMs += msSince(t);
+			if (!inset || !sidesAtLeast(q.corners, config.min_marker_side))
+				continue;
+			++res.candidates;
+			t = Clock::now();
+			b = detail::binarise(warped, bits);
+			decodeMs += msSince(t);
+		}
 		t = Clock::now();
-		const bool warpedOk = detail::warpMarker(image, q.corners, bits, warped);
-		warpMs += msSince(t);
-		if (!warpedOk)
-			continue;
-
-		t = Clock::now();
-		const detail::Binarised b = detail::binarise(warped, bits);
 		detail::Decoded d;
 		if (b.contrast >= 10.0f && b.border_errors <= borderAllowance)
 			d = detail::decode(*dict, b.code, maxHamming);

@@ -5,6 +5,10 @@
 //
 // All arithmetic is integer and exactly specified, so that other front ends
 // (the QPU kernels) can reproduce the EdgeMap byte for byte:
+//   p  = the image smoothed by the binomial [1 2 1]x[1 2 1] / 16, rounded,
+//        edges replicated. Blurred edges have a broad, flat gradient
+//        profile; without smoothing, noise splits its crest into broken
+//        zig-zag edges and the marker outline no longer closes.
 //   gx = (p[y-1][x+1] + 2 p[y][x+1] + p[y+1][x+1]) - (same at x-1)
 //   gy = (p[y+1][x-1] + 2 p[y+1][x] + p[y+1][x+1]) - (same at y-1)
 //   m  = gx^2 + gy^2, zero on the outermost row and column
@@ -128,14 +132,26 @@ void CpuFrontEnd::runBand(const ImageView &src, const FrontEndParams &params, Ed
 {
 	const int w = src.width, h = src.height;
 	s.resize(w);
-	/* Ring of three gradient rows: index (row % 3). */
-	for (int r = y0 - 1; r <= y0; ++r)
-		detail::gradientRow(src, r, s.gx[r % 3].data(), s.gy[r % 3].data(), s.mag[r % 3].data());
+	/* Gradient row r needs smoothed rows r-1..r+1; both live in rings. */
+	auto smoothed = [&](int r) { return s.smooth[r & 3].data(); };
+	auto gradient = [&](int r) {
+		const int i = r % 3;
+		if (r <= 0 || r >= h - 1)
+			detail::zeroGradientRow(w, s.gx[i].data(), s.gy[i].data(), s.mag[i].data());
+		else
+			detail::gradientRow(smoothed(r - 1), smoothed(r), smoothed(r + 1), w, s.gx[i].data(),
+					    s.gy[i].data(), s.mag[i].data());
+	};
+	for (int r = std::max(0, y0 - 2); r <= std::min(h - 1, y0 + 1); ++r)
+		detail::smoothRow(src, r, smoothed(r));
+	gradient(y0 - 1);
+	gradient(y0);
 
 	for (int y = y0; y < y1; ++y) {
 		const int next = y + 1;
-		detail::gradientRow(src, next, s.gx[next % 3].data(), s.gy[next % 3].data(),
-				    s.mag[next % 3].data());
+		if (next + 1 <= h - 1)
+			detail::smoothRow(src, next + 1, smoothed(next + 1));
+		gradient(next);
 		const detail::GradRows rows{
 			{ s.gx[(y - 1) % 3].data(), s.gx[y % 3].data(), s.gx[next % 3].data() },
 			{ s.gy[(y - 1) % 3].data(), s.gy[y % 3].data(), s.gy[next % 3].data() },
@@ -149,7 +165,6 @@ void CpuFrontEnd::runBand(const ImageView &src, const FrontEndParams &params, Ed
 			detail::markTiles(edgeRow, w, tileRow);
 		}
 	}
-	(void)h;
 }
 
 } // namespace

@@ -22,19 +22,26 @@ void scaleNearest(const ImageView &src, int dstW, int dstH, std::uint8_t *dst)
 	}
 }
 
-void gradientRow(const ImageView &src, int r, std::int16_t *gx, std::int16_t *gy,
-		 std::int32_t *mag)
+void smoothRow(const ImageView &src, int r, std::uint8_t *out)
 {
-	const int w = src.width;
-	if (r <= 0 || r >= src.height - 1) {
-		std::memset(gx, 0, sizeof(*gx) * w);
-		std::memset(gy, 0, sizeof(*gy) * w);
-		std::memset(mag, 0, sizeof(*mag) * w);
+	const int w = src.width, h = src.height;
+	const std::uint8_t *a = src.row(std::max(r - 1, 0));
+	const std::uint8_t *b = src.row(r);
+	const std::uint8_t *c = src.row(std::min(r + 1, h - 1));
+	auto column = [&](int x) { return a[x] + 2 * b[x] + c[x]; };
+	if (w == 1) {
+		out[0] = static_cast<std::uint8_t>((4 * column(0) + 8) >> 4);
 		return;
 	}
-	const std::uint8_t *a = src.row(r - 1);
-	const std::uint8_t *b = src.row(r);
-	const std::uint8_t *c = src.row(r + 1);
+	out[0] = static_cast<std::uint8_t>((3 * column(0) + column(1) + 8) >> 4);
+	for (int x = 1; x < w - 1; ++x)
+		out[x] = static_cast<std::uint8_t>((column(x - 1) + 2 * column(x) + column(x + 1) + 8) >> 4);
+	out[w - 1] = static_cast<std::uint8_t>((column(w - 2) + 3 * column(w - 1) + 8) >> 4);
+}
+
+void gradientRow(const std::uint8_t *a, const std::uint8_t *b, const std::uint8_t *c, int w,
+		 std::int16_t *gx, std::int16_t *gy, std::int32_t *mag)
+{
 	gx[0] = gy[0] = 0;
 	mag[0] = 0;
 	gx[w - 1] = gy[w - 1] = 0;
@@ -46,6 +53,13 @@ void gradientRow(const ImageView &src, int r, std::int16_t *gx, std::int16_t *gy
 		gy[x] = static_cast<std::int16_t>(sy);
 		mag[x] = sx * sx + sy * sy;
 	}
+}
+
+void zeroGradientRow(int w, std::int16_t *gx, std::int16_t *gy, std::int32_t *mag)
+{
+	std::memset(gx, 0, sizeof(*gx) * w);
+	std::memset(gy, 0, sizeof(*gy) * w);
+	std::memset(mag, 0, sizeof(*mag) * w);
 }
 
 bool isCorner(const GradRows &rows, int x, std::int64_t cornerThreshold)

@@ -18,12 +18,15 @@ struct GradRows {
 	const std::int32_t *mag[3];
 };
 
-/// Per-thread scratch: a ring of three gradient rows.
+/// Per-thread scratch: rings of smoothed rows and of gradient rows.
 struct RowScratch {
+	std::vector<std::uint8_t> smooth[4];
 	std::vector<std::int16_t> gx[3], gy[3];
 	std::vector<std::int32_t> mag[3];
 	void resize(int w)
 	{
+		for (int i = 0; i < 4; ++i)
+			smooth[i].resize(w);
 		for (int i = 0; i < 3; ++i) {
 			gx[i].resize(w);
 			gy[i].resize(w);
@@ -36,9 +39,17 @@ struct RowScratch {
 /// ((2x + 1) * round(65536 * srcW / dstW)) >> 17, clamped; rows likewise.
 void scaleNearest(const ImageView &src, int dstW, int dstH, std::uint8_t *dst);
 
-/// Sobel gradients of row r; all zero on the outermost rows and columns.
-void gradientRow(const ImageView &src, int r, std::int16_t *gx, std::int16_t *gy,
-		 std::int32_t *mag);
+/// Row r of the image smoothed by the 3x3 binomial kernel [1 2 1]^T [1 2 1] / 16,
+/// rounded, with edge pixels replicated beyond the frame.
+void smoothRow(const ImageView &src, int r, std::uint8_t *out);
+
+/// Sobel gradients of the middle of three smoothed rows a, b, c; zero in
+/// the first and last column.
+void gradientRow(const std::uint8_t *a, const std::uint8_t *b, const std::uint8_t *c, int w,
+		 std::int16_t *gx, std::int16_t *gy, std::int32_t *mag);
+
+/// The gradient row of the outermost image rows: all zero.
+void zeroGradientRow(int w, std::int16_t *gx, std::int16_t *gy, std::int32_t *mag);
 
 /// Non-maximum suppression, edge threshold and corner test of the middle
 /// row. Writes w bytes; returns whether any pixel is an edge.
