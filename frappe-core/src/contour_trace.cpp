@@ -9,10 +9,9 @@
 #include "contour_trace.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstring>
-#include <cstdio>
-#include <cstdlib>
 
 namespace frappe::detail {
 
@@ -77,12 +76,12 @@ void ContourTracer::trace(const EdgeMap &edges, const TraceParams &params, std::
 			/* A marker outline is at least four sides of min_side pixels. */
 			if (static_cast<float>(steps_) < 2.8f * params.min_side)
 				continue;
+			/* The paper's rule first: the corner clusters; failing that,
+			 * the outline's extreme points. */
 			Quad quad;
-			const bool found = (!tooManyClusters_ && clusters_.size() >= 4 && quadFromClusters(quad)) ||
-					   quadFromOutline(quad);
-			const bool acc = found && acceptQuad(params, w, h, quad);
-			if (getenv("FRAPPE_DBG") && steps_ > 60) { fprintf(stderr, "border at %d,%d %s steps %d clusters %zu found %d acc %d:", x, y, fromDir?"outer":"hole", steps_, clusters_.size(), found, acc); for (auto&c:clusters_) fprintf(stderr, " (%.0f,%.0f)x%d", c.sx/c.n, c.sy/c.n, c.n); fprintf(stderr, "\n"); }
-			if (acc)
+			if ((!tooManyClusters_ && clusters_.size() >= 4 && quadFromClusters(quad) &&
+			     acceptQuad(params, w, h, quad)) ||
+			    (quadFromOutline(quad) && acceptQuad(params, w, h, quad)))
 				out.push_back(quad);
 		}
 	}
@@ -178,16 +177,26 @@ void ContourTracer::follow(int x0, int y0, int fromDir, const EdgeMap &edges)
 bool ContourTracer::quadFromClusters(Quad &quad) const
 {
 	const int n = static_cast<int>(clusters_.size());
-	Point2f c[kMaxClusters];
+	std::array<Point2f, kMaxClusters> c{};
 	for (int i = 0; i < n; ++i)
 		c[i] = { clusters_[i].sx / static_cast<float>(clusters_[i].n),
 			 clusters_[i].sy / static_cast<float>(clusters_[i].n) };
+	/* Order by angle about the centre: a border that wanders through a gap
+	 * can meet the corners out of turn. */
+	float mx = 0, my = 0;
+	for (int i = 0; i < n; ++i) {
+		mx += c[i].x / static_cast<float>(n);
+		my += c[i].y / static_cast<float>(n);
+	}
+	std::sort(c.begin(), c.begin() + n, [&](Point2f p, Point2f q) {
+		return std::atan2(p.y - my, p.x - mx) < std::atan2(q.y - my, q.x - mx);
+	});
 	float bestArea = 0.0f;
 	for (int a = 0; a < n; ++a)
 		for (int b = a + 1; b < n; ++b)
 			for (int cc = b + 1; cc < n; ++cc)
 				for (int d = cc + 1; d < n; ++d) {
-					/* Clusters are in border order, so a-b-c-d is a simple polygon. */
+					/* In angular order a-b-c-d is a simple polygon. */
 					const float area = 0.5f * std::abs(cross(c[a], c[b], c[cc]) + cross(c[a], c[cc], c[d]));
 					if (area > bestArea) {
 						bestArea = area;
@@ -278,32 +287,38 @@ bool ContourTracer::acceptQuad(const TraceParams &params, int w, int h, Quad &qu
 		    q[i].y > static_cast<float>(h - 1) - m)
 			return false;
 	}
-	/* A closed outline is followed in about one step per pixel of perimeter
-	 * (8-connected steps are 0.71 to 1 px). An open curve, or one with spurs,
-	 * is walked out and back: far more steps than its corners explain. */
-	if (static_cast<float>(steps_) > 1.25f * perimeter + 8.0f ||
-	    static_cast<float>(steps_) < 0.6f * perimeter)
-		return false;
-
-	/* Every border pixel must lie close to one of the four sides. */
-	float nx[4], ny[4], nc[4];
+	/* The border must run along all four sides: an open curve, or a corner
+	 * cluster that is no corner, leaves a side without border pixels. A
+	 * border that also wanders inside (through a gap in a blurred outline)
+	 * still covers the four sides, and is kept. */
+	float nx[4], ny[4], nc[4], ox[4], oy[4], len[4];
 	for (int i = 0; i < 4; ++i) {
 		const Point2f a = q[i], b = q[(i + 1) & 3];
-		const float len = std::sqrt(dist2(a, b));
-		nx[i] = -(b.y - a.y) / len;
-		ny[i] = (b.x - a.x) / len;
+		len[i] = std::sqrt(dist2(a, b));
+		ox[i] = (b.x - a.x) / len[i];
+		oy[i] = (b.y - a.y) / len[i];
+		nx[i] = -oy[i];
+		ny[i] = ox[i];
 		nc[i] = nx[i] * a.x + ny[i] * a.y;
 	}
-	const float tol = std::max(2.0f, 0.08f * std::sqrt(shortest));
-	int off = 0;
+	const float tol = std::max(1.5f, 0.06f * std::sqrt(shortest));
+	constexpr int kBins = 16;
+	std::uint32_t covered[4] = {};
 	for (const Pixel &p : points_) {
-		float best = 1e30f;
-		for (int i = 0; i < 4; ++i)
-			best = std::min(best, std::abs(nx[i] * static_cast<float>(p.x) + ny[i] * static_cast<float>(p.y) - nc[i]));
-		off += best > tol;
+		const float px = static_cast<float>(p.x), py = static_cast<float>(p.y);
+		for (int i = 0; i < 4; ++i) {
+			if (std::abs(nx[i] * px + ny[i] * py - nc[i]) > tol)
+				continue;
+			const float t = (ox[i] * (px - q[i].x) + oy[i] * (py - q[i].y)) / len[i];
+			if (t >= 0.0f && t < 1.0f)
+				covered[i] |= 1u << static_cast<int>(t * kBins);
+		}
 	}
-	/* A few pixels of a rounded corner may stray; a side that bulges may not. */
-	return off * 20 <= static_cast<int>(points_.size());
+	for (int i = 0; i < 4; ++i) {
+		if (std::popcount(covered[i]) < kBins * 7 / 16)
+			return false;
+	}
+	return true;
 }
 
 void removeDuplicateQuads(std::vector<Quad> &quads, float tolerance)

@@ -1,0 +1,140 @@
+// SPDX-License-Identifier: MIT
+// frappe-render: draws markers, for printing or for test scenes.
+//
+//   frappe-render --dictionary aruco_mip_36h12 --id 7 --cell 40 marker7.png
+//   frappe-render --scene --dictionary apriltag_36h11 --seed 3 scene.png   (+ scene.json truth)
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <random>
+#include <string>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "frappe/frappe.h"
+#include "frappe/render.h"
+
+namespace {
+
+const char kUsage[] =
+	"usage: frappe-render [--dictionary NAME] [--id N] [--cell PX] [--quiet CELLS] OUT.png\n"
+	"       frappe-render --scene [--dictionary NAME] [--seed S] [--count N] OUT.png\n"
+	"\n"
+	"The first form draws one marker upright, for printing. The second draws a\n"
+	"640x480 scene of markers under perspective, blur and noise, and writes their\n"
+	"ids and corners (OpenCV order, pixel centres at integers) to OUT.json.\n";
+
+[[noreturn]] void fail(const std::string &m)
+{
+	std::cerr << "frappe-render: " << m << "\n(try --help)\n";
+	std::exit(2);
+}
+
+/* Corners of a square of `side` px at (cx, cy), rolled, tilted about its
+ * horizontal axis and projected by a camera 4 sides away. */
+std::array<frappe::Point2f, 4> pose(double cx, double cy, double side, double roll, double tilt)
+{
+	const double r = roll * M_PI / 180, t = tilt * M_PI / 180;
+	const double xs[4] = { -0.5, 0.5, 0.5, -0.5 }, ys[4] = { -0.5, -0.5, 0.5, 0.5 };
+	std::array<frappe::Point2f, 4> q;
+	for (int i = 0; i < 4; ++i) {
+		const double Z = 4 + ys[i] * std::sin(t);
+		const double u = 4 * xs[i] / Z, v = 4 * ys[i] * std::cos(t) / Z;
+		q[i] = { static_cast<float>(cx + side * (u * std::cos(r) - v * std::sin(r))),
+			 static_cast<float>(cy + side * (u * std::sin(r) + v * std::cos(r))) };
+	}
+	return q;
+}
+
+} // namespace
+
+int main(int argc, char **argv)
+{
+	std::string dictName = "aruco_mip_36h12", out;
+	int id = 0, cell = 20, quiet = 1, seed = 1, count = 6;
+	bool scene = false;
+	for (int i = 1; i < argc; ++i) {
+		const std::string a = argv[i];
+		auto value = [&]() -> std::string {
+			if (i + 1 >= argc)
+				fail(a + " needs a value");
+			return argv[++i];
+		};
+		if (a == "-h" || a == "--help") {
+			std::cout << kUsage;
+			return 0;
+		} else if (a == "--dictionary" || a == "-d") {
+			dictName = value();
+		} else if (a == "--id") {
+			id = std::stoi(value());
+		} else if (a == "--cell") {
+			cell = std::stoi(value());
+		} else if (a == "--quiet") {
+			quiet = std::stoi(value());
+		} else if (a == "--seed") {
+			seed = std::stoi(value());
+		} else if (a == "--count") {
+			count = std::stoi(value());
+		} else if (a == "--scene") {
+			scene = true;
+		} else if (a[0] == '-') {
+			fail("unknown option " + a);
+		} else {
+			out = a;
+		}
+	}
+	const frappe::Dictionary *dict = frappe::findDictionary(dictName);
+	if (!dict)
+		fail("unknown dictionary '" + dictName + "'; known: " + frappe::dictionaryNames());
+	if (out.empty())
+		fail("no output file");
+
+	if (!scene) {
+		if (id < 0 || id >= dict->size())
+			fail("id must be in 0.." + std::to_string(dict->size() - 1));
+		int side = 0;
+		auto px = frappe::markerImage(*dict, id, cell, quiet, side);
+		cv::Mat img(side, side, CV_8UC1, px.data());
+		return cv::imwrite(out, img) ? 0 : 1;
+	}
+
+	/* A scene: a textured backdrop, markers in a loose grid, then optics. */
+	std::mt19937 rng(seed);
+	std::uniform_real_distribution<double> U(0, 1);
+	cv::Mat img(480, 640, CV_8UC1);
+	for (int y = 0; y < 480; ++y)
+		for (int x = 0; x < 640; ++x)
+			img.at<std::uint8_t>(y, x) = static_cast<std::uint8_t>(
+				90 + 40 * std::sin(x * 0.021 + y * 0.013) + 25 * std::sin(x * 0.11) * std::cos(y * 0.07));
+	frappe::MutableImageView view{ img.data, 640, 480, static_cast<int>(img.step[0]) };
+	std::ofstream json(out.substr(0, out.find_last_of('.')) + ".json");
+	json << "{\"image\": \"" << out.substr(out.find_last_of('/') + 1) << "\", \"family\": \"" << dict->name
+	     << "\", \"markers\": [";
+	const int cols = 3, rows = (count + cols - 1) / cols;
+	for (int k = 0; k < count; ++k) {
+		const int mid = static_cast<int>(U(rng) * dict->size());
+		const double cx = 110 + (k % cols) * 210 + 20 * (U(rng) - 0.5);
+		const double cy = 480.0 / (rows + 1) * (k / cols + 1) + 20 * (U(rng) - 0.5);
+		const double side = 50 + 70 * U(rng);
+		const auto q = pose(cx, cy, side, 360 * U(rng), 50 * U(rng));
+		frappe::RenderOptions opt;
+		opt.black = static_cast<std::uint8_t>(15 + 20 * U(rng));
+		opt.white = static_cast<std::uint8_t>(200 + 50 * U(rng));
+		frappe::renderMarker(view, *dict, mid, q, opt);
+		char buf[256];
+		std::snprintf(buf, sizeof(buf), "%s{\"id\": %d, \"corners\": [[%.3f, %.3f], [%.3f, %.3f], [%.3f, %.3f], [%.3f, %.3f]]}",
+			      k ? ", " : "", mid, q[0].x, q[0].y, q[1].x, q[1].y, q[2].x, q[2].y, q[3].x, q[3].y);
+		json << buf;
+	}
+	json << "]}\n";
+	cv::GaussianBlur(img, img, cv::Size(0, 0), 0.7);
+	cv::Mat noise(img.size(), CV_16SC1);
+	cv::randn(noise, 0, 3);
+	cv::Mat wide;
+	img.convertTo(wide, CV_16SC1);
+	wide += noise;
+	wide.convertTo(img, CV_8UC1);
+	return cv::imwrite(out, img) ? 0 : 1;
+}

@@ -1,0 +1,80 @@
+#!/usr/bin/env python3
+"""frappe-detect as a user meets it: the contract mode, the human mode,
+unreadable files and bad options.
+
+usage: test_cli.py FRAPPE_DETECT
+"""
+import json
+import os
+import subprocess
+import sys
+import tempfile
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+SAMPLES = os.path.join(HERE, '..', '..', 'examples', 'images')
+
+
+def run(*args, cwd=None):
+    return subprocess.run(list(args), capture_output=True, text=True, cwd=cwd)
+
+
+def check(cond, what):
+    if not cond:
+        print('FAIL: ' + what)
+        sys.exit(1)
+    print('ok: ' + what)
+
+
+def main():
+    exe = sys.argv[1]
+    sample = os.path.join(SAMPLES, 'markers-36h12.png')
+    expected = json.load(open(os.path.join(SAMPLES, 'markers-36h12.json')))
+    with tempfile.TemporaryDirectory() as tmp:
+        # Contract mode, with a missing and an unreadable file in the list.
+        bad = os.path.join(tmp, 'not-an-image.png')
+        with open(bad, 'w') as f:
+            f.write('hello')
+        lst = os.path.join(tmp, 'list.txt')
+        with open(lst, 'w') as f:
+            f.write('# a comment\n\n%s\n%s\n%s\n' % (sample, os.path.join(tmp, 'missing.png'), bad))
+        out = os.path.join(tmp, 'dets.jsonl')
+        r = run(exe, '--dictionary', 'aruco_mip_36h12', '--list', lst, '--out', out, '--repeat', '3',
+                '--threads', '1')
+        check(r.returncode == 0, 'contract mode exits 0 with bad images in the list')
+        lines = [json.loads(l) for l in open(out)]
+        check(len(lines) == 3, 'one JSON line per listed image')
+        check(lines[0]['image'] == sample, 'image path exactly as listed')
+        ids = sorted(m['id'] for m in lines[0]['markers'])
+        check(ids == sorted(m['id'] for m in expected['markers']), 'sample ids %s' % ids)
+        for m in lines[0]['markers']:
+            truth = next(t for t in expected['markers'] if t['id'] == m['id'])
+            err = max(abs(a - b) for p, q in zip(m['corners'], truth['corners']) for a, b in zip(p, q))
+            check(err < 0.5, 'id %d corners within 0.5 px of the rendered truth (%.3f)' % (m['id'], err))
+        check(lines[0]['time_ms'] > 0, 'time_ms reported')
+        check('error' in lines[1] and lines[1]['markers'] == [], 'missing file is an error entry')
+        check('error' in lines[2], 'undecodable file is an error entry')
+        check('missing.png' in r.stderr and 'not-an-image.png' in r.stderr, 'errors on stderr')
+
+        # Human mode.
+        png = os.path.join(tmp, 'annotated.png')
+        r = run(exe, sample, '--annotate', png)
+        check(r.returncode == 0, 'human mode exits 0')
+        check(('%d markers' % len(expected['markers'])) in r.stdout, 'prints the marker count')
+        check(os.path.getsize(png) > 1000, 'writes the annotated image')
+        r = run(exe, os.path.join(tmp, 'missing.png'))
+        check(r.returncode == 1 and 'cannot open' in r.stderr, 'unreadable file in human mode: exit 1')
+
+        # Bad options.
+        r = run(exe, '--dictionary', 'nope', sample)
+        check(r.returncode == 2 and "unknown dictionary 'nope'" in r.stderr, 'unknown dictionary named')
+        r = run(exe, '--repeat', 'x', sample)
+        check(r.returncode == 2, 'non-numeric --repeat rejected')
+        r = run(exe, '--dictionaries')
+        check(r.returncode == 0 and 'apriltag_36h11' in r.stdout, '--dictionaries lists them')
+        r = run(exe, '--list', os.path.join(tmp, 'nolist.txt'), '--out', out)
+        check(r.returncode == 2, 'missing list file is an error')
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())

@@ -1,0 +1,149 @@
+// SPDX-License-Identifier: MIT
+// Suzuki border following and candidate selection on hand-made edge maps.
+#include <gtest/gtest.h>
+
+#include "contour_trace.h"
+#include "frappe/edge_map.h"
+
+using namespace frappe;
+using namespace frappe::detail;
+
+namespace {
+
+EdgeMap emptyMap(int w, int h)
+{
+	EdgeMap em;
+	em.resize(w, h);
+	std::fill(em.pixels.begin(), em.pixels.end(), 0);
+	std::fill(em.tiles.begin(), em.tiles.end(), 0);
+	return em;
+}
+
+void set(EdgeMap &em, int x, int y, std::uint8_t v)
+{
+	em.pixels[static_cast<std::size_t>(y) * em.width + x] = v;
+	em.tiles[static_cast<std::size_t>(y / EdgeMap::kTile) * em.tiles_x + x / EdgeMap::kTile] = 1;
+}
+
+/* A one-pixel ring around [x0, x1] x [y0, y1] with corner flags on the four
+ * corner pixels and their neighbours along the ring. */
+void ring(EdgeMap &em, int x0, int y0, int x1, int y1)
+{
+	for (int x = x0; x <= x1; ++x) {
+		set(em, x, y0, EdgeMap::kEdge);
+		set(em, x, y1, EdgeMap::kEdge);
+	}
+	for (int y = y0; y <= y1; ++y) {
+		set(em, x0, y, EdgeMap::kEdge);
+		set(em, x1, y, EdgeMap::kEdge);
+	}
+	const int cx[4] = { x0, x1, x1, x0 }, cy[4] = { y0, y0, y1, y1 };
+	for (int k = 0; k < 4; ++k) {
+		for (int d = -1; d <= 1; ++d) {
+			const int xs[2] = { cx[k] + d, cx[k] }, ys[2] = { cy[k], cy[k] + d };
+			for (int j = 0; j < 2; ++j)
+				if (xs[j] >= x0 && xs[j] <= x1 && ys[j] >= y0 && ys[j] <= y1)
+					set(em, xs[j], ys[j], EdgeMap::kEdge | EdgeMap::kCorner);
+		}
+	}
+}
+
+} // namespace
+
+TEST(ContourTrace, OneRingGivesOneQuadAtItsCorners)
+{
+	EdgeMap em = emptyMap(80, 60);
+	ring(em, 20, 15, 50, 40);
+	ContourTracer tracer;
+	std::vector<Quad> quads;
+	tracer.trace(em, TraceParams{}, quads);
+	/* The outer and the hole border of the ring: both found... */
+	EXPECT_EQ(quads.size(), 2u);
+	EXPECT_EQ(tracer.bordersFollowed(), 2);
+	/* ...and one survives de-duplication. */
+	removeDuplicateQuads(quads, 2.5f);
+	ASSERT_EQ(quads.size(), 1u);
+	const Quad &q = quads[0];
+	/* Clockwise on screen: positive signed area in y-down coordinates. */
+	float area = 0;
+	for (int i = 0; i < 4; ++i)
+		area += q.corners[i].x * q.corners[(i + 1) & 3].y - q.corners[(i + 1) & 3].x * q.corners[i].y;
+	EXPECT_GT(area, 0.0f);
+	const float ex[4] = { 20, 50, 50, 20 }, ey[4] = { 15, 15, 40, 40 };
+	for (const Point2f &c : q.corners) {
+		bool near = false;
+		for (int k = 0; k < 4; ++k)
+			near = near || (std::abs(c.x - ex[k]) <= 1.0f && std::abs(c.y - ey[k]) <= 1.0f);
+		EXPECT_TRUE(near) << c.x << "," << c.y;
+	}
+}
+
+TEST(ContourTrace, OpenCurveIsNotACandidate)
+{
+	EdgeMap em = emptyMap(80, 60);
+	ring(em, 20, 15, 50, 40);
+	/* Remove the bottom side: a U is three sides, not a marker outline. */
+	for (int x = 21; x <= 49; ++x)
+		em.pixels[static_cast<std::size_t>(40) * em.width + x] = 0;
+	ContourTracer tracer;
+	std::vector<Quad> quads;
+	tracer.trace(em, TraceParams{}, quads);
+	EXPECT_TRUE(quads.empty());
+}
+
+TEST(ContourTrace, OutlineWithAGapIsStillACandidate)
+{
+	/* Blur breaks outlines; a border that runs along all four sides is
+	 * kept even when it slips through a gap. */
+	EdgeMap em = emptyMap(80, 60);
+	ring(em, 20, 15, 50, 40);
+	for (int x = 33; x <= 36; ++x)
+		em.pixels[static_cast<std::size_t>(40) * em.width + x] = 0;
+	ContourTracer tracer;
+	std::vector<Quad> quads;
+	tracer.trace(em, TraceParams{}, quads);
+	removeDuplicateQuads(quads, 2.5f);
+	ASSERT_EQ(quads.size(), 1u);
+}
+
+TEST(ContourTrace, TooSmallAndTouchingTheFrameAreDropped)
+{
+	EdgeMap em = emptyMap(80, 60);
+	ring(em, 10, 10, 15, 15); /* 5 px sides < min_side 8 */
+	ring(em, 1, 20, 30, 50);  /* corner on the frame margin */
+	ContourTracer tracer;
+	std::vector<Quad> quads;
+	TraceParams p;
+	p.border_margin = 2.0f;
+	tracer.trace(em, p, quads);
+	EXPECT_TRUE(quads.empty());
+}
+
+TEST(ContourTrace, StrayCornerOnASideIsIgnored)
+{
+	EdgeMap em = emptyMap(80, 60);
+	ring(em, 20, 15, 50, 40);
+	set(em, 35, 15, EdgeMap::kEdge | EdgeMap::kCorner); /* noise half-way along the top */
+	ContourTracer tracer;
+	std::vector<Quad> quads;
+	tracer.trace(em, TraceParams{}, quads);
+	removeDuplicateQuads(quads, 2.5f);
+	ASSERT_EQ(quads.size(), 1u);
+	for (const Point2f &c : quads[0].corners)
+		EXPECT_GT(std::abs(c.x - 35.0f), 5.0f) << "the stray cluster became a corner";
+}
+
+TEST(ContourTrace, EmptyTilesAreSkippedWithoutLosingContours)
+{
+	EdgeMap em = emptyMap(96, 96);
+	ring(em, 40, 40, 70, 70);
+	ContourTracer tracer;
+	std::vector<Quad> quads;
+	tracer.trace(em, TraceParams{}, quads);
+	EXPECT_EQ(quads.size(), 2u);
+	/* Marking its tiles empty hides the ring from the scan entirely. */
+	std::fill(em.tiles.begin(), em.tiles.end(), 0);
+	tracer.trace(em, TraceParams{}, quads);
+	EXPECT_TRUE(quads.empty());
+	EXPECT_EQ(tracer.bordersFollowed(), 0);
+}

@@ -1,0 +1,139 @@
+// SPDX-License-Identifier: MIT
+// Dictionaries and the Hamming decoder: every code of every dictionary in
+// all four rotations, with up to h_thr bits flipped, and h_thr + 1 rejected.
+#include <bit>
+#include <random>
+#include <set>
+
+#include <gtest/gtest.h>
+
+#include "decode.h"
+#include "frappe/dictionary.h"
+
+using namespace frappe;
+
+TEST(Dictionary, AllSharedDictionariesAreBuiltIn)
+{
+	const std::set<std::string_view> expected = {
+		"4x4_50", "4x4_100", "4x4_250", "4x4_1000", "5x5_50", "5x5_100", "5x5_250", "5x5_1000",
+		"6x6_50", "6x6_100", "6x6_250", "6x6_1000", "7x7_50", "7x7_100", "7x7_250", "7x7_1000",
+		"apriltag_16h5", "apriltag_25h9", "apriltag_36h10", "apriltag_36h11", "aruco_mip_36h12",
+		"aruco_original",
+	};
+	std::set<std::string_view> got;
+	for (const Dictionary &d : dictionaries())
+		got.insert(d.name);
+	EXPECT_EQ(got, expected);
+}
+
+TEST(Dictionary, KnownCodesAndSizes)
+{
+	const Dictionary *d = findDictionary("aruco_mip_36h12");
+	ASSERT_NE(d, nullptr);
+	EXPECT_EQ(d->bits, 6);
+	EXPECT_EQ(d->size(), 250);
+	EXPECT_EQ(d->min_hamming, 12);
+	EXPECT_EQ(d->codes[0], 0xd2b63a09dull); /* id 0, from the dictionary README */
+	EXPECT_EQ(d->defaultMaxHamming(), 5);
+	EXPECT_EQ(findDictionary("apriltag_36h11")->size(), 587);
+	EXPECT_EQ(findDictionary("apriltag_36h11")->defaultMaxHamming(), 5);
+	EXPECT_EQ(findDictionary("4x4_50")->defaultMaxHamming(), 1);
+	EXPECT_EQ(findDictionary("aruco_original")->defaultMaxHamming(), 0);
+}
+
+TEST(Dictionary, AliasesAndUnknownNames)
+{
+	EXPECT_EQ(findDictionary("opencv_6x6_250"), findDictionary("6x6_250"));
+	EXPECT_EQ(findDictionary("DICT_6X6_250"), findDictionary("6x6_250"));
+	EXPECT_EQ(findDictionary("DICT_APRILTAG_36h11"), findDictionary("apriltag_36h11"));
+	EXPECT_EQ(findDictionary("tag36h11"), findDictionary("apriltag_36h11"));
+	EXPECT_EQ(findDictionary("ARUCO_MIP_36h12"), findDictionary("aruco_mip_36h12"));
+	EXPECT_EQ(findDictionary("6x6_251"), nullptr);
+	EXPECT_EQ(findDictionary(""), nullptr);
+	EXPECT_NE(dictionaryNames().find("apriltag_16h5"), std::string::npos);
+}
+
+TEST(Dictionary, RotateCodeTurnsTheGridClockwise)
+{
+	/* 2x2 grid: top row a b, bottom row c d -> after a clockwise quarter
+	 * turn: top row c a, bottom row d b. Bits: a=3 b=2 c=1 d=0. */
+	EXPECT_EQ(rotateCode(0b1000, 2), 0b0100u); /* a moves to top-right */
+	EXPECT_EQ(rotateCode(0b0100, 2), 0b0001u); /* b moves to bottom-right */
+	EXPECT_EQ(rotateCode(0b0010, 2), 0b1000u); /* c moves to top-left */
+	for (const Dictionary &d : dictionaries()) {
+		for (int id = 0; id < d.size(); id += 7) {
+			std::uint64_t c = d.codes[id];
+			for (int r = 0; r < 4; ++r)
+				c = rotateCode(c, d.bits);
+			ASSERT_EQ(c, d.codes[id]) << d.name << " id " << id;
+		}
+	}
+}
+
+namespace {
+
+std::uint64_t flipBits(std::uint64_t code, int bits, int flips, std::mt19937 &rng)
+{
+	std::uniform_int_distribution<int> pick(0, bits * bits - 1);
+	std::uint64_t mask = 0;
+	while (std::popcount(mask) < flips)
+		mask |= 1ull << pick(rng);
+	return code ^ mask;
+}
+
+} // namespace
+
+class DictionaryDecode : public ::testing::TestWithParam<int> {};
+
+TEST_P(DictionaryDecode, EveryCodeEveryRotationUpToMaxHamming)
+{
+	const Dictionary &d = dictionaries()[GetParam()];
+	const int h = d.defaultMaxHamming();
+	std::mt19937 rng(1234 + GetParam());
+	/* The 1000-code dictionaries take every 3rd id to bound the run time. */
+	const int step = d.size() > 600 ? 3 : 1;
+	for (int id = 0; id < d.size(); id += step) {
+		/* Seen with the marker turned r quarter turns clockwise, the marker's
+		 * top-left corner sits at quad corner r. */
+		for (int r = 0; r < 4; ++r) {
+			std::uint64_t grid = d.codes[id];
+			for (int t = 0; t < r; ++t)
+				grid = rotateCode(grid, d.bits);
+			const int flips = (id + r) % (h + 1);
+			const std::uint64_t seen = flipBits(grid, d.bits, flips, rng);
+			const detail::Decoded got = detail::decode(d, seen, h);
+			if (got.id != id && d.min_hamming == 0) {
+				/* aruco_original has rotation-symmetric and duplicate
+				 * codes; a decode must still be one of them. */
+				ASSERT_GE(got.id, 0);
+				continue;
+			}
+			ASSERT_EQ(got.id, id) << d.name << " rotation " << r << " flips " << flips;
+			ASSERT_EQ(got.hamming, flips);
+			if (d.min_hamming > 0 && flips == 0) {
+				ASSERT_EQ(got.rotation, r) << d.name << " id " << id;
+			}
+		}
+	}
+}
+
+TEST_P(DictionaryDecode, OneMoreFlipThanMaxHammingIsRejected)
+{
+	const Dictionary &d = dictionaries()[GetParam()];
+	const int h = d.defaultMaxHamming();
+	if (d.min_hamming < 2 * h + 2)
+		GTEST_SKIP() << d.name << ": h_thr + 1 flips may land within h_thr of another code";
+	std::mt19937 rng(99 + GetParam());
+	for (int id = 0; id < d.size(); id += 5) {
+		const std::uint64_t seen = flipBits(d.codes[id], d.bits, h + 1, rng);
+		const detail::Decoded got = detail::decode(d, seen, h);
+		ASSERT_EQ(got.id, -1) << d.name << " id " << id << " decoded as " << got.id;
+	}
+}
+
+INSTANTIATE_TEST_SUITE_P(All, DictionaryDecode,
+			 ::testing::Range(0, static_cast<int>(dictionaries().size())),
+			 [](const auto &info) {
+				 std::string n(dictionaries()[info.param].name);
+				 return n;
+			 });

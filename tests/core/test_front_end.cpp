@@ -1,0 +1,175 @@
+// SPDX-License-Identifier: MIT
+// The CPU front end on small constructed images: where the edges and the
+// corners of a square fall, the tile mask, and independence from stride,
+// threads and padding.
+#include <gtest/gtest.h>
+
+#include "frappe/frappe.h"
+#include "scene.h"
+
+using namespace frappe;
+using frappe::test::Image;
+
+namespace {
+
+FrontEndParams defaultParams()
+{
+	return Detector(Config{}).frontEndParams();
+}
+
+/* A bright axis-aligned square [x0, x1) x [y0, y1) on a dark ground. */
+Image square(int w, int h, int x0, int y0, int x1, int y1, int padding = 0)
+{
+	Image img(w, h, 30, padding);
+	for (int y = y0; y < y1; ++y)
+		for (int x = x0; x < x1; ++x)
+			img.at(x, y) = 220;
+	return img;
+}
+
+} // namespace
+
+TEST(FrontEnd, ParamsFollowTheConfig)
+{
+	const FrontEndParams p = defaultParams();
+	/* (0.27 * 255)^2 = 4740.2 and 0.19 * 255^2 = 12354.75 */
+	EXPECT_EQ(p.edge_threshold_sq, 4740);
+	EXPECT_EQ(p.corner_threshold, 12354);
+}
+
+TEST(FrontEnd, EdgesOfASquareLieOnItsBoundary)
+{
+	const Image img = square(64, 48, 16, 12, 48, 36);
+	EdgeMap em;
+	makeCpuFrontEnd(1)->run(img.view(), 1.0f, defaultParams(), em);
+	ASSERT_EQ(em.width, 64);
+	ASSERT_EQ(em.height, 48);
+	int edges = 0;
+	for (int y = 0; y < 48; ++y) {
+		for (int x = 0; x < 64; ++x) {
+			if (!(em.at(x, y) & EdgeMap::kEdge))
+				continue;
+			++edges;
+			/* Within a pixel of the step between columns 15|16, 47|48 or rows 11|12, 35|36. */
+			const bool nearV = (x >= 15 && x <= 16) || (x >= 47 && x <= 48);
+			const bool nearH = (y >= 11 && y <= 12) || (y >= 35 && y <= 36);
+			EXPECT_TRUE((nearV && y >= 10 && y <= 37) || (nearH && x >= 14 && x <= 49))
+				<< "edge at " << x << "," << y;
+		}
+	}
+	/* One line per side: about the perimeter, not a double line. */
+	EXPECT_GE(edges, 2 * (32 + 24) - 8);
+	EXPECT_LE(edges, 2 * (32 + 24) + 8);
+	/* Every side is present. */
+	for (int y = 14; y < 34; ++y) {
+		EXPECT_TRUE((em.at(15, y) | em.at(16, y)) & EdgeMap::kEdge) << y;
+		EXPECT_TRUE((em.at(47, y) | em.at(48, y)) & EdgeMap::kEdge) << y;
+	}
+}
+
+TEST(FrontEnd, CornersOnlyNearTheFourCorners)
+{
+	const Image img = square(64, 48, 16, 12, 48, 36);
+	EdgeMap em;
+	makeCpuFrontEnd(1)->run(img.view(), 1.0f, defaultParams(), em);
+	const int cx[4] = { 16, 47, 47, 16 }, cy[4] = { 12, 12, 35, 35 };
+	int near[4] = {};
+	for (int y = 0; y < 48; ++y) {
+		for (int x = 0; x < 64; ++x) {
+			if (!(em.at(x, y) & EdgeMap::kCorner))
+				continue;
+			EXPECT_TRUE(em.at(x, y) & EdgeMap::kEdge) << "corners are edge pixels";
+			bool ok = false;
+			for (int k = 0; k < 4; ++k) {
+				if (std::abs(x - cx[k]) <= 3 && std::abs(y - cy[k]) <= 3) {
+					++near[k];
+					ok = true;
+				}
+			}
+			EXPECT_TRUE(ok) << "corner pixel at " << x << "," << y << " far from every corner";
+		}
+	}
+	for (int k = 0; k < 4; ++k)
+		EXPECT_GE(near[k], 1) << "corner " << k << " not marked";
+}
+
+TEST(FrontEnd, OuterFrameIsAlwaysClear)
+{
+	/* A pattern that would put edges everywhere. */
+	Image img(40, 30);
+	for (int y = 0; y < 30; ++y)
+		for (int x = 0; x < 40; ++x)
+			img.at(x, y) = ((x / 2 + y / 2) & 1) ? 250 : 5;
+	EdgeMap em;
+	makeCpuFrontEnd(1)->run(img.view(), 1.0f, defaultParams(), em);
+	for (int x = 0; x < 40; ++x) {
+		EXPECT_EQ(em.at(x, 0), 0);
+		EXPECT_EQ(em.at(x, 29), 0);
+	}
+	for (int y = 0; y < 30; ++y) {
+		EXPECT_EQ(em.at(0, y), 0);
+		EXPECT_EQ(em.at(39, y), 0);
+	}
+}
+
+TEST(FrontEnd, TileMaskMarksExactlyTheTilesWithEdges)
+{
+	/* A flat image has no edges and no occupied tiles. */
+	Image flat(100, 70, 77);
+	EdgeMap em;
+	makeCpuFrontEnd(1)->run(flat.view(), 1.0f, defaultParams(), em);
+	EXPECT_EQ(em.tiles_x, 7);
+	EXPECT_EQ(em.tiles_y, 5);
+	for (std::uint8_t t : em.tiles)
+		EXPECT_EQ(t, 0);
+
+	const Image img = square(100, 70, 40, 40, 60, 60);
+	makeCpuFrontEnd(1)->run(img.view(), 1.0f, defaultParams(), em);
+	for (int ty = 0; ty < em.tiles_y; ++ty) {
+		for (int tx = 0; tx < em.tiles_x; ++tx) {
+			bool any = false;
+			for (int y = ty * 16; y < std::min(70, ty * 16 + 16); ++y)
+				for (int x = tx * 16; x < std::min(100, tx * 16 + 16); ++x)
+					any = any || (em.at(x, y) & EdgeMap::kEdge);
+			EXPECT_EQ(em.tileEmpty(tx, ty), !any) << tx << "," << ty;
+		}
+	}
+}
+
+TEST(FrontEnd, SameEdgesForAnyStrideAndThreadCount)
+{
+	Image tight(203, 157);
+	Image padded(203, 157, 128, 37);
+	std::mt19937 rng(5);
+	test::addNoise(tight, 40.0f, rng);
+	for (int y = 0; y < 157; ++y)
+		for (int x = 0; x < 203; ++x)
+			padded.at(x, y) = tight.at(x, y);
+	/* Garbage in the padding must not matter. */
+	for (int y = 0; y < 157; ++y)
+		for (int x = 203; x < 240; ++x)
+			padded.pixels[static_cast<std::size_t>(y) * padded.stride + x] = static_cast<std::uint8_t>(x * 7);
+	EdgeMap a, b, c;
+	makeCpuFrontEnd(1)->run(tight.view(), 1.0f, defaultParams(), a);
+	makeCpuFrontEnd(1)->run(padded.view(), 1.0f, defaultParams(), b);
+	makeCpuFrontEnd(3)->run(tight.view(), 1.0f, defaultParams(), c);
+	EXPECT_EQ(a.pixels, b.pixels);
+	EXPECT_EQ(a.pixels, c.pixels);
+	EXPECT_EQ(a.tiles, c.tiles);
+}
+
+TEST(FrontEnd, ScalingSamplesTheNearestPixel)
+{
+	EXPECT_EQ(scaledLength(640, 0.5f), 320);
+	EXPECT_EQ(scaledLength(640, 1.0f), 640);
+	EXPECT_EQ(scaledLength(3, 0.1f), 1);
+	const Image img = square(128, 96, 32, 32, 96, 64);
+	EdgeMap em;
+	makeCpuFrontEnd(1)->run(img.view(), 0.5f, defaultParams(), em);
+	EXPECT_EQ(em.width, 64);
+	EXPECT_EQ(em.height, 48);
+	EXPECT_FLOAT_EQ(em.scale, 0.5f);
+	/* The square maps to [16, 48) x [16, 32): its left side is at 15|16. */
+	EXPECT_TRUE((em.at(15, 24) | em.at(16, 24)) & EdgeMap::kEdge);
+	EXPECT_FALSE(em.at(30, 24) & EdgeMap::kEdge);
+}

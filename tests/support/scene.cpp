@@ -1,0 +1,78 @@
+// SPDX-License-Identifier: MIT
+#include "scene.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace frappe::test {
+
+std::array<Point2f, 4> squarePose(float cx, float cy, float side, float roll, float tilt,
+				  float distance)
+{
+	const double r = roll * M_PI / 180.0, t = tilt * M_PI / 180.0;
+	const double f = distance; /* focal length in units of the side */
+	std::array<Point2f, 4> out;
+	const double xs[4] = { -0.5, 0.5, 0.5, -0.5 }, ys[4] = { -0.5, -0.5, 0.5, 0.5 };
+	for (int i = 0; i < 4; ++i) {
+		/* Tilt about the marker's x axis, then project, then roll. */
+		const double X = xs[i], Y = ys[i] * std::cos(t), Z = distance + ys[i] * std::sin(t);
+		const double u = f * X / Z, v = f * Y / Z;
+		out[i] = { static_cast<float>(cx + side * (u * std::cos(r) - v * std::sin(r))),
+			   static_cast<float>(cy + side * (u * std::sin(r) + v * std::cos(r))) };
+	}
+	return out;
+}
+
+void blur(Image &img, float sigma)
+{
+	if (sigma <= 0.0f)
+		return;
+	const int radius = std::max(1, static_cast<int>(std::ceil(3.0f * sigma)));
+	std::vector<float> k(2 * radius + 1);
+	float sum = 0;
+	for (int i = -radius; i <= radius; ++i)
+		sum += k[i + radius] = std::exp(-0.5f * i * i / (sigma * sigma));
+	for (float &v : k)
+		v /= sum;
+	std::vector<float> tmp(static_cast<std::size_t>(img.width) * img.height);
+	for (int y = 0; y < img.height; ++y)
+		for (int x = 0; x < img.width; ++x) {
+			float acc = 0;
+			for (int i = -radius; i <= radius; ++i)
+				acc += k[i + radius] * img.at(std::clamp(x + i, 0, img.width - 1), y);
+			tmp[static_cast<std::size_t>(y) * img.width + x] = acc;
+		}
+	for (int y = 0; y < img.height; ++y)
+		for (int x = 0; x < img.width; ++x) {
+			float acc = 0;
+			for (int i = -radius; i <= radius; ++i)
+				acc += k[i + radius] * tmp[static_cast<std::size_t>(std::clamp(y + i, 0, img.height - 1)) * img.width + x];
+			img.at(x, y) = static_cast<std::uint8_t>(std::clamp(std::lround(acc), 0L, 255L));
+		}
+}
+
+void addNoise(Image &img, float sigma, std::mt19937 &rng)
+{
+	std::normal_distribution<float> n(0.0f, sigma);
+	for (int y = 0; y < img.height; ++y)
+		for (int x = 0; x < img.width; ++x)
+			img.at(x, y) = static_cast<std::uint8_t>(std::clamp(std::lround(img.at(x, y) + n(rng)), 0L, 255L));
+}
+
+float meanCornerError(const std::array<Point2f, 4> &a, const std::array<Point2f, 4> &b)
+{
+	float e = 0;
+	for (int i = 0; i < 4; ++i)
+		e += std::hypot(a[i].x - b[i].x, a[i].y - b[i].y);
+	return e / 4;
+}
+
+const Marker *findMarker(const std::vector<Marker> &markers, int id)
+{
+	for (const Marker &m : markers)
+		if (m.id == id)
+			return &m;
+	return nullptr;
+}
+
+} // namespace frappe::test
