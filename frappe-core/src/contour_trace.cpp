@@ -61,8 +61,13 @@ void ContourTracer::trace(const EdgeMap &edges, const TraceParams &params, std::
 				continue;
 			}
 			const std::uint8_t f = row[x];
-			if (f == 0)
+			if (f == 0) {
+				/* Most pixels are background: hop over zero words. */
+				std::uint64_t word;
+				while (x + 9 < w && (std::memcpy(&word, row + x + 1, 8), word == 0))
+					x += 8;
 				continue;
+			}
 			int fromDir;
 			if (f == 1 && row[x - 1] == 0)
 				fromDir = 4; /* outer border: came from the left */

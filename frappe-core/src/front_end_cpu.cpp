@@ -140,17 +140,17 @@ void CpuFrontEnd::runBand(const ImageView &src, const FrontEndParams &params, Ed
 			detail::zeroGradientRow(w, s.gx[i].data(), s.gy[i].data(), s.mag[i].data());
 		else
 			detail::gradientRow(smoothed(r - 1), smoothed(r), smoothed(r + 1), w, s.gx[i].data(),
-					    s.gy[i].data(), s.mag[i].data());
+					    s.gy[i].data(), s.mag[i].data(), s.separable.data());
 	};
 	for (int r = std::max(0, y0 - 2); r <= std::min(h - 1, y0 + 1); ++r)
-		detail::smoothRow(src, r, smoothed(r));
+		detail::smoothRow(src, r, smoothed(r), s.columns.data());
 	gradient(y0 - 1);
 	gradient(y0);
 
 	for (int y = y0; y < y1; ++y) {
 		const int next = y + 1;
 		if (next + 1 <= h - 1)
-			detail::smoothRow(src, next + 1, smoothed(next + 1));
+			detail::smoothRow(src, next + 1, smoothed(next + 1), s.columns.data());
 		gradient(next);
 		const detail::GradRows rows{
 			{ s.gx[(y - 1) % 3].data(), s.gx[y % 3].data(), s.gx[next % 3].data() },

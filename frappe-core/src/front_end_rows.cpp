@@ -22,33 +22,42 @@ void scaleNearest(const ImageView &src, int dstW, int dstH, std::uint8_t *dst)
 	}
 }
 
-void smoothRow(const ImageView &src, int r, std::uint8_t *out)
+void smoothRow(const ImageView &src, int r, std::uint8_t *out, std::uint16_t *tmp)
 {
 	const int w = src.width, h = src.height;
 	const std::uint8_t *a = src.row(std::max(r - 1, 0));
 	const std::uint8_t *b = src.row(r);
 	const std::uint8_t *c = src.row(std::min(r + 1, h - 1));
-	auto column = [&](int x) { return a[x] + 2 * b[x] + c[x]; };
+	/* Separable: the vertical [1 2 1] first, into 16 bits, then across. */
+	for (int x = 0; x < w; ++x)
+		tmp[x] = static_cast<std::uint16_t>(a[x] + 2 * b[x] + c[x]);
 	if (w == 1) {
-		out[0] = static_cast<std::uint8_t>((4 * column(0) + 8) >> 4);
+		out[0] = static_cast<std::uint8_t>((4 * tmp[0] + 8) >> 4);
 		return;
 	}
-	out[0] = static_cast<std::uint8_t>((3 * column(0) + column(1) + 8) >> 4);
+	out[0] = static_cast<std::uint8_t>((3 * tmp[0] + tmp[1] + 8) >> 4);
 	for (int x = 1; x < w - 1; ++x)
-		out[x] = static_cast<std::uint8_t>((column(x - 1) + 2 * column(x) + column(x + 1) + 8) >> 4);
-	out[w - 1] = static_cast<std::uint8_t>((column(w - 2) + 3 * column(w - 1) + 8) >> 4);
+		out[x] = static_cast<std::uint8_t>((tmp[x - 1] + 2 * tmp[x] + tmp[x + 1] + 8) >> 4);
+	out[w - 1] = static_cast<std::uint8_t>((tmp[w - 2] + 3 * tmp[w - 1] + 8) >> 4);
 }
 
 void gradientRow(const std::uint8_t *a, const std::uint8_t *b, const std::uint8_t *c, int w,
-		 std::int16_t *gx, std::int16_t *gy, std::int32_t *mag)
+		 std::int16_t *gx, std::int16_t *gy, std::int32_t *mag, std::int16_t *tmp)
 {
+	/* Separable Sobel: vertical smoothing and vertical difference per
+	 * column, then the horizontal difference and smoothing. */
+	std::int16_t *vs = tmp, *vd = tmp + w;
+	for (int x = 0; x < w; ++x) {
+		vs[x] = static_cast<std::int16_t>(a[x] + 2 * b[x] + c[x]);
+		vd[x] = static_cast<std::int16_t>(c[x] - a[x]);
+	}
 	gx[0] = gy[0] = 0;
 	mag[0] = 0;
 	gx[w - 1] = gy[w - 1] = 0;
 	mag[w - 1] = 0;
 	for (int x = 1; x < w - 1; ++x) {
-		const int sx = (a[x + 1] + 2 * b[x + 1] + c[x + 1]) - (a[x - 1] + 2 * b[x - 1] + c[x - 1]);
-		const int sy = (c[x - 1] + 2 * c[x] + c[x + 1]) - (a[x - 1] + 2 * a[x] + a[x + 1]);
+		const std::int32_t sx = vs[x + 1] - vs[x - 1];
+		const std::int32_t sy = vd[x - 1] + 2 * vd[x] + vd[x + 1];
 		gx[x] = static_cast<std::int16_t>(sx);
 		gy[x] = static_cast<std::int16_t>(sy);
 		mag[x] = sx * sx + sy * sy;

@@ -21,12 +21,16 @@ struct GradRows {
 /// Per-thread scratch: rings of smoothed rows and of gradient rows.
 struct RowScratch {
 	std::vector<std::uint8_t> smooth[4];
+	std::vector<std::uint16_t> columns;    ///< smoothRow's vertical pass
+	std::vector<std::int16_t> separable;   ///< gradientRow's two column passes
 	std::vector<std::int16_t> gx[3], gy[3];
 	std::vector<std::int32_t> mag[3];
 	void resize(int w)
 	{
 		for (int i = 0; i < 4; ++i)
 			smooth[i].resize(w);
+		columns.resize(w);
+		separable.resize(2 * static_cast<std::size_t>(w));
 		for (int i = 0; i < 3; ++i) {
 			gx[i].resize(w);
 			gy[i].resize(w);
@@ -40,13 +44,13 @@ struct RowScratch {
 void scaleNearest(const ImageView &src, int dstW, int dstH, std::uint8_t *dst);
 
 /// Row r of the image smoothed by the 3x3 binomial kernel [1 2 1]^T [1 2 1] / 16,
-/// rounded, with edge pixels replicated beyond the frame.
-void smoothRow(const ImageView &src, int r, std::uint8_t *out);
+/// rounded, with edge pixels replicated beyond the frame. `tmp` holds w values.
+void smoothRow(const ImageView &src, int r, std::uint8_t *out, std::uint16_t *tmp);
 
 /// Sobel gradients of the middle of three smoothed rows a, b, c; zero in
-/// the first and last column.
+/// the first and last column. `tmp` holds 2w values.
 void gradientRow(const std::uint8_t *a, const std::uint8_t *b, const std::uint8_t *c, int w,
-		 std::int16_t *gx, std::int16_t *gy, std::int32_t *mag);
+		 std::int16_t *gx, std::int16_t *gy, std::int32_t *mag, std::int16_t *tmp);
 
 /// The gradient row of the outermost image rows: all zero.
 void zeroGradientRow(int w, std::int16_t *gx, std::int16_t *gy, std::int32_t *mag);
