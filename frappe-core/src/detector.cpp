@@ -5,6 +5,7 @@
 #include <chrono>
 #include <algorithm>
 #include <cmath>
+#include <mutex>
 #include <stdexcept>
 #include <string>
 
@@ -89,6 +90,9 @@ struct Detector::Impl {
 	int maxHamming = 0;
 	FrontEndParams params;
 	std::unique_ptr<FrontEnd> frontEnd;
+	/* Read by the front end, written by the back end: in pipelined use
+	 * they run on different threads. */
+	std::mutex adaptiveLock;
 	detail::AdaptiveScale adaptive;
 
 	struct Slot {
@@ -249,7 +253,11 @@ void Detector::runFrontEnd(const ImageView &image, int slot)
 	d.checkImage(image);
 	Impl::Slot &s = d.slots[slot & 1];
 	const auto t0 = Clock::now();
-	float scale = d.adaptive.next(d.config);
+	float scale;
+	{
+		std::lock_guard<std::mutex> lock(d.adaptiveLock);
+		scale = d.adaptive.next(d.config);
+	}
 	/* Never scale a frame so small that a marker could not survive it. */
 	if (scaledLength(image.width, scale) < 32 || scaledLength(image.height, scale) < 32)
 		scale = 1.0f;
@@ -266,7 +274,10 @@ const Result &Detector::runBackEnd(const ImageView &image, int slot)
 	Impl &d = *impl_;
 	Impl::Slot &s = d.slots[slot & 1];
 	d.backEnd(image, s);
-	d.adaptive.update(s.result.markers);
+	{
+		std::lock_guard<std::mutex> lock(d.adaptiveLock);
+		d.adaptive.update(s.result.markers);
+	}
 	double total = 0;
 	for (double ms : s.result.times.ms)
 		total += ms;
@@ -283,7 +294,11 @@ void Detector::setFrontEnd(std::unique_ptr<FrontEnd> frontEnd)
 
 const FrontEnd &Detector::frontEnd() const { return *impl_->frontEnd; }
 const EdgeMap &Detector::edgeMap(int slot) const { return impl_->slots[slot & 1].edges; }
-void Detector::reset() { impl_->adaptive.reset(); }
+void Detector::reset()
+{
+	std::lock_guard<std::mutex> lock(impl_->adaptiveLock);
+	impl_->adaptive.reset();
+}
 const Config &Detector::config() const { return impl_->config; }
 const Dictionary &Detector::dictionary() const { return *impl_->dict; }
 int Detector::maxHamming() const { return impl_->maxHamming; }

@@ -1,0 +1,53 @@
+// SPDX-License-Identifier: MIT
+// After the first frame of a given size, detect() allocates nothing: this
+// binary counts every operator new.
+#include <atomic>
+#include <cstdlib>
+#include <new>
+
+#include <gtest/gtest.h>
+
+#include "frappe/frappe.h"
+#include "scene.h"
+
+namespace {
+std::atomic<long> gAllocations{ 0 };
+}
+
+void *operator new(std::size_t n)
+{
+	++gAllocations;
+	if (void *p = std::malloc(n ? n : 1))
+		return p;
+	throw std::bad_alloc();
+}
+void operator delete(void *p) noexcept { std::free(p); }
+void operator delete(void *p, std::size_t) noexcept { std::free(p); }
+
+using namespace frappe;
+using namespace frappe::test;
+
+TEST(NoAllocation, SecondFrameOfTheSameSizeAllocatesNothing)
+{
+	const Dictionary &dict = *findDictionary("aruco_mip_36h12");
+	Image a(640, 480, 80), b(640, 480, 120);
+	std::mt19937 rng(3);
+	for (int k = 0; k < 6; ++k) {
+		renderMarker(a.mut(), dict, k, squarePose(80.0f + 100.0f * k, 150.0f, 60.0f, 20.0f * k, 30.0f));
+		renderMarker(b.mut(), dict, 10 + k, squarePose(80.0f + 100.0f * k, 330.0f, 70.0f, -15.0f * k, 20.0f));
+	}
+	addNoise(a, 3.0f, rng);
+	addNoise(b, 3.0f, rng);
+	Detector det(Config{});
+	/* Warm up on both frames: buffers grow to what these scenes need. */
+	det.detect(a.view());
+	det.detect(b.view());
+
+	const long before = gAllocations.load();
+	const std::size_t na = det.detect(a.view()).markers.size();
+	const std::size_t nb = det.detect(b.view()).markers.size();
+	const long after = gAllocations.load();
+	EXPECT_EQ(na, 6u);
+	EXPECT_EQ(nb, 6u);
+	EXPECT_EQ(after - before, 0) << "detect() allocated on a frame of a size it had seen";
+}
