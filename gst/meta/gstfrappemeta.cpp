@@ -1,0 +1,130 @@
+/* SPDX-License-Identifier: MIT
+ *
+ * gstfrappemeta.cpp: registration and transforms of GstFrappeMarkerMeta.
+ */
+#include "gstfrappemeta.h"
+
+#include <cstring>
+
+#include <gst/video/video.h>
+
+GType gst_frappe_marker_meta_api_get_type(void)
+{
+	static GType type = 0;
+	static const gchar *tags[] = { GST_META_TAG_VIDEO_STR, GST_META_TAG_VIDEO_SIZE_STR,
+				       GST_META_TAG_VIDEO_ORIENTATION_STR, nullptr };
+
+	if (g_once_init_enter(&type)) {
+		GType t = gst_meta_api_type_register("GstFrappeMarkerMetaAPI", tags);
+		g_once_init_leave(&type, t);
+	}
+	return type;
+}
+
+static gboolean frappe_marker_meta_init(GstMeta *meta, gpointer, GstBuffer *)
+{
+	auto *m = reinterpret_cast<GstFrappeMarkerMeta *>(meta);
+	m->id = -1;
+	m->dictionary = nullptr;
+	std::memset(m->corners, 0, sizeof(m->corners));
+	m->hamming = 0;
+	m->has_pose = FALSE;
+	std::memset(m->rvec, 0, sizeof(m->rvec));
+	std::memset(m->tvec, 0, sizeof(m->tvec));
+	m->reprojection_error = 0.0;
+	m->alternative_reprojection_error = 0.0;
+	return TRUE;
+}
+
+static gboolean frappe_marker_meta_transform(GstBuffer *dest, GstMeta *meta, GstBuffer *,
+					     GQuark type, gpointer data)
+{
+	const auto *src = reinterpret_cast<const GstFrappeMarkerMeta *>(meta);
+
+	if (GST_META_TRANSFORM_IS_COPY(type)) {
+		GstFrappeMarkerMeta *m = gst_buffer_add_frappe_marker_meta(
+			dest, src->id, src->dictionary, src->corners, src->hamming);
+		if (!m)
+			return FALSE;
+		m->has_pose = src->has_pose;
+		std::memcpy(m->rvec, src->rvec, sizeof(m->rvec));
+		std::memcpy(m->tvec, src->tvec, sizeof(m->tvec));
+		m->reprojection_error = src->reprojection_error;
+		m->alternative_reprojection_error = src->alternative_reprojection_error;
+		return TRUE;
+	}
+
+	if (GST_VIDEO_META_TRANSFORM_IS_SCALE(type)) {
+		const auto *trans = static_cast<const GstVideoMetaTransform *>(data);
+		const gint inW = GST_VIDEO_INFO_WIDTH(trans->in_info);
+		const gint inH = GST_VIDEO_INFO_HEIGHT(trans->in_info);
+		if (inW <= 0 || inH <= 0)
+			return FALSE;
+		const gdouble sx = static_cast<gdouble>(GST_VIDEO_INFO_WIDTH(trans->out_info)) / inW;
+		const gdouble sy = static_cast<gdouble>(GST_VIDEO_INFO_HEIGHT(trans->out_info)) / inH;
+		gfloat corners[8];
+		/* Pixel centres sit at integers: scale about the image's corner. */
+		for (int i = 0; i < 4; ++i) {
+			corners[2 * i] = static_cast<gfloat>((src->corners[2 * i] + 0.5) * sx - 0.5);
+			corners[2 * i + 1] = static_cast<gfloat>((src->corners[2 * i + 1] + 0.5) * sy - 0.5);
+		}
+		GstFrappeMarkerMeta *m = gst_buffer_add_frappe_marker_meta(dest, src->id, src->dictionary,
+									   corners, src->hamming);
+		if (!m)
+			return FALSE;
+		/* The pose is in metres in the camera frame: scaling the image does
+		 * not move the marker. The reprojection error is in pixels. */
+		m->has_pose = src->has_pose;
+		std::memcpy(m->rvec, src->rvec, sizeof(m->rvec));
+		std::memcpy(m->tvec, src->tvec, sizeof(m->tvec));
+		m->reprojection_error = src->reprojection_error * (sx + sy) / 2.0;
+		m->alternative_reprojection_error = src->alternative_reprojection_error * (sx + sy) / 2.0;
+		return TRUE;
+	}
+
+	/* Anything else (crops, rotations, ...) would invalidate the corners. */
+	return FALSE;
+}
+
+const GstMetaInfo *gst_frappe_marker_meta_get_info(void)
+{
+	static const GstMetaInfo *info = nullptr;
+
+	if (g_once_init_enter(&info)) {
+		const GstMetaInfo *i = gst_meta_register(
+			GST_FRAPPE_MARKER_META_API_TYPE, "GstFrappeMarkerMeta",
+			sizeof(GstFrappeMarkerMeta), frappe_marker_meta_init, nullptr,
+			frappe_marker_meta_transform);
+		g_once_init_leave(&info, i);
+	}
+	return info;
+}
+
+GstFrappeMarkerMeta *gst_buffer_add_frappe_marker_meta(GstBuffer *buffer, gint id,
+						       const gchar *dictionary,
+						       const gfloat corners[8], guint hamming)
+{
+	g_return_val_if_fail(GST_IS_BUFFER(buffer), nullptr);
+	g_return_val_if_fail(corners != nullptr, nullptr);
+
+	auto *m = reinterpret_cast<GstFrappeMarkerMeta *>(
+		gst_buffer_add_meta(buffer, GST_FRAPPE_MARKER_META_INFO, nullptr));
+	if (!m)
+		return nullptr;
+	m->id = id;
+	m->dictionary = dictionary ? g_intern_string(dictionary) : nullptr;
+	std::memcpy(m->corners, corners, sizeof(m->corners));
+	m->hamming = hamming;
+	return m;
+}
+
+guint gst_buffer_get_n_frappe_marker_metas(GstBuffer *buffer)
+{
+	g_return_val_if_fail(GST_IS_BUFFER(buffer), 0);
+
+	guint n = 0;
+	gpointer state = nullptr;
+	while (gst_buffer_iterate_meta_filtered(buffer, &state, GST_FRAPPE_MARKER_META_API_TYPE))
+		++n;
+	return n;
+}

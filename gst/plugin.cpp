@@ -1,0 +1,16 @@
+/* SPDX-License-Identifier: MIT
+ *
+ * plugin.cpp: the frappe GStreamer plugin.
+ */
+#include <gst/gst.h>
+
+#include "gstfrappedetect.h"
+
+static gboolean plugin_init(GstPlugin *plugin)
+{
+	return GST_ELEMENT_REGISTER(frappedetect, plugin);
+}
+
+GST_PLUGIN_DEFINE(GST_VERSION_MAJOR, GST_VERSION_MINOR, frappe,
+		  "Frappe square fiducial marker (ArUco, AprilTag) detection",
+		  plugin_init, FRAPPE_VERSION, "MIT", "frappe", "https://github.com/frappe-markers/frappe")

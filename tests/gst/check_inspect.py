@@ -1,0 +1,39 @@
+#!/usr/bin/env python3
+# SPDX-License-Identifier: MIT
+"""gst-inspect-1.0 frappedetect must exit 0, print no warnings or criticals,
+and list every property the issue asks for."""
+import subprocess
+import sys
+
+PROPERTIES = ["dictionary", "mode", "edge-threshold", "corner-threshold", "max-hamming",
+              "scaled-size", "max-scaled-frames", "annotate", "post-messages", "pipelined",
+              "backend", "marker-size", "camera-matrix", "distortion", "stats"]
+
+
+def main():
+    inspect = sys.argv[1]
+    for args in (["frappedetect"], ["frappe"]):
+        p = subprocess.run([inspect] + args, capture_output=True, text=True)
+        if p.returncode != 0:
+            print(f"{args}: exit {p.returncode}\n{p.stderr}")
+            return 1
+        noise = [l for l in (p.stderr + p.stdout).splitlines()
+                 if "WARNING" in l or "CRITICAL" in l or "ERROR" in l]
+        if p.stderr.strip() or noise:
+            print(f"{args}: unexpected output:\n{p.stderr}\n" + "\n".join(noise))
+            return 1
+    out = subprocess.run([inspect, "frappedetect"], capture_output=True, text=True).stdout
+    missing = [name for name in PROPERTIES if f"\n  {name} " not in out]
+    if missing:
+        print("missing properties: " + ", ".join(missing))
+        return 1
+    for fmt in ("GRAY8", "I420", "YV12", "NV12", "NV21"):
+        if fmt not in out:
+            print("missing format " + fmt)
+            return 1
+    print("gst-inspect-1.0 frappedetect: clean")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,182 @@
+// SPDX-License-Identifier: MIT
+// helpers.h: frames with rendered markers for the frappedetect tests.
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include <gst/check/gstharness.h>
+#include <gst/gst.h>
+#include <gst/video/video.h>
+#include <gtest/gtest.h>
+
+#include <frappe/dictionary.h>
+#include <frappe/render.h>
+
+#include "gstfrappemeta.h"
+
+namespace frappe::gsttest {
+
+struct Placed {
+	int id;
+	std::array<Point2f, 4> corners;
+};
+
+/// A frame description: format, size and an optional padded luma stride.
+struct FrameSpec {
+	GstVideoFormat format = GST_VIDEO_FORMAT_GRAY8;
+	int width = 640;
+	int height = 480;
+	int padding = 0; ///< extra bytes per row of every plane (adds a GstVideoMeta)
+	std::uint8_t background = 128;
+};
+
+inline std::string capsString(const FrameSpec &s, int fps = 30)
+{
+	return "video/x-raw,format=" + std::string(gst_video_format_to_string(s.format)) +
+	       ",width=" + std::to_string(s.width) + ",height=" + std::to_string(s.height) +
+	       ",framerate=" + std::to_string(fps) + "/1";
+}
+
+/// Allocates a frame and draws the markers into its luma plane; chroma is
+/// neutral grey. With padding the strides differ from GStreamer's default
+/// and a GstVideoMeta says so.
+inline GstBuffer *makeFrame(const FrameSpec &s, const std::vector<Placed> &markers,
+			    const frappe::Dictionary &dict, GstClockTime pts = 0,
+			    GstClockTime duration = GST_SECOND / 30)
+{
+	GstVideoInfo info;
+	gst_video_info_set_format(&info, s.format, static_cast<guint>(s.width), static_cast<guint>(s.height));
+	gsize offsets[GST_VIDEO_MAX_PLANES] = {};
+	gint strides[GST_VIDEO_MAX_PLANES] = {};
+	gsize size = GST_VIDEO_INFO_SIZE(&info);
+	const guint planes = GST_VIDEO_INFO_N_PLANES(&info);
+	/* Rows per plane as GStreamer lays them out by default. */
+	auto planeRows = [&](guint p) {
+		const gsize end = p + 1 < planes ? GST_VIDEO_INFO_PLANE_OFFSET(&info, p + 1) : GST_VIDEO_INFO_SIZE(&info);
+		return static_cast<int>((end - GST_VIDEO_INFO_PLANE_OFFSET(&info, p)) /
+					static_cast<gsize>(GST_VIDEO_INFO_PLANE_STRIDE(&info, p)));
+	};
+	for (guint p = 0; p < planes; ++p) {
+		strides[p] = GST_VIDEO_INFO_PLANE_STRIDE(&info, p);
+		offsets[p] = GST_VIDEO_INFO_PLANE_OFFSET(&info, p);
+	}
+	if (s.padding) {
+		size = 0;
+		for (guint p = 0; p < planes; ++p) {
+			strides[p] += s.padding;
+			offsets[p] = size;
+			size += static_cast<gsize>(strides[p]) * static_cast<gsize>(planeRows(p));
+		}
+	}
+	GstBuffer *buf = gst_buffer_new_allocate(nullptr, size, nullptr);
+	if (s.padding)
+		gst_buffer_add_video_meta_full(buf, GST_VIDEO_FRAME_FLAG_NONE, s.format, static_cast<guint>(s.width),
+					       static_cast<guint>(s.height), planes, offsets, strides);
+	GstMapInfo map;
+	gst_buffer_map(buf, &map, GST_MAP_WRITE);
+	/* Padding bytes get a value no marker has, to catch stride mistakes. */
+	std::memset(map.data, 77, map.size);
+	for (guint p = 0; p < planes; ++p) {
+		const int rows = planeRows(p);
+		const int rowBytes = GST_VIDEO_INFO_PLANE_STRIDE(&info, p);
+		for (int y = 0; y < rows; ++y)
+			std::memset(map.data + offsets[p] + static_cast<gsize>(y) * static_cast<gsize>(strides[p]),
+				    p == 0 ? s.background : 128, static_cast<std::size_t>(rowBytes));
+	}
+	frappe::MutableImageView luma{ map.data + offsets[0], s.width, s.height, strides[0] };
+	for (const Placed &m : markers)
+		frappe::renderMarker(luma, dict, m.id, m.corners);
+	gst_buffer_unmap(buf, &map);
+	GST_BUFFER_PTS(buf) = pts;
+	GST_BUFFER_DURATION(buf) = duration;
+	return buf;
+}
+
+/// An upright square marker with top-left corner (x, y) and side `side`.
+inline Placed square(int id, float x, float y, float side)
+{
+	return { id, { Point2f{ x, y }, { x + side, y }, { x + side, y + side }, { x, y + side } } };
+}
+
+/// A slightly rotated and skewed marker around (cx, cy).
+inline Placed tilted(int id, float cx, float cy, float side, float angle)
+{
+	Placed p{ id, {} };
+	const float c = std::cos(angle), s = std::sin(angle);
+	const float h = side / 2;
+	const float local[4][2] = { { -h, -h }, { h, -h * 0.95f }, { h * 1.05f, h }, { -h, h } };
+	for (int i = 0; i < 4; ++i)
+		p.corners[static_cast<std::size_t>(i)] = { cx + c * local[i][0] - s * local[i][1],
+							   cy + s * local[i][0] + c * local[i][1] };
+	return p;
+}
+
+inline std::vector<GstFrappeMarkerMeta *> markerMetas(GstBuffer *buf)
+{
+	std::vector<GstFrappeMarkerMeta *> out;
+	gpointer state = nullptr;
+	GstMeta *m;
+	while ((m = gst_buffer_iterate_meta_filtered(buf, &state, GST_FRAPPE_MARKER_META_API_TYPE)))
+		out.push_back(reinterpret_cast<GstFrappeMarkerMeta *>(m));
+	return out;
+}
+
+/// Asserts that every placed marker is in the metas with corners within tol.
+inline void expectMarkers(GstBuffer *buf, const std::vector<Placed> &placed, const char *dictName,
+			  float tol = 0.3f)
+{
+	const auto metas = markerMetas(buf);
+	ASSERT_EQ(metas.size(), placed.size());
+	for (const Placed &p : placed) {
+		const GstFrappeMarkerMeta *found = nullptr;
+		for (const auto *m : metas)
+			if (m->id == p.id)
+				found = m;
+		ASSERT_NE(found, nullptr) << "marker " << p.id << " missing";
+		EXPECT_STREQ(found->dictionary, dictName);
+		EXPECT_EQ(found->hamming, 0u);
+		for (int k = 0; k < 4; ++k) {
+			EXPECT_NEAR(found->corners[2 * k], p.corners[static_cast<std::size_t>(k)].x, tol)
+				<< "marker " << p.id << " corner " << k;
+			EXPECT_NEAR(found->corners[2 * k + 1], p.corners[static_cast<std::size_t>(k)].y, tol)
+				<< "marker " << p.id << " corner " << k;
+		}
+	}
+}
+
+/// The frappedetect element of a harness (gst_harness_new_parse wraps it in a bin).
+inline GstElement *detector(GstHarness *h)
+{
+	if (!GST_IS_BIN(h->element))
+		return h->element;
+	GstElement *found = nullptr;
+	GstIterator *it = gst_bin_iterate_elements(GST_BIN(h->element));
+	GValue item = G_VALUE_INIT;
+	while (!found && gst_iterator_next(it, &item) == GST_ITERATOR_OK) {
+		auto *e = GST_ELEMENT(g_value_get_object(&item));
+		if (g_str_has_prefix(GST_OBJECT_NAME(e), "frappedetect"))
+			found = e;
+		g_value_reset(&item);
+	}
+	g_value_unset(&item);
+	gst_iterator_free(it);
+	return found; /* the bin holds the reference */
+}
+
+inline const frappe::Dictionary &dict(const char *name)
+{
+	return *frappe::findDictionary(name);
+}
+
+class GstEnvironment : public ::testing::Environment {
+public:
+	void SetUp() override { gst_init(nullptr, nullptr); }
+};
+
+} // namespace frappe::gsttest
