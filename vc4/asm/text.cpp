@@ -143,7 +143,7 @@ std::optional<ReadReg> readReg(const std::string &name)
 	for (uint8_t code = 0; code < 48; ++code) {
 		Alu probe;
 		probe.sig = Sig::SmallImmediate;
-		probe.op_add = AddOp::Add;
+		probe.op_add = isa::AddOp::Add;
 		probe.add_b = Mux::B;
 		probe.raddr_b = code;
 		const std::string text = disassemble(encode(probe));
@@ -412,7 +412,7 @@ uint64_t parseAlu(const Line &line, const std::vector<std::string> &segments)
 			"clz", "", "", "", "", "", "v8adds", "v8subs"}, add.op);
 		if (op < 0)
 			line.fail("unknown ADD op '" + add.op + "'");
-		alu.op_add = static_cast<AddOp>(op);
+		alu.op_add = static_cast<isa::AddOp>(op);
 		alu.cond_add = add.cond;
 		auto [name, tail] = suffix(add.dst);
 		auto w = writeReg(name);

@@ -78,6 +78,8 @@ bool isFloatOp(AddOp op)
 
 bool isFloatOp(MulOp op) { return op == MulOp::FMul; }
 
+bool hasFloatResult(AddOp op) { return op == AddOp::ItoF || (isFloatOp(op) && op != AddOp::FtoI); }
+
 namespace {
 
 LaneResult floatResult(float f) { return {fromFloat(f), false, 0}; }

@@ -16,8 +16,12 @@ struct LaneResult {
 	int64_t wide = 0; // exact integer result of add/sub, for the saturating packs
 };
 
+// Whether an op reads its inputs as floats (drives unpack conversions)...
 bool isFloatOp(isa::AddOp op);
 bool isFloatOp(isa::MulOp op);
+// ...and whether its result is a float (drives flags and float16 packing): ftoi reads a
+// float and returns an integer, itof the reverse.
+bool hasFloatResult(isa::AddOp op);
 
 LaneResult addOp(isa::AddOp op, uint32_t a, uint32_t b);
 LaneResult mulOp(isa::MulOp op, uint32_t a, uint32_t b);

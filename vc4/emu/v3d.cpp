@@ -688,7 +688,7 @@ void Qpu::executeAlu(uint64_t word)
 		for (unsigned l = 0; l < kLanes; ++l) {
 			v[l] = add_r[l].value;
 			if (!i.pm && !file_b && i.waddr_add < 32 && i.pack != Pack::None)
-				v[l] = packRegfileA(i.pack, add_r[l], isFloatOp(i.op_add), ra_[i.waddr_add][l]);
+				v[l] = packRegfileA(i.pack, add_r[l], hasFloatResult(i.op_add), ra_[i.waddr_add][l]);
 		}
 		write(i.waddr_add, file_b, v, add_mask, i.cond_add != Cond::Always);
 	}
@@ -720,7 +720,7 @@ void Qpu::executeAlu(uint64_t word)
 			carry[l] = r.carry;
 			m[l] = c == Cond::Never ? true : (from_add ? add_mask[l] : mul_mask[l]);
 		}
-		setFlags(v, carry, m, from_add ? isFloatOp(i.op_add) : isFloatOp(i.op_mul));
+		setFlags(v, carry, m, from_add ? hasFloatResult(i.op_add) : isFloatOp(i.op_mul));
 	}
 	if (i.sig == Sig::LoadTmu0 || i.sig == Sig::LoadTmu1) {
 		auto &fifo = tmu_fifo_[i.sig == Sig::LoadTmu1];

@@ -170,3 +170,14 @@ TEST(EmuFlags, ZeroAndNegative)
 	EXPECT_FALSE(negativeFlag(0x80000000u, true));
 	EXPECT_TRUE(negativeFlag(f(-1.0f), true));
 }
+
+TEST(EmuFloat, ConversionResultKinds)
+{
+	// ftoi returns an integer (flags as integer), itof a float.
+	EXPECT_TRUE(isFloatOp(AddOp::FtoI));
+	EXPECT_FALSE(hasFloatResult(AddOp::FtoI));
+	EXPECT_FALSE(isFloatOp(AddOp::ItoF));
+	EXPECT_TRUE(hasFloatResult(AddOp::ItoF));
+	EXPECT_TRUE(hasFloatResult(AddOp::FMaxAbs));
+	EXPECT_FALSE(hasFloatResult(AddOp::Add));
+}

@@ -9,6 +9,10 @@
 #include <exception>
 #include <string>
 
+#include <fstream>
+#include <sstream>
+
+#include "asm/text.hpp"
 #include "emu/v3d.hpp"
 #include "samples/samples.hpp"
 #include "tools/listing.hpp"
@@ -19,7 +23,8 @@ void usage()
 {
 	std::fprintf(stderr,
 	             "usage: vc4-run [--code FILE] [--qpus N] [--random SEED] [--lenient] IN.pgm OUT.pgm\n"
-	             "  --code FILE    hex listing or binary of a tile program (default: built-in tile copy)\n"
+	             "  --code FILE    hex listing, binary, or .qasm listing in vc4-dis syntax of a tile\n"
+	             "                 program (default: built-in tile copy)\n"
 	             "  --qpus N       QPUs per launch, 1..12 (default 12)\n"
 	             "  --random SEED  seeded random interleaving instead of round robin\n"
 	             "  --lenient      do not fault on documented hazards\n");
@@ -60,7 +65,17 @@ int main(int argc, char **argv)
 		return 2;
 	}
 	try {
-		const auto code = code_path.empty() ? samples::tileCopy().code : tools::readCodeFile(code_path);
+		std::vector<uint64_t> code;
+		if (code_path.empty()) {
+			code = samples::tileCopy().code;
+		} else if (code_path.size() > 5 && code_path.substr(code_path.size() - 5) == ".qasm") {
+			std::ifstream f(code_path);
+			std::ostringstream text;
+			text << f.rdbuf();
+			code = qasm::assembleText(text.str());
+		} else {
+			code = tools::readCodeFile(code_path);
+		}
 		const tools::GreyImage in = tools::readPgm(in_path);
 		const unsigned tiles_x = (in.width + 63) / 64, tiles_y = (in.height + 15) / 16;
 		const uint32_t pitch = tiles_x * 64, rows = tiles_y * 16;
