@@ -5,6 +5,11 @@
  * \todo Backends vc4 and vc4-emu (arrive with the vc4 issues).
  * \todo GstAnalyticsRelationMeta output behind a >= 1.24 meson feature.
  * \todo An overlay-composition path for GL/compositor consumers.
+ * \todo Overlap in pipelined AScale mode: frappe-core's Detector reads the
+ *       adaptive scale in runFrontEnd() and writes it in runBackEnd() without
+ *       a lock, so in AScale mode the element waits for the held back end
+ *       before the next front end (correct, but no overlap) until the core
+ *       makes that hand-over thread-safe.
  */
 
 /**
@@ -50,8 +55,9 @@
  *
  * With #GstFrappeDetect:pipelined, the front end of frame N+1 runs while the
  * back end of frame N runs on a worker thread. The element then holds one
- * buffer, answers the LATENCY query with one extra frame, pushes the held
- * buffer on EOS, caps, segment, gap and stream-start, and drops it on flush.
+ * buffer, answers the LATENCY query with one extra frame, asks upstream
+ * pools for one more buffer, pushes the held buffer on EOS, caps, segment,
+ * gap, stream-start and DRAIN queries, and drops it on flush.
  * Every buffer comes out once, in order, with its own metas.
  *
  * ## Example launch lines
@@ -76,6 +82,7 @@
 #include <atomic>
 #include <cmath>
 #include <condition_variable>
+#include <cstdio>
 #include <cstring>
 #include <exception>
 #include <functional>
@@ -337,6 +344,8 @@ struct FrappeDetectPrivate {
 	bool loggedMemory = false;
 	bool warnedStride = false;
 	guint64 frames = 0;
+	frappe::StageTimes windowTimes; /* sums over the current 100 frames */
+	double windowPoseMs = 0.0;
 };
 
 struct _GstFrappeDetect {
@@ -430,6 +439,28 @@ static void update_stats(GstFrappeDetect *self, const frappe::Result &result, do
 			  G_TYPE_BOOLEAN, priv->active.pipelined, nullptr);
 
 	GST_LOG_OBJECT(self, "stats %" GST_PTR_FORMAT, static_cast<void *>(s));
+
+	/* Every 100 frames, the average cost per stage at INFO level, so
+	 * GST_DEBUG=frappedetect:4 shows the speed without any tooling. */
+	priv->windowTimes.total_ms += result.times.total_ms + poseMs;
+	for (std::size_t i = 0; i < result.times.ms.size(); ++i)
+		priv->windowTimes.ms[i] += result.times.ms[i];
+	priv->windowPoseMs += poseMs;
+	if (priv->frames % 100 == 0) {
+		std::string line;
+		for (int i = 0; i < frappe::kStageCount; ++i) {
+			char part[64];
+			std::snprintf(part, sizeof(part), "%s %.2f, ",
+				      std::string(frappe::stageName(static_cast<frappe::Stage>(i))).c_str(),
+				      priv->windowTimes.ms[static_cast<std::size_t>(i)] / 100.0);
+			line += part;
+		}
+		GST_INFO_OBJECT(self, "last 100 frames, ms per frame: %spose %.2f, total %.2f%s", line.c_str(),
+				priv->windowPoseMs / 100.0, priv->windowTimes.total_ms / 100.0,
+				priv->active.pipelined ? " (front end overlapped with the back end)" : "");
+		priv->windowTimes = {};
+		priv->windowPoseMs = 0.0;
+	}
 	GST_OBJECT_LOCK(self);
 	if (priv->stats)
 		gst_structure_free(priv->stats);
@@ -746,26 +777,29 @@ static GstFlowReturn process(GstFrappeDetect *self, GstBuffer *input)
 				    GST_VIDEO_FRAME_COMP_STRIDE(&f.frame, 0));
 
 	frappe::Detector &detector = *priv->detector;
+	const bool pipelined = priv->active.pipelined;
 	try {
-		if (!priv->active.pipelined) {
+		if (!pipelined) {
 			detector.runFrontEnd(f.image, 0);
 			f.result = &detector.runBackEnd(f.image, 0);
-			finish(self, f);
-			return GST_FLOW_OK;
+		} else {
+			f.slot = priv->held ? 1 - priv->held->slot : 0;
+			/* frappe-core's adaptive scale state is shared by the two
+			 * slots without a lock: in AScale mode the back end of the
+			 * held frame must complete before the next front end starts. */
+			if (priv->active.mode == GST_FRAPPE_MODE_ASCALE)
+				priv->worker.wait();
+			detector.runFrontEnd(f.image, f.slot); /* overlaps the held back end */
 		}
-
-		f.slot = priv->held ? 1 - priv->held->slot : 0;
-		/* frappe-core's adaptive scale state is shared by the two slots
-		 * without a lock: in AScale mode the back end of the held frame
-		 * must complete before the next front end starts. */
-		if (priv->active.mode == GST_FRAPPE_MODE_ASCALE)
-			priv->worker.wait();
-		detector.runFrontEnd(f.image, f.slot); /* overlaps the held back end */
 	} catch (const std::exception &e) {
 		gst_video_frame_unmap(&f.frame);
 		gst_buffer_unref(f.buffer);
 		GST_ELEMENT_ERROR(self, STREAM, FAILED, ("Marker detection failed"), ("%s", e.what()));
 		return GST_FLOW_ERROR;
+	}
+	if (!pipelined) {
+		finish(self, f);
+		return GST_FLOW_OK;
 	}
 
 	finish_held(self);
@@ -838,6 +872,15 @@ static gboolean gst_frappe_detect_sink_event(GstBaseTransform *trans, GstEvent *
 static gboolean gst_frappe_detect_query(GstBaseTransform *trans, GstPadDirection direction, GstQuery *query)
 {
 	GstFrappeDetect *self = GST_FRAPPE_DETECT(trans);
+
+	/* Upstream wants its buffers back (e.g. to change its pool): push the
+	 * held one. DRAIN is serialized, so this is the streaming thread. */
+	if (direction == GST_PAD_SINK && GST_QUERY_TYPE(query) == GST_QUERY_DRAIN &&
+	    (self->priv->held || !self->priv->output.empty())) {
+		GST_DEBUG_OBJECT(self, "draining for a DRAIN query");
+		drain(self);
+	}
+
 	gboolean ret = GST_BASE_TRANSFORM_CLASS(parent_class)->query(trans, direction, query);
 
 	if (ret && direction == GST_PAD_SRC && GST_QUERY_TYPE(query) == GST_QUERY_LATENCY) {
@@ -867,6 +910,33 @@ static gboolean gst_frappe_detect_query(GstBaseTransform *trans, GstPadDirection
 	return ret;
 }
 
+/* Holding a buffer in pipelined mode takes one more from upstream's pool. */
+static gboolean gst_frappe_detect_propose_allocation(GstBaseTransform *trans, GstQuery *decide_query,
+						     GstQuery *query)
+{
+	GstFrappeDetect *self = GST_FRAPPE_DETECT(trans);
+	if (!GST_BASE_TRANSFORM_CLASS(parent_class)->propose_allocation(trans, decide_query, query))
+		return FALSE;
+
+	GST_OBJECT_LOCK(self);
+	const gboolean pipelined = self->priv->props.pipelined;
+	GST_OBJECT_UNLOCK(self);
+	if (!pipelined)
+		return TRUE;
+	for (guint i = 0; i < gst_query_get_n_allocation_pools(query); ++i) {
+		GstBufferPool *pool = nullptr;
+		guint size, min, max;
+		gst_query_parse_nth_allocation_pool(query, i, &pool, &size, &min, &max);
+		if (max != 0 && max < min + 1)
+			max = min + 1;
+		gst_query_set_nth_allocation_pool(query, i, pool, size, min + 1, max);
+		GST_DEBUG_OBJECT(self, "asking for %u buffers in pool %u (one held)", min + 1, i);
+		if (pool)
+			gst_object_unref(pool);
+	}
+	return TRUE;
+}
+
 static gboolean gst_frappe_detect_start(GstBaseTransform *trans)
 {
 	GstFrappeDetect *self = GST_FRAPPE_DETECT(trans);
@@ -874,6 +944,8 @@ static gboolean gst_frappe_detect_start(GstBaseTransform *trans)
 	self->priv->active = self->priv->props;
 	GST_OBJECT_UNLOCK(self);
 	self->priv->frames = 0;
+	self->priv->windowTimes = {};
+	self->priv->windowPoseMs = 0.0;
 	self->priv->loggedMemory = false;
 	self->priv->warnedStride = false;
 	return TRUE;
@@ -1199,6 +1271,7 @@ static void gst_frappe_detect_class_init(GstFrappeDetectClass *klass)
 	trans_class->generate_output = GST_DEBUG_FUNCPTR(gst_frappe_detect_generate_output);
 	trans_class->sink_event = GST_DEBUG_FUNCPTR(gst_frappe_detect_sink_event);
 	trans_class->query = GST_DEBUG_FUNCPTR(gst_frappe_detect_query);
+	trans_class->propose_allocation = GST_DEBUG_FUNCPTR(gst_frappe_detect_propose_allocation);
 	trans_class->start = GST_DEBUG_FUNCPTR(gst_frappe_detect_start);
 	trans_class->stop = GST_DEBUG_FUNCPTR(gst_frappe_detect_stop);
 	filter_class->set_info = GST_DEBUG_FUNCPTR(gst_frappe_detect_set_info);

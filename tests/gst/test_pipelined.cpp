@@ -145,6 +145,32 @@ TEST(Pipelined, FlushDropsTheHeldBuffer)
 	gst_harness_teardown(h);
 }
 
+TEST(Pipelined, DrainQueryPushesTheHeldBuffer)
+{
+	FrameSpec spec;
+	GstHarness *h = gst_harness_new_parse("frappedetect pipelined=true");
+	gst_harness_set_src_caps_str(h, capsString(spec).c_str());
+	ASSERT_EQ(gst_harness_push(h, frameOf(0, spec)), GST_FLOW_OK);
+	ASSERT_EQ(gst_harness_push(h, frameOf(1, spec)), GST_FLOW_OK);
+	EXPECT_EQ(gst_harness_buffers_received(h), 1u);
+	GstQuery *drain = gst_query_new_drain();
+	EXPECT_TRUE(gst_pad_peer_query(h->srcpad, drain));
+	gst_query_unref(drain);
+	EXPECT_EQ(gst_harness_buffers_received(h), 2u);
+	for (int i = 0; i < 2; ++i) {
+		GstBuffer *out = gst_harness_pull(h);
+		expectFrame(out, i, spec);
+		gst_buffer_unref(out);
+	}
+	/* And the stream goes on. */
+	ASSERT_EQ(gst_harness_push(h, frameOf(2, spec)), GST_FLOW_OK);
+	ASSERT_TRUE(gst_harness_push_event(h, gst_event_new_eos()));
+	GstBuffer *out = gst_harness_try_pull(h);
+	expectFrame(out, 2, spec);
+	gst_buffer_unref(out);
+	gst_harness_teardown(h);
+}
+
 TEST(Pipelined, CapsChangeDrains)
 {
 	FrameSpec a{ GST_VIDEO_FORMAT_I420, 640, 480, 0 };
