@@ -32,22 +32,6 @@ const char kUsage[] =
 	std::exit(2);
 }
 
-/* Corners of a square of `side` px at (cx, cy), rolled, tilted about its
- * horizontal axis and projected by a camera 4 sides away. */
-std::array<frappe::Point2f, 4> pose(double cx, double cy, double side, double roll, double tilt)
-{
-	const double r = roll * M_PI / 180, t = tilt * M_PI / 180;
-	const double xs[4] = { -0.5, 0.5, 0.5, -0.5 }, ys[4] = { -0.5, -0.5, 0.5, 0.5 };
-	std::array<frappe::Point2f, 4> q;
-	for (int i = 0; i < 4; ++i) {
-		const double Z = 4 + ys[i] * std::sin(t);
-		const double u = 4 * xs[i] / Z, v = 4 * ys[i] * std::cos(t) / Z;
-		q[i] = { static_cast<float>(cx + side * (u * std::cos(r) - v * std::sin(r))),
-			 static_cast<float>(cy + side * (u * std::sin(r) + v * std::cos(r))) };
-	}
-	return q;
-}
-
 } // namespace
 
 int main(int argc, char **argv)
@@ -118,7 +102,8 @@ int main(int argc, char **argv)
 		const double cx = 110 + (k % cols) * 210 + 20 * (U(rng) - 0.5);
 		const double cy = 480.0 / (rows + 1) * (k / cols + 1) + 20 * (U(rng) - 0.5);
 		const double side = 50 + 70 * U(rng);
-		const auto q = pose(cx, cy, side, 360 * U(rng), 50 * U(rng));
+		const auto q = frappe::perspectiveSquare(static_cast<float>(cx), static_cast<float>(cy), static_cast<float>(side),
+							 static_cast<float>(360 * U(rng)), static_cast<float>(50 * U(rng)));
 		frappe::RenderOptions opt;
 		opt.black = static_cast<std::uint8_t>(15 + 20 * U(rng));
 		opt.white = static_cast<std::uint8_t>(200 + 50 * U(rng));

@@ -89,6 +89,22 @@ void renderMarker(MutableImageView image, const Dictionary &dict, int id,
 	}
 }
 
+std::array<Point2f, 4> perspectiveSquare(float cx, float cy, float side, float roll, float tilt,
+					 float distance)
+{
+	const double r = roll * M_PI / 180.0, t = tilt * M_PI / 180.0;
+	const double xs[4] = { -0.5, 0.5, 0.5, -0.5 }, ys[4] = { -0.5, -0.5, 0.5, 0.5 };
+	std::array<Point2f, 4> out;
+	for (int i = 0; i < 4; ++i) {
+		/* Tilt about the square's x axis, project, then roll. */
+		const double Z = distance + ys[i] * std::sin(t);
+		const double u = distance * xs[i] / Z, v = distance * ys[i] * std::cos(t) / Z;
+		out[i] = { static_cast<float>(cx + side * (u * std::cos(r) - v * std::sin(r))),
+			   static_cast<float>(cy + side * (u * std::sin(r) + v * std::cos(r))) };
+	}
+	return out;
+}
+
 std::vector<std::uint8_t> markerImage(const Dictionary &dict, int id, int cell_px, int quiet_cells,
 				      int &side)
 {

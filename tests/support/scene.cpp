@@ -9,18 +9,7 @@ namespace frappe::test {
 std::array<Point2f, 4> squarePose(float cx, float cy, float side, float roll, float tilt,
 				  float distance)
 {
-	const double r = roll * M_PI / 180.0, t = tilt * M_PI / 180.0;
-	const double f = distance; /* focal length in units of the side */
-	std::array<Point2f, 4> out;
-	const double xs[4] = { -0.5, 0.5, 0.5, -0.5 }, ys[4] = { -0.5, -0.5, 0.5, 0.5 };
-	for (int i = 0; i < 4; ++i) {
-		/* Tilt about the marker's x axis, then project, then roll. */
-		const double X = xs[i], Y = ys[i] * std::cos(t), Z = distance + ys[i] * std::sin(t);
-		const double u = f * X / Z, v = f * Y / Z;
-		out[i] = { static_cast<float>(cx + side * (u * std::cos(r) - v * std::sin(r))),
-			   static_cast<float>(cy + side * (u * std::sin(r) + v * std::cos(r))) };
-	}
-	return out;
+	return perspectiveSquare(cx, cy, side, roll, tilt, distance);
 }
 
 void blur(Image &img, float sigma)

@@ -36,6 +36,14 @@ struct RenderOptions {
 void renderMarker(MutableImageView image, const Dictionary &dict, int id,
 		  const std::array<Point2f, 4> &corners, const RenderOptions &options = {});
 
+/// Corners (top-left, top-right, bottom-right, bottom-left) of a square of
+/// `side` pixels centred at (cx, cy), tilted by `tilt` degrees about its
+/// horizontal axis, seen by a pinhole camera `distance` sides away whose
+/// focal length keeps an untilted square `side` wide, then rolled by `roll`
+/// degrees in the image plane. For test scenes and samples.
+std::array<Point2f, 4> perspectiveSquare(float cx, float cy, float side, float roll, float tilt,
+					 float distance = 4.0f);
+
 /// An upright marker image, `cell_px` pixels a cell, with its quiet zone:
 /// side = (bits + 2 + 2 * quiet_cells) * cell_px.
 std::vector<std::uint8_t> markerImage(const Dictionary &dict, int id, int cell_px,
