@@ -18,8 +18,10 @@
 //   edge: m > edge_threshold_sq and m > m(previous neighbour) and
 //   m >= m(next neighbour) along the direction (previous = left/up)
 //   corner: edge and the minimum eigenvalue of the 3x3 sum of
-//   [gx^2 gxgy; gxgy gy^2] > corner_threshold, decided without a root:
-//   S - 2T > 0 and (S - 2T)^2 > (Sxx - Syy)^2 + 4 Sxy^2, S = Sxx + Syy.
+//   [gx^2 gxgy; gxgy gy^2] > corner_threshold T, decided without a root
+//   and in 32-bit integers (the QPU multiplies 24 x 24 bits):
+//   c = (Sxx + Syy - 2T) >> 9, a = |Sxx - Syy| >> 9, b = |Sxy| >> 8
+//   (arithmetic shifts), corner when c > 0 and c*c > a*a + b*b.
 #include <algorithm>
 #include <cstdlib>
 #include <thread>

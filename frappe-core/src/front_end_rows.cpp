@@ -83,11 +83,14 @@ bool isCorner(const GradRows &rows, int x, std::int64_t cornerThreshold)
 			sxy += gx * gy;
 		}
 	}
-	const std::int64_t s = static_cast<std::int64_t>(sxx) + syy - 2 * cornerThreshold;
-	if (s <= 0)
+	/* In 32 bits (the QPU has no wider multiply): the sums are below 2^24.2
+	 * and D <= S^2, so after >> 9 every square below fits in an int32. */
+	const std::int32_t c = (sxx + syy - 2 * static_cast<std::int32_t>(cornerThreshold)) >> 9;
+	if (c <= 0)
 		return false;
-	const std::int64_t d = static_cast<std::int64_t>(sxx) - syy;
-	return s * s > d * d + 4 * static_cast<std::int64_t>(sxy) * sxy;
+	const std::int32_t a = std::abs(sxx - syy) >> 9;
+	const std::int32_t b = std::abs(sxy) >> 8;
+	return c * c > a * a + b * b;
 }
 
 bool edgeRow(const GradRows &rows, int w, const FrontEndParams &params, std::uint8_t *out)
