@@ -21,6 +21,33 @@ namespace {
 constexpr int kDx[8] = { 1, 1, 0, -1, -1, -1, 0, 1 };
 constexpr int kDy[8] = { 0, -1, -1, -1, 0, 1, 1, 1 };
 
+/* Step 3.3 of Suzuki's algorithm as a table: for the direction `back` to the
+ * previous border pixel and the mask of non-zero neighbours (bit d for
+ * direction d), the first non-zero neighbour counter-clockwise after `back`
+ * (low 3 bits) and whether the right neighbour (direction 0) was examined
+ * and found zero on the way (bit 3). Replaces a data-dependent loop whose
+ * branches the CPU cannot predict. */
+struct NextStepTable {
+	std::uint8_t entry[8][256];
+	constexpr NextStepTable() : entry{}
+	{
+		for (int back = 0; back < 8; ++back)
+			for (int mask = 1; mask < 256; ++mask) {
+				bool rightExamined = false;
+				for (int k = 1; k <= 8; ++k) {
+					const int d = (back + k) & 7;
+					if (mask & (1 << d)) {
+						entry[back][mask] = static_cast<std::uint8_t>(d | (rightExamined ? 8 : 0));
+						break;
+					}
+					if (d == 0)
+						rightExamined = true;
+				}
+			}
+	}
+};
+constexpr NextStepTable kNextStep;
+
 float cross(Point2f o, Point2f a, Point2f b)
 {
 	return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x);
@@ -47,47 +74,59 @@ void ContourTracer::trace(const EdgeMap &edges, const TraceParams &params, std::
 	stride_ = w;
 	radius2_ = params.cluster_radius * params.cluster_radius;
 	labels_.resize(static_cast<std::size_t>(w) * h);
-	const std::uint8_t *src = edges.pixels.data();
-	for (std::size_t i = 0; i < labels_.size(); ++i)
-		labels_[i] = src[i] & EdgeMap::kEdge;
+	/* Label 1 for every edge pixel; a plain loop over local pointers that
+	 * the compiler vectorises. */
+	{
+		const std::uint8_t *src = edges.pixels.data();
+		std::uint8_t *dst = labels_.data();
+		const std::size_t n = labels_.size();
+		for (std::size_t i = 0; i < n; ++i)
+			dst[i] = src[i] & EdgeMap::kEdge;
+	}
 
 	constexpr int T = EdgeMap::kTile;
 	for (int y = 1; y < h - 1; ++y) {
 		const std::uint8_t *tileRow = edges.tiles.data() + static_cast<std::size_t>(y / T) * edges.tiles_x;
 		std::uint8_t *row = labels_.data() + static_cast<std::size_t>(y) * w;
-		for (int x = 1; x < w - 1; ++x) {
-			if (tileRow[x / T] == 0) {
-				x = (x / T + 1) * T - 1; /* the loop's ++x lands on the next tile */
+		for (int tx = 0; tx < edges.tiles_x; ++tx) {
+			if (tileRow[tx] == 0)
 				continue;
-			}
-			const std::uint8_t f = row[x];
-			if (f == 0) {
-				/* Most pixels are background: hop over zero words. */
-				std::uint64_t word;
-				while (x + 9 < w && (std::memcpy(&word, row + x + 1, 8), word == 0))
-					x += 8;
-				continue;
-			}
-			int fromDir;
-			if (f == 1 && row[x - 1] == 0)
-				fromDir = 4; /* outer border: came from the left */
-			else if ((f == 1 || f == 2) && row[x + 1] == 0)
-				fromDir = 0; /* hole border: the hole is to the right */
-			else
-				continue;
+			/* Runs of occupied tiles are scanned as one stretch. */
+			int tEnd = tx + 1;
+			while (tEnd < edges.tiles_x && tileRow[tEnd])
+				++tEnd;
+			const int x0 = std::max(1, tx * T), x1 = std::min(w - 1, tEnd * T);
+			tx = tEnd;
+			for (int x = x0; x < x1; ++x) {
+				const std::uint8_t f = row[x];
+				if (f == 0) {
+					/* Most pixels are background: hop over zero words. */
+					std::uint64_t word;
+					while (x + 9 < x1 && (std::memcpy(&word, row + x + 1, 8), word == 0))
+						x += 8;
+					continue;
+				}
+				int fromDir;
+				if (f == 1 && row[x - 1] == 0)
+					fromDir = 4; /* outer border: came from the left */
+				else if ((f == 1 || f == 2) && row[x + 1] == 0)
+					fromDir = 0; /* hole border: the hole is to the right */
+				else
+					continue;
 
-			++borders_;
-			follow(x, y, fromDir, edges);
-			/* A marker outline is at least four sides of min_side pixels. */
-			if (static_cast<float>(steps_) < 2.8f * params.min_side)
-				continue;
-			/* The paper's rule first: the corner clusters; failing that,
-			 * the outline's extreme points. */
-			Quad quad;
-			if ((!tooManyClusters_ && clusters_.size() >= 4 && quadFromClusters(quad) &&
-			     acceptQuad(params, w, h, quad)) ||
-			    (quadFromOutline(quad) && acceptQuad(params, w, h, quad)))
-				out.push_back(quad);
+				++borders_;
+				follow(x, y, fromDir, edges);
+				/* A marker outline is at least four sides of min_side pixels. */
+				if (static_cast<float>(steps_) < 2.8f * params.min_side)
+					continue;
+				/* The paper's rule first: the corner clusters; failing that,
+				 * the outline's extreme points. */
+				Quad quad;
+				if ((!tooManyClusters_ && clusters_.size() >= 4 && quadFromClusters(quad) &&
+				     acceptQuad(params, w, h, quad)) ||
+				    (quadFromOutline(quad) && acceptQuad(params, w, h, quad)))
+					out.push_back(quad);
+			}
 		}
 	}
 }
@@ -127,51 +166,50 @@ void ContourTracer::follow(int x0, int y0, int fromDir, const EdgeMap &edges)
 		clusters_.push_back({ fx, fy, 1, x, y });
 	};
 
+	/* Pointer offsets of the eight neighbours, in kDx/kDy order. */
+	const std::ptrdiff_t off[8] = { 1, 1 - w, -w, -1 - w, -1, w - 1, w, w + 1 };
+	auto neighbourMask = [&](const std::uint8_t *p) {
+		unsigned m = 0;
+		for (int d = 0; d < 8; ++d)
+			m |= static_cast<unsigned>(p[off[d]] != 0) << d;
+		return m;
+	};
+
 	/* 3.1: clockwise from fromDir, find the first non-zero neighbour. */
-	int d1 = -1;
-	for (int k = 0; k < 8; ++k) {
-		const int d = (fromDir - k + 8) & 7;
-		if (at(x0 + kDx[d], y0 + kDy[d]) != 0) {
-			d1 = d;
-			break;
-		}
-	}
-	if (d1 < 0) {
-		at(x0, y0) = 3; /* isolated pixel */
+	std::uint8_t *p0 = &at(x0, y0);
+	const unsigned mask0 = neighbourMask(p0);
+	if (mask0 == 0) {
+		*p0 = 3; /* isolated pixel */
 		visit(x0, y0);
 		return;
 	}
-	const int x1 = x0 + kDx[d1], y1 = y0 + kDy[d1];
+	int d1 = fromDir;
+	while (!(mask0 & (1u << d1)))
+		d1 = (d1 + 7) & 7;
+	std::uint8_t *p1 = p0 + off[d1];
+	std::uint8_t *p3 = p0;
 	int x3 = x0, y3 = y0;
-	int back = d1; /* direction from (x3, y3) to the previous border pixel */
+	int back = d1; /* direction from p3 to the previous border pixel */
+	const std::size_t maxSteps = 4 * labels_.size();
 	for (;;) {
 		/* 3.3: counter-clockwise from the pixel after `back`. */
-		int d4 = -1;
-		bool rightExamined = false;
-		for (int k = 1; k <= 8; ++k) {
-			const int d = (back + k) & 7;
-			if (at(x3 + kDx[d], y3 + kDy[d]) != 0) {
-				d4 = d;
-				break;
-			}
-			if (d == 0)
-				rightExamined = true;
-		}
+		const std::uint8_t step = kNextStep.entry[back][neighbourMask(p3)];
+		const int d4 = step & 7;
 		/* 3.4: mark the current pixel. */
-		std::uint8_t &cur = at(x3, y3);
-		if (rightExamined)
-			cur = 3;
-		else if (cur == 1)
-			cur = 2;
+		if (step & 8)
+			*p3 = 3;
+		else if (*p3 == 1)
+			*p3 = 2;
 		visit(x3, y3);
-		const int x4 = x3 + kDx[d4], y4 = y3 + kDy[d4];
+		std::uint8_t *p4 = p3 + off[d4];
 		/* 3.5: back at the start, about to repeat the first move. */
-		if (x4 == x0 && y4 == y0 && x3 == x1 && y3 == y1)
+		if (p4 == p0 && p3 == p1)
 			return;
 		back = (d4 + 4) & 7;
-		x3 = x4;
-		y3 = y4;
-		if (static_cast<std::size_t>(steps_) > 4 * labels_.size()) /* only on a corrupt label image */
+		p3 = p4;
+		x3 += kDx[d4];
+		y3 += kDy[d4];
+		if (static_cast<std::size_t>(steps_) > maxSteps) /* only on a corrupt label image */
 			return;
 	}
 }

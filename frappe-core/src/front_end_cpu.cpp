@@ -54,7 +54,10 @@ namespace {
 class CpuFrontEnd final : public FrontEnd
 {
 public:
-	explicit CpuFrontEnd(int threads) : threads_(threads) {}
+	CpuFrontEnd(int threads, const detail::RowKernels &kernels)
+		: threads_(threads), kernels_(kernels)
+	{
+	}
 	const char *name() const override { return "cpu"; }
 	void run(const ImageView &image, float scale, const FrontEndParams &params,
 		 EdgeMap &out) override;
@@ -64,6 +67,7 @@ private:
 		     int y0, int y1, detail::RowScratch &scratch);
 
 	int threads_;
+	const detail::RowKernels &kernels_;
 	std::vector<std::uint8_t> scaled_;
 	std::vector<detail::RowScratch> scratch_;
 };
@@ -133,34 +137,43 @@ void CpuFrontEnd::runBand(const ImageView &src, const FrontEndParams &params, Ed
 			  int y0, int y1, detail::RowScratch &s)
 {
 	const int w = src.width, h = src.height;
+	const detail::RowKernels &k = kernels_;
 	s.resize(w);
 	/* Gradient row r needs smoothed rows r-1..r+1; both live in rings. */
 	auto smoothed = [&](int r) { return s.smooth[r & 3].data(); };
 	auto gradient = [&](int r) {
 		const int i = r % 3;
 		if (r <= 0 || r >= h - 1)
-			detail::zeroGradientRow(w, s.gx[i].data(), s.gy[i].data(), s.mag[i].data());
+			detail::zeroGradientRow(w, s.gx[i].data(), s.gy[i].data(), s.mag[i].data(), s.tensor(i));
 		else
-			detail::gradientRow(smoothed(r - 1), smoothed(r), smoothed(r + 1), w, s.gx[i].data(),
-					    s.gy[i].data(), s.mag[i].data(), s.separable.data());
+			k.gradient(smoothed(r - 1), smoothed(r), smoothed(r + 1), w, s.gx[i].data(),
+				   s.gy[i].data(), s.mag[i].data(), s.separable.data(), s.tensor(i));
+	};
+	/* Rows beyond the frame replicate its first and last row. */
+	auto smoothRow = [&](int r) {
+		k.smooth(src.row(std::max(r - 1, 0)), src.row(r), src.row(std::min(r + 1, h - 1)), w,
+			 smoothed(r), s.columns.data());
 	};
 	for (int r = std::max(0, y0 - 2); r <= std::min(h - 1, y0 + 1); ++r)
-		detail::smoothRow(src, r, smoothed(r), s.columns.data());
+		smoothRow(r);
 	gradient(y0 - 1);
 	gradient(y0);
 
 	for (int y = y0; y < y1; ++y) {
 		const int next = y + 1;
 		if (next + 1 <= h - 1)
-			detail::smoothRow(src, next + 1, smoothed(next + 1), s.columns.data());
+			smoothRow(next + 1);
 		gradient(next);
 		const detail::GradRows rows{
 			{ s.gx[(y - 1) % 3].data(), s.gx[y % 3].data(), s.gx[next % 3].data() },
 			{ s.gy[(y - 1) % 3].data(), s.gy[y % 3].data(), s.gy[next % 3].data() },
 			{ s.mag[(y - 1) % 3].data(), s.mag[y % 3].data(), s.mag[next % 3].data() },
+			{ s.txx[(y - 1) % 3].data(), s.txx[y % 3].data(), s.txx[next % 3].data() },
+			{ s.tyy[(y - 1) % 3].data(), s.tyy[y % 3].data(), s.tyy[next % 3].data() },
+			{ s.txy[(y - 1) % 3].data(), s.txy[y % 3].data(), s.txy[next % 3].data() },
 		};
 		std::uint8_t *edgeRow = out.pixels.data() + static_cast<std::size_t>(y) * w;
-		const bool any = detail::edgeRow(rows, w, params, edgeRow);
+		const bool any = k.edge(rows, w, params, edgeRow);
 		if (any) {
 			std::uint8_t *tileRow = out.tiles.data() +
 						static_cast<std::size_t>(y / EdgeMap::kTile) * out.tiles_x;
@@ -173,7 +186,12 @@ void CpuFrontEnd::runBand(const ImageView &src, const FrontEndParams &params, Ed
 
 std::unique_ptr<FrontEnd> makeCpuFrontEnd(int threads)
 {
-	return std::make_unique<CpuFrontEnd>(threads);
+	return std::make_unique<CpuFrontEnd>(threads, detail::bestRowKernels());
+}
+
+std::unique_ptr<FrontEnd> detail::makeCpuFrontEnd(int threads, const RowKernels &kernels)
+{
+	return std::make_unique<CpuFrontEnd>(threads, kernels);
 }
 
 } // namespace frappe

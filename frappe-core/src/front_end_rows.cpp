@@ -22,12 +22,9 @@ void scaleNearest(const ImageView &src, int dstW, int dstH, std::uint8_t *dst)
 	}
 }
 
-void smoothRow(const ImageView &src, int r, std::uint8_t *out, std::uint16_t *tmp)
+void smoothRow(const std::uint8_t *a, const std::uint8_t *b, const std::uint8_t *c, int w,
+	       std::uint8_t *out, std::uint16_t *tmp)
 {
-	const int w = src.width, h = src.height;
-	const std::uint8_t *a = src.row(std::max(r - 1, 0));
-	const std::uint8_t *b = src.row(r);
-	const std::uint8_t *c = src.row(std::min(r + 1, h - 1));
 	/* Separable: the vertical [1 2 1] first, into 16 bits, then across. */
 	for (int x = 0; x < w; ++x)
 		tmp[x] = static_cast<std::uint16_t>(a[x] + 2 * b[x] + c[x]);
@@ -42,7 +39,8 @@ void smoothRow(const ImageView &src, int r, std::uint8_t *out, std::uint16_t *tm
 }
 
 void gradientRow(const std::uint8_t *a, const std::uint8_t *b, const std::uint8_t *c, int w,
-		 std::int16_t *gx, std::int16_t *gy, std::int32_t *mag, std::int16_t *tmp)
+		 std::int16_t *gx, std::int16_t *gy, std::int32_t *mag, std::int16_t *tmp,
+		 TensorRow /* the scalar corner test sums on demand */)
 {
 	/* Separable Sobel: vertical smoothing and vertical difference per
 	 * column, then the horizontal difference and smoothing. */
@@ -64,11 +62,14 @@ void gradientRow(const std::uint8_t *a, const std::uint8_t *b, const std::uint8_
 	}
 }
 
-void zeroGradientRow(int w, std::int16_t *gx, std::int16_t *gy, std::int32_t *mag)
+void zeroGradientRow(int w, std::int16_t *gx, std::int16_t *gy, std::int32_t *mag, TensorRow tensor)
 {
 	std::memset(gx, 0, sizeof(*gx) * w);
 	std::memset(gy, 0, sizeof(*gy) * w);
 	std::memset(mag, 0, sizeof(*mag) * w);
+	std::memset(tensor.xx, 0, sizeof(*tensor.xx) * w);
+	std::memset(tensor.yy, 0, sizeof(*tensor.yy) * w);
+	std::memset(tensor.xy, 0, sizeof(*tensor.xy) * w);
 }
 
 bool isCorner(const GradRows &rows, int x, std::int64_t cornerThreshold)
@@ -95,6 +96,13 @@ bool isCorner(const GradRows &rows, int x, std::int64_t cornerThreshold)
 
 bool edgeRow(const GradRows &rows, int w, const FrontEndParams &params, std::uint8_t *out)
 {
+	out[0] = 0;
+	out[w - 1] = 0;
+	return edgeSpan(rows, 1, w - 1, params, out);
+}
+
+bool edgeSpan(const GradRows &rows, int x0, int x1, const FrontEndParams &params, std::uint8_t *out)
+{
 	const std::int32_t *up = rows.mag[0];
 	const std::int32_t *mid = rows.mag[1];
 	const std::int32_t *down = rows.mag[2];
@@ -102,9 +110,7 @@ bool edgeRow(const GradRows &rows, int w, const FrontEndParams &params, std::uin
 	const std::int16_t *gyr = rows.gy[1];
 	const std::int64_t thr = params.edge_threshold_sq;
 	bool any = false;
-	out[0] = 0;
-	out[w - 1] = 0;
-	for (int x = 1; x < w - 1; ++x) {
+	for (int x = x0; x < x1; ++x) {
 		const std::int32_t m = mid[x];
 		std::uint8_t v = 0;
 		if (m > thr) {
@@ -147,5 +153,18 @@ void markTiles(const std::uint8_t *edgeRow, int w, std::uint8_t *tileRow)
 			tileRow[t] = 1;
 	}
 }
+
+const RowKernels &scalarRowKernels()
+{
+	static constexpr RowKernels kScalar{ "scalar", smoothRow, gradientRow, edgeRow };
+	return kScalar;
+}
+
+#ifndef FRAPPE_HAVE_HWY
+const RowKernels &bestRowKernels()
+{
+	return scalarRowKernels();
+}
+#endif
 
 } // namespace frappe::detail

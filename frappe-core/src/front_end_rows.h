@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "frappe/edge_map.h"
@@ -11,11 +12,18 @@
 
 namespace frappe::detail {
 
+/// One row of the structure tensor's products summed over x-1..x+1, for the
+/// vectorised corner test (the scalar kernels leave it untouched).
+struct TensorRow {
+	std::int32_t *xx, *yy, *xy;
+};
+
 /// Three consecutive rows (y-1, y, y+1) of gradients and squared magnitudes.
 struct GradRows {
 	const std::int16_t *gx[3];
 	const std::int16_t *gy[3];
 	const std::int32_t *mag[3];
+	const std::int32_t *txx[3], *tyy[3], *txy[3]; ///< TensorRow sums, when computed
 };
 
 /// Per-thread scratch: rings of smoothed rows and of gradient rows.
@@ -25,6 +33,8 @@ struct RowScratch {
 	std::vector<std::int16_t> separable;   ///< gradientRow's two column passes
 	std::vector<std::int16_t> gx[3], gy[3];
 	std::vector<std::int32_t> mag[3];
+	std::vector<std::int32_t> txx[3], tyy[3], txy[3];
+	TensorRow tensor(int i) { return { txx[i].data(), tyy[i].data(), txy[i].data() }; }
 	void resize(int w)
 	{
 		for (int i = 0; i < 4; ++i)
@@ -35,6 +45,9 @@ struct RowScratch {
 			gx[i].resize(w);
 			gy[i].resize(w);
 			mag[i].resize(w);
+			txx[i].resize(w);
+			tyy[i].resize(w);
+			txy[i].resize(w);
 		}
 	}
 };
@@ -43,24 +56,51 @@ struct RowScratch {
 /// ((2x + 1) * round(65536 * srcW / dstW)) >> 17, clamped; rows likewise.
 void scaleNearest(const ImageView &src, int dstW, int dstH, std::uint8_t *dst);
 
-/// Row r of the image smoothed by the 3x3 binomial kernel [1 2 1]^T [1 2 1] / 16,
-/// rounded, with edge pixels replicated beyond the frame. `tmp` holds w values.
-void smoothRow(const ImageView &src, int r, std::uint8_t *out, std::uint16_t *tmp);
+/// The middle of three image rows a, b, c smoothed by the 3x3 binomial
+/// kernel [1 2 1]^T [1 2 1] / 16, rounded, edge pixels replicated beyond the
+/// first and last column. `tmp` holds w values.
+void smoothRow(const std::uint8_t *a, const std::uint8_t *b, const std::uint8_t *c, int w,
+	       std::uint8_t *out, std::uint16_t *tmp);
 
 /// Sobel gradients of the middle of three smoothed rows a, b, c; zero in
 /// the first and last column. `tmp` holds 2w values.
 void gradientRow(const std::uint8_t *a, const std::uint8_t *b, const std::uint8_t *c, int w,
-		 std::int16_t *gx, std::int16_t *gy, std::int32_t *mag, std::int16_t *tmp);
+		 std::int16_t *gx, std::int16_t *gy, std::int32_t *mag, std::int16_t *tmp,
+		 TensorRow tensor);
 
 /// The gradient row of the outermost image rows: all zero.
-void zeroGradientRow(int w, std::int16_t *gx, std::int16_t *gy, std::int32_t *mag);
+void zeroGradientRow(int w, std::int16_t *gx, std::int16_t *gy, std::int32_t *mag, TensorRow tensor);
 
 /// Non-maximum suppression, edge threshold and corner test of the middle
 /// row. Writes w bytes; returns whether any pixel is an edge.
 bool edgeRow(const GradRows &rows, int w, const FrontEndParams &params, std::uint8_t *out);
 
+/// edgeRow's rule for columns x0 .. x1-1 only (1 <= x0, x1 <= w-1).
+bool edgeSpan(const GradRows &rows, int x0, int x1, const FrontEndParams &params, std::uint8_t *out);
+
 /// ORs each 16-pixel run of an edge row into its tile's occupancy byte.
 void markTiles(const std::uint8_t *edgeRow, int w, std::uint8_t *tileRow);
+
+/// The row kernels one front end uses: the portable scalar ones above, or
+/// their vectorised twins, which must produce the same bytes.
+struct RowKernels {
+	const char *name;
+	void (*smooth)(const std::uint8_t *a, const std::uint8_t *b, const std::uint8_t *c, int w,
+		       std::uint8_t *out, std::uint16_t *tmp);
+	void (*gradient)(const std::uint8_t *a, const std::uint8_t *b, const std::uint8_t *c, int w,
+			 std::int16_t *gx, std::int16_t *gy, std::int32_t *mag, std::int16_t *tmp,
+			 TensorRow tensor);
+	bool (*edge)(const GradRows &rows, int w, const FrontEndParams &params, std::uint8_t *out);
+};
+
+/// The scalar kernels: the reference, and the ARMv6 path.
+const RowKernels &scalarRowKernels();
+/// The fastest kernels for this CPU (Highway's runtime dispatch), or the
+/// scalar ones when the build has no Highway.
+const RowKernels &bestRowKernels();
+
+/// A CPU front end with the given kernels (tests compare them).
+std::unique_ptr<FrontEnd> makeCpuFrontEnd(int threads, const RowKernels &kernels);
 
 /// The corner decision for one pixel from its 3x3 gradient neighbourhood.
 bool isCorner(const GradRows &rows, int x, std::int64_t cornerThreshold);

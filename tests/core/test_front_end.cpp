@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "frappe/frappe.h"
+#include "front_end_rows.h"
 #include "scene.h"
 
 using namespace frappe;
@@ -172,4 +173,58 @@ TEST(FrontEnd, ScalingSamplesTheNearestPixel)
 	/* The square maps to [16, 48) x [16, 32): its left side is at 15|16. */
 	EXPECT_TRUE((em.at(15, 24) | em.at(16, 24)) & EdgeMap::kEdge);
 	EXPECT_FALSE(em.at(30, 24) & EdgeMap::kEdge);
+}
+
+/* The vectorised kernels must give the scalar kernels' bytes on every
+ * width (vector bodies, tails, both), on saturated gradients and on dense
+ * corners. */
+TEST(FrontEnd, VectorKernelsMatchTheScalarOnesByteForByte)
+{
+	const detail::RowKernels &best = detail::bestRowKernels();
+	const detail::RowKernels &scalar = detail::scalarRowKernels();
+	if (best.smooth == scalar.smooth)
+		GTEST_SKIP() << "built without Highway: only the scalar kernels exist";
+	auto scalarFe = detail::makeCpuFrontEnd(1, scalar);
+	auto bestFe = detail::makeCpuFrontEnd(1, best);
+
+	FrontEndParams loose = defaultParams();
+	loose.edge_threshold_sq = 10;
+	loose.corner_threshold = 0;
+	const FrontEndParams paramsList[] = { defaultParams(), loose };
+
+	std::mt19937 rng(11);
+	int compared = 0, edges = 0, corners = 0;
+	for (int w : { 1, 2, 3, 4, 5, 7, 9, 15, 16, 17, 31, 33, 47, 64, 65, 100, 257, 641 }) {
+		for (int kind = 0; kind < 3; ++kind) {
+			const int h = 3 + (w * 7 + kind * 5) % 41;
+			Image img(w, h, 0, kind == 1 ? 13 : 0);
+			std::uniform_int_distribution<int> any(0, 255), coin(0, 1);
+			for (int y = 0; y < h; ++y)
+				for (int x = 0; x < w; ++x) {
+					if (kind == 0) /* noise: edges everywhere */
+						img.at(x, y) = static_cast<std::uint8_t>(any(rng));
+					else if (kind == 1) /* 0/255 blocks: the largest gradients */
+						img.at(x, y) = ((x / 3 + y / 2) & 1) ? 255 : 0;
+					else /* smooth ramps with sparse spikes */
+						img.at(x, y) = static_cast<std::uint8_t>(
+							(x * 5 + y * 3) % 256 ^ (coin(rng) && coin(rng) ? 255 : 0));
+				}
+			for (const FrontEndParams &p : paramsList) {
+				EdgeMap a, b;
+				scalarFe->run(img.view(), 1.0f, p, a);
+				bestFe->run(img.view(), 1.0f, p, b);
+				ASSERT_EQ(a.pixels, b.pixels) << "width " << w << " kind " << kind;
+				ASSERT_EQ(a.tiles, b.tiles) << "width " << w << " kind " << kind;
+				for (std::uint8_t v : a.pixels) {
+					edges += v & EdgeMap::kEdge;
+					corners += (v & EdgeMap::kCorner) != 0;
+				}
+				++compared;
+			}
+		}
+	}
+	/* The comparison must have covered edges and corners, not blank maps. */
+	EXPECT_GT(edges, 10000);
+	EXPECT_GT(corners, 1000);
+	EXPECT_EQ(compared, 18 * 3 * 2);
 }
