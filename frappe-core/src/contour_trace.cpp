@@ -98,14 +98,22 @@ void ContourTracer::trace(const EdgeMap &edges, const TraceParams &params, std::
 			const int x0 = std::max(1, tx * T), x1 = std::min(w - 1, tEnd * T);
 			tx = tEnd;
 			for (int x = x0; x < x1; ++x) {
-				const std::uint8_t f = row[x];
-				if (f == 0) {
-					/* Most pixels are background: hop over zero words. */
+				/* Most pixels are background: find the next non-zero label
+				 * eight at a time (little-endian: the lowest set byte is
+				 * the leftmost pixel). */
+				if (x + 8 <= x1) {
 					std::uint64_t word;
-					while (x + 9 < x1 && (std::memcpy(&word, row + x + 1, 8), word == 0))
-						x += 8;
-					continue;
+					std::memcpy(&word, row + x, 8);
+					if (word == 0) {
+						x += 7;
+						continue;
+					}
+					if constexpr (std::endian::native == std::endian::little)
+						x += std::countr_zero(word) >> 3;
 				}
+				const std::uint8_t f = row[x];
+				if (f == 0)
+					continue;
 				int fromDir;
 				if (f == 1 && row[x - 1] == 0)
 					fromDir = 4; /* outer border: came from the left */

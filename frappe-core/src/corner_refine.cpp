@@ -15,13 +15,14 @@ struct Line {
 	double nx, ny, c;
 };
 
-constexpr int kMaxSamples = 48;  /* edge points per side */
+constexpr int kMaxSamples = 48;  /* edge points per side, final pass */
+constexpr int kCoarseSamples = 16; /* edge points per side, first pass */
 constexpr int kMaxProfile = 64;  /* samples along one normal */
 constexpr float kProfileStep = 0.5f;
 
 /* Measures one side from a to b (clockwise quad, so the marker interior is
  * on the right of a->b on screen). */
-bool fitSide(const ImageView &img, Point2f a, Point2f b, float search, Line &line)
+bool fitSide(const ImageView &img, Point2f a, Point2f b, float search, int maxSamples, Line &line)
 {
 	const float dx = b.x - a.x, dy = b.y - a.y;
 	const float len = std::sqrt(dx * dx + dy * dy);
@@ -35,7 +36,7 @@ bool fitSide(const ImageView &img, Point2f a, Point2f b, float search, Line &lin
 	const float usable = len - 2.0f * margin;
 	if (usable <= 0.0f)
 		return false;
-	const int nSamples = std::clamp(static_cast<int>(usable / 1.5f), 3, kMaxSamples);
+	const int nSamples = std::clamp(static_cast<int>(usable / 1.5f), 3, maxSamples);
 	const int half = std::min(kMaxProfile / 2 - 1, static_cast<int>(std::ceil(search / kProfileStep)) + 1);
 
 	double sw = 0, sx = 0, sy = 0, sxx = 0, syy = 0, sxy = 0;
@@ -105,11 +106,11 @@ bool intersect(const Line &l1, const Line &l2, Point2f &p)
 	return true;
 }
 
-bool refineOnce(const ImageView &img, std::array<Point2f, 4> &q, float search)
+bool refineOnce(const ImageView &img, std::array<Point2f, 4> &q, float search, int maxSamples)
 {
 	Line lines[4];
 	for (int i = 0; i < 4; ++i) {
-		if (!fitSide(img, q[i], q[(i + 1) & 3], search, lines[i]))
+		if (!fitSide(img, q[i], q[(i + 1) & 3], search, maxSamples, lines[i]))
 			return false;
 	}
 	std::array<Point2f, 4> r;
@@ -130,11 +131,12 @@ bool refineOnce(const ImageView &img, std::array<Point2f, 4> &q, float search)
 bool refineCorners(const ImageView &image, std::array<Point2f, 4> &corners, float search)
 {
 	std::array<Point2f, 4> q = corners;
-	if (!refineOnce(image, q, search))
+	/* The wide first pass only has to place the sides roughly: few points. */
+	if (!refineOnce(image, q, search, kCoarseSamples))
 		return false;
 	/* A second, narrow pass: the sides are now well placed, so the
 	 * measurement points avoid the corners exactly and the window shrinks. */
-	refineOnce(image, q, std::min(search, 1.5f));
+	refineOnce(image, q, std::min(search, 1.5f), kMaxSamples);
 	corners = q;
 	return true;
 }

@@ -144,10 +144,17 @@ bool edgeSpan(const GradRows &rows, int x0, int x1, const FrontEndParams &params
 
 void markTiles(const std::uint8_t *edgeRow, int w, std::uint8_t *tileRow)
 {
-	for (int x0 = 0, t = 0; x0 < w; x0 += EdgeMap::kTile, ++t) {
-		const int x1 = std::min(w, x0 + EdgeMap::kTile);
+	int x0 = 0, t = 0;
+	for (; x0 + EdgeMap::kTile <= w; x0 += EdgeMap::kTile, ++t) {
+		std::uint64_t a, b;
+		std::memcpy(&a, edgeRow + x0, 8);
+		std::memcpy(&b, edgeRow + x0 + 8, 8);
+		if (a | b)
+			tileRow[t] = 1;
+	}
+	if (x0 < w) {
 		std::uint8_t acc = 0;
-		for (int x = x0; x < x1; ++x)
+		for (int x = x0; x < w; ++x)
 			acc |= edgeRow[x];
 		if (acc)
 			tileRow[t] = 1;
