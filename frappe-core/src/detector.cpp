@@ -285,6 +285,11 @@ const Result &Detector::runBackEnd(const ImageView &image, int slot)
 	return s.result;
 }
 
+void Detector::checkImage(const ImageView &image) const
+{
+	impl_->checkImage(image);
+}
+
 void Detector::setFrontEnd(std::unique_ptr<FrontEnd> frontEnd)
 {
 	if (!frontEnd)

@@ -29,6 +29,7 @@
 
 #include "frappe/edge_map.h"
 #include "front_end_rows.h"
+#include "worker.h"
 
 namespace frappe {
 
@@ -70,6 +71,7 @@ private:
 	const detail::RowKernels &kernels_;
 	std::vector<std::uint8_t> scaled_;
 	std::vector<detail::RowScratch> scratch_;
+	detail::WorkerPool pool_;
 };
 
 void CpuFrontEnd::run(const ImageView &image, float scale, const FrontEndParams &params,
@@ -102,7 +104,7 @@ void CpuFrontEnd::run(const ImageView &image, float scale, const FrontEndParams 
 				  : threads_;
 	/* Bands are whole tile rows so that no two threads touch one tile. */
 	const int tileRows = (h + EdgeMap::kTile - 1) / EdgeMap::kTile;
-	bands = std::clamp(bands, 1, std::max(1, tileRows));
+	bands = std::clamp(bands, 1, std::min(detail::WorkerPool::kMaxTasks, std::max(1, tileRows)));
 	if (scratch_.size() < static_cast<std::size_t>(bands))
 		scratch_.resize(bands);
 
@@ -115,21 +117,12 @@ void CpuFrontEnd::run(const ImageView &image, float scale, const FrontEndParams 
 		runBand(src, params, out, 1, h - 1, scratch_[0]);
 		return;
 	}
-	/* TODO(speed): a persistent worker pool instead of a thread per band. */
-	std::vector<std::thread> workers;
-	workers.reserve(bands - 1);
-	for (int b = 1; b < bands; ++b) {
-		workers.emplace_back([&, b] {
-			int y0, y1;
-			bandRows(b, y0, y1);
-			runBand(src, params, out, y0, y1, scratch_[b]);
-		});
-	}
-	int y0, y1;
-	bandRows(0, y0, y1);
-	runBand(src, params, out, y0, y1, scratch_[0]);
-	for (std::thread &t : workers)
-		t.join();
+	auto band = [&](int b) {
+		int y0, y1;
+		bandRows(b, y0, y1);
+		runBand(src, params, out, y0, y1, scratch_[b]);
+	};
+	pool_.run(bands, band);
 }
 
 /* Edge rows y0 .. y1-1 (1 <= y0, y1 <= h-1). */

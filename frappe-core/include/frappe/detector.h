@@ -68,6 +68,9 @@ public:
 	/// the width. Images too small to hold a marker give no markers.
 	const Result &detect(const ImageView &image);
 
+	/// Throws std::invalid_argument for an image detect() would refuse.
+	void checkImage(const ImageView &image) const;
+
 	/// Two-stage use for pipelining: the front end of one frame may run on
 	/// one thread while the back end of the frame in the other slot runs on
 	/// another. `slot` is 0 or 1; the image must stay valid until

@@ -8,4 +8,5 @@
 #include "frappe/edge_map.h"
 #include "frappe/image.h"
 #include "frappe/marker.h"
+#include "frappe/pipeline.h"
 #include "frappe/version.h"

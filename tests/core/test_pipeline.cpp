@@ -1,0 +1,99 @@
+// SPDX-License-Identifier: MIT
+// The pipelined mode gives, one frame late and in order, exactly what
+// detect() gives frame by frame; bad frames are refused without losing the
+// ones in flight.
+#include <gtest/gtest.h>
+
+#include "frappe/frappe.h"
+#include "scene.h"
+
+using namespace frappe;
+using namespace frappe::test;
+
+namespace {
+
+std::vector<Image> sequence(int frames)
+{
+	const Dictionary &dict = *findDictionary("aruco_mip_36h12");
+	std::vector<Image> out;
+	std::mt19937 rng(21);
+	for (int f = 0; f < frames; ++f) {
+		Image img(320, 240, 100);
+		/* A different set of ids per frame, so a swapped result shows. */
+		for (int k = 0; k <= f % 3; ++k)
+			renderMarker(img.mut(), dict, 7 * f + k,
+				     squarePose(60.0f + 95.0f * k, 80.0f + 10.0f * f, 50.0f, 11.0f * f, 15.0f));
+		addNoise(img, 2.0f, rng);
+		out.push_back(std::move(img));
+	}
+	return out;
+}
+
+void expectSame(const Result &a, const Result &b, int frame)
+{
+	ASSERT_EQ(a.markers.size(), b.markers.size()) << "frame " << frame;
+	for (std::size_t i = 0; i < a.markers.size(); ++i) {
+		EXPECT_EQ(a.markers[i].id, b.markers[i].id) << "frame " << frame;
+		for (int c = 0; c < 4; ++c) {
+			EXPECT_EQ(a.markers[i].corners[c].x, b.markers[i].corners[c].x);
+			EXPECT_EQ(a.markers[i].corners[c].y, b.markers[i].corners[c].y);
+		}
+	}
+}
+
+} // namespace
+
+TEST(Pipeline, SameMarkersAsDetectOneFrameLateInOrder)
+{
+	const std::vector<Image> frames = sequence(9);
+	Detector reference(Config{});
+	std::vector<Result> expected;
+	for (const Image &f : frames)
+		expected.push_back(reference.detect(f.view()));
+
+	Pipeline pipeline(Config{});
+	std::vector<Result> got;
+	for (const Image &f : frames) {
+		if (const Result *r = pipeline.push(f.view()))
+			got.push_back(*r);
+	}
+	EXPECT_TRUE(pipeline.pending());
+	const Result *last = pipeline.flush();
+	ASSERT_NE(last, nullptr);
+	got.push_back(*last);
+	EXPECT_FALSE(pipeline.pending());
+	EXPECT_EQ(pipeline.flush(), nullptr);
+
+	ASSERT_EQ(got.size(), frames.size());
+	for (std::size_t i = 0; i < frames.size(); ++i) {
+		expectSame(got[i], expected[i], static_cast<int>(i));
+		EXPECT_EQ(static_cast<int>(got[i].markers.size()), static_cast<int>(i % 3) + 1);
+	}
+}
+
+TEST(Pipeline, BadFrameIsRefusedAndTheFrameInFlightSurvives)
+{
+	const std::vector<Image> frames = sequence(3);
+	Detector reference(Config{});
+	Pipeline pipeline(Config{});
+	EXPECT_EQ(pipeline.push(frames[0].view()), nullptr);
+	EXPECT_THROW(pipeline.push(ImageView(nullptr, 10, 10, 10)), std::invalid_argument);
+	EXPECT_THROW(pipeline.push(ImageView(frames[1].pixels.data(), 320, 240, 100)), std::invalid_argument);
+	const Result *r0 = pipeline.push(frames[1].view());
+	ASSERT_NE(r0, nullptr);
+	expectSame(*r0, reference.detect(frames[0].view()), 0);
+	const Result *r1 = pipeline.flush();
+	ASSERT_NE(r1, nullptr);
+	expectSame(*r1, reference.detect(frames[1].view()), 1);
+}
+
+TEST(Pipeline, FlushWithNothingInFlight)
+{
+	Pipeline pipeline(Config{});
+	EXPECT_FALSE(pipeline.pending());
+	EXPECT_EQ(pipeline.flush(), nullptr);
+	/* Destroying a pipeline with a frame in flight waits for it. */
+	const std::vector<Image> frames = sequence(1);
+	Pipeline other(Config{});
+	EXPECT_EQ(other.push(frames[0].view()), nullptr);
+}
