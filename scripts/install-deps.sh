@@ -9,7 +9,7 @@ packages=(
 	# frappe-core, the CLI and the benchmarks
 	libopencv-dev libeigen3-dev libhwy-dev
 	# tests
-	libgtest-dev libgmock-dev libbenchmark-dev
+	libgtest-dev libgmock-dev libbenchmark-dev libapriltag-dev
 	# the GStreamer element and its examples
 	libgstreamer1.0-dev libgstreamer-plugins-base1.0-dev
 	gstreamer1.0-tools gstreamer1.0-plugins-base gstreamer1.0-plugins-good
