@@ -124,8 +124,11 @@ void ContourTracer::trace(const EdgeMap &edges, const TraceParams &params, std::
 
 				++borders_;
 				follow(x, y, fromDir, edges);
-				/* A marker outline is at least four sides of min_side pixels. */
+				/* A marker outline is at least four sides of min_side pixels,
+				 * and spans at least min_side / sqrt(2) each way. */
 				if (static_cast<float>(steps_) < 2.8f * params.min_side)
+					continue;
+				if (!spansAtLeast(0.7f * params.min_side))
 					continue;
 				/* The paper's rule first: the corner clusters; failing that,
 				 * the outline's extreme points. */
@@ -137,6 +140,18 @@ void ContourTracer::trace(const EdgeMap &edges, const TraceParams &params, std::
 			}
 		}
 	}
+}
+
+bool ContourTracer::spansAtLeast(float span) const
+{
+	int minX = points_[0].x, maxX = minX, minY = points_[0].y, maxY = minY;
+	for (const Pixel &p : points_) {
+		minX = std::min(minX, p.x);
+		maxX = std::max(maxX, p.x);
+		minY = std::min(minY, p.y);
+		maxY = std::max(maxY, p.y);
+	}
+	return static_cast<float>(maxX - minX) >= span && static_cast<float>(maxY - minY) >= span;
 }
 
 /* Follows one border from (x, y); (x, y) + kD[fromDir] is the background
@@ -239,9 +254,13 @@ bool ContourTracer::quadFromClusters(Quad &quad) const
 		mx += c[i].x / static_cast<float>(n);
 		my += c[i].y / static_cast<float>(n);
 	}
-	std::sort(c.begin(), c.begin() + n, [&](Point2f p, Point2f q) {
-		return std::atan2(p.y - my, p.x - mx) < std::atan2(q.y - my, q.x - mx);
-	});
+	std::array<std::pair<float, Point2f>, kMaxClusters> byAngle{};
+	for (int i = 0; i < n; ++i)
+		byAngle[i] = { std::atan2(c[i].y - my, c[i].x - mx), c[i] };
+	std::sort(byAngle.begin(), byAngle.begin() + n,
+		  [](const auto &p, const auto &q) { return p.first < q.first; });
+	for (int i = 0; i < n; ++i)
+		c[i] = byAngle[i].second;
 	float bestArea = 0.0f;
 	for (int a = 0; a < n; ++a)
 		for (int b = a + 1; b < n; ++b)

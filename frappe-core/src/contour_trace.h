@@ -46,6 +46,7 @@ private:
 		int fx, fy;   ///< first member, the cluster's anchor
 	};
 	void follow(int x, int y, int fromDir, const EdgeMap &edges);
+	bool spansAtLeast(float span) const; ///< the last border's bounding box
 	bool quadFromClusters(Quad &quad) const;
 	bool quadFromOutline(Quad &quad) const;
 	bool acceptQuad(const TraceParams &params, int w, int h, Quad &quad) const;

@@ -87,6 +87,12 @@ Binarised binarise(const WarpedMarker &w, int bits)
 	return out;
 }
 
+/* The nearest codeword is a popcount per codeword and rotation; without
+ * -mpopcnt GCC calls a library routine for each, so on x86 a second copy
+ * with the POPCNT instruction is chosen at load time. */
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+__attribute__((target_clones("popcnt", "default")))
+#endif
 Decoded decode(const Dictionary &dict, std::uint64_t code, int maxHamming)
 {
 	/* rotations[r]: the code as read with quad corner r as the top-left.

@@ -64,6 +64,36 @@ bool sidesAtLeast(const std::array<Point2f, 4> &q, float side)
 	return true;
 }
 
+float quadArea(const std::array<Point2f, 4> &q)
+{
+	float twice = 0.0f;
+	for (int i = 0; i < 4; ++i)
+		twice += q[i].x * q[(i + 1) & 3].y - q[(i + 1) & 3].x * q[i].y;
+	return 0.5f * std::abs(twice);
+}
+
+Point2f quadCentre(const std::array<Point2f, 4> &q)
+{
+	return { 0.25f * (q[0].x + q[1].x + q[2].x + q[3].x), 0.25f * (q[0].y + q[1].y + q[2].y + q[3].y) };
+}
+
+/* A candidate around an already decoded marker, of about its size: the
+ * outline of its quiet zone, which would decode to the same marker again. */
+bool surroundsDecoded(const std::array<Point2f, 4> &q, float area, const std::vector<Marker> &found)
+{
+	const Point2f c = quadCentre(q);
+	for (const Marker &m : found) {
+		const float am = quadArea(m.corners);
+		if (area > 3.0f * am || 3.0f * area < am)
+			continue;
+		const Point2f cm = quadCentre(m.corners);
+		const float dx = c.x - cm.x, dy = c.y - cm.y;
+		if (dx * dx + dy * dy < 0.12f * am)
+			return true;
+	}
+	return false;
+}
+
 /* Largest image side accepted: contour coordinates are ints and buffers are
  * sized from width * height. */
 constexpr int kMaxSide = 1 << 15;
@@ -139,6 +169,11 @@ void Detector::Impl::backEnd(const ImageView &image, Slot &slot)
 	tp.border_margin = 1.0f;
 	tracer.trace(edges, tp, quads);
 	detail::removeDuplicateQuads(quads, 2.5f);
+	/* Smallest first: a marker's own outline decodes before the outline of
+	 * its quiet zone, which can then be skipped. */
+	std::sort(quads.begin(), quads.end(), [](const detail::Quad &a, const detail::Quad &b) {
+		return quadArea(a.corners) < quadArea(b.corners);
+	});
 	res.times[Stage::Trace] = msSince(t);
 
 	const float search = 2.5f / scale;
@@ -151,6 +186,10 @@ void Detector::Impl::backEnd(const ImageView &image, Slot &slot)
 		for (Point2f &p : q.corners) {
 			p.x = (p.x + 0.5f) / scale - 0.5f;
 			p.y = (p.y + 0.5f) / scale - 0.5f;
+		}
+		if (surroundsDecoded(q.corners, quadArea(q.corners), res.markers)) {
+			refineMs += msSince(t);
+			continue;
 		}
 		std::array<Point2f, 4> outline = q.corners;
 		bool refined = detail::refineCorners(image, q.corners, search);
