@@ -16,6 +16,7 @@ namespace frappe::detail {
 /// vectorised corner test (the scalar kernels leave it untouched).
 struct TensorRow {
 	std::int32_t *xx, *yy, *xy;
+	std::int32_t *scratch; ///< 3w values for the unsummed products
 };
 
 /// Three consecutive rows (y-1, y, y+1) of gradients and squared magnitudes.
@@ -34,13 +35,15 @@ struct RowScratch {
 	std::vector<std::int16_t> gx[3], gy[3];
 	std::vector<std::int32_t> mag[3];
 	std::vector<std::int32_t> txx[3], tyy[3], txy[3];
-	TensorRow tensor(int i) { return { txx[i].data(), tyy[i].data(), txy[i].data() }; }
+	std::vector<std::int32_t> products;
+	TensorRow tensor(int i) { return { txx[i].data(), tyy[i].data(), txy[i].data(), products.data() }; }
 	void resize(int w)
 	{
 		for (int i = 0; i < 4; ++i)
 			smooth[i].resize(w);
 		columns.resize(w);
 		separable.resize(2 * static_cast<std::size_t>(w));
+		products.resize(3 * static_cast<std::size_t>(w));
 		for (int i = 0; i < 3; ++i) {
 			gx[i].resize(w);
 			gy[i].resize(w);

@@ -101,33 +101,41 @@ void GradientRow(const std::uint8_t *a, const std::uint8_t *b, const std::uint8_
 	}
 
 	/* The squared magnitude, and the tensor products summed over x-1..x+1
-	 * for the corner test; gx and gy are 0 in the end columns. */
-	mag[0] = mag[w - 1] = 0;
+	 * for the corner test: each product once, then the sums. gx and gy are
+	 * 0 in the end columns. */
+	std::int32_t *pxx = tensor.scratch, *pyy = pxx + w, *pxy = pyy + w;
+	x = 0;
+	for (; x + N32 <= w; x += N32) {
+		const auto vx = hn::PromoteTo(d32, hn::LoadU(d16h, gx + x));
+		const auto vy = hn::PromoteTo(d32, hn::LoadU(d16h, gy + x));
+		const auto xx = hn::Mul(vx, vx), yy = hn::Mul(vy, vy);
+		hn::StoreU(hn::Add(xx, yy), d32, mag + x);
+		hn::StoreU(xx, d32, pxx + x);
+		hn::StoreU(yy, d32, pyy + x);
+		hn::StoreU(hn::Mul(vx, vy), d32, pxy + x);
+	}
+	for (; x < w; ++x) {
+		pxx[x] = gx[x] * gx[x];
+		pyy[x] = gy[x] * gy[x];
+		pxy[x] = gx[x] * gy[x];
+		mag[x] = pxx[x] + pyy[x];
+	}
 	std::int32_t *txx = tensor.xx, *tyy = tensor.yy, *txy = tensor.xy;
 	txx[0] = tyy[0] = txy[0] = 0;
 	txx[w - 1] = tyy[w - 1] = txy[w - 1] = 0;
+	auto sum3 = [&](const std::int32_t *p) {
+		return hn::Add(hn::Add(hn::LoadU(d32, p - 1), hn::LoadU(d32, p)), hn::LoadU(d32, p + 1));
+	};
 	x = 1;
 	for (; x + N32 <= w - 1; x += N32) {
-		const auto xl = hn::PromoteTo(d32, hn::LoadU(d16h, gx + x - 1));
-		const auto xm = hn::PromoteTo(d32, hn::LoadU(d16h, gx + x));
-		const auto xr = hn::PromoteTo(d32, hn::LoadU(d16h, gx + x + 1));
-		const auto yl = hn::PromoteTo(d32, hn::LoadU(d16h, gy + x - 1));
-		const auto ym = hn::PromoteTo(d32, hn::LoadU(d16h, gy + x));
-		const auto yr = hn::PromoteTo(d32, hn::LoadU(d16h, gy + x + 1));
-		const auto xx = hn::Mul(xm, xm), yy = hn::Mul(ym, ym);
-		hn::StoreU(hn::Add(xx, yy), d32, mag + x);
-		hn::StoreU(hn::Add(hn::Add(hn::Mul(xl, xl), hn::Mul(xr, xr)), xx), d32, txx + x);
-		hn::StoreU(hn::Add(hn::Add(hn::Mul(yl, yl), hn::Mul(yr, yr)), yy), d32, tyy + x);
-		hn::StoreU(hn::Add(hn::Add(hn::Mul(xl, yl), hn::Mul(xr, yr)), hn::Mul(xm, ym)), d32, txy + x);
+		hn::StoreU(sum3(pxx + x), d32, txx + x);
+		hn::StoreU(sum3(pyy + x), d32, tyy + x);
+		hn::StoreU(sum3(pxy + x), d32, txy + x);
 	}
 	for (; x < w - 1; ++x) {
-		mag[x] = gx[x] * gx[x] + gy[x] * gy[x];
-		txx[x] = tyy[x] = txy[x] = 0;
-		for (int d = -1; d <= 1; ++d) {
-			txx[x] += gx[x + d] * gx[x + d];
-			tyy[x] += gy[x + d] * gy[x + d];
-			txy[x] += gx[x + d] * gy[x + d];
-		}
+		txx[x] = pxx[x - 1] + pxx[x] + pxx[x + 1];
+		tyy[x] = pyy[x - 1] + pyy[x] + pyy[x + 1];
+		txy[x] = pxy[x - 1] + pxy[x] + pxy[x + 1];
 	}
 }
 
