@@ -125,18 +125,32 @@ struct Detector::Impl {
 	std::mutex adaptiveLock;
 	detail::AdaptiveScale adaptive;
 
+	/* One frame in flight: its edges, its candidates, its result. */
 	struct Slot {
 		EdgeMap edges;
+		std::vector<detail::Quad> quads;
 		Result result;
 	};
-	Slot slots[2];
+	Slot slots[kSlots];
 
+	/* Used by one stage each, so that stages of different slots can run
+	 * at once: the tracer by runTrace(), the warp buffer by runFinish(). */
 	detail::ContourTracer tracer;
-	std::vector<detail::Quad> quads;
 	detail::WarpedMarker warped;
 
 	void checkImage(const ImageView &image) const;
-	void backEnd(const ImageView &image, Slot &slot);
+	void trace(Slot &slot);
+	void finish(const ImageView &image, Slot &slot);
+	Slot &slotAt(int slot)
+	{
+		return const_cast<Slot &>(static_cast<const Impl *>(this)->slotAt(slot));
+	}
+	const Slot &slotAt(int slot) const
+	{
+		if (slot < 0 || slot >= kSlots)
+			throw std::invalid_argument("frappe::Detector: slot must be 0.." + std::to_string(kSlots - 1));
+		return slots[slot];
+	}
 };
 
 void Detector::Impl::checkImage(const ImageView &image) const
@@ -154,15 +168,12 @@ void Detector::Impl::checkImage(const ImageView &image) const
 		fail("image data is null");
 }
 
-void Detector::Impl::backEnd(const ImageView &image, Slot &slot)
+void Detector::Impl::trace(Slot &slot)
 {
-	Result &res = slot.result;
 	const EdgeMap &edges = slot.edges;
 	const float scale = edges.scale;
-	res.markers.clear();
-	res.candidates = 0;
-
-	auto t = Clock::now();
+	std::vector<detail::Quad> &quads = slot.quads;
+	const auto t = Clock::now();
 	detail::TraceParams tp;
 	tp.cluster_radius = config.corner_cluster_radius;
 	tp.min_side = std::max(4.0f, config.min_marker_side * scale);
@@ -174,14 +185,23 @@ void Detector::Impl::backEnd(const ImageView &image, Slot &slot)
 	std::sort(quads.begin(), quads.end(), [](const detail::Quad &a, const detail::Quad &b) {
 		return quadArea(a.corners) < quadArea(b.corners);
 	});
-	res.times[Stage::Trace] = msSince(t);
+	slot.result.times[Stage::Trace] = msSince(t);
+}
+
+void Detector::Impl::finish(const ImageView &image, Slot &slot)
+{
+	Result &res = slot.result;
+	const float scale = slot.edges.scale;
+	res.markers.clear();
+	res.candidates = 0;
+	auto t = Clock::now();
 
 	const float search = 2.5f / scale;
 	const int bits = dict->bits;
 	const int borderAllowance = allowedBorderErrors(bits);
 	const int whiteFrame = 3 * bits + 3; /* three quarters of the 4(n+1) border cells */
 	double refineMs = 0, warpMs = 0, decodeMs = 0;
-	for (detail::Quad &q : quads) {
+	for (detail::Quad &q : slot.quads) {
 		t = Clock::now();
 		for (Point2f &p : q.corners) {
 			p.x = (p.x + 0.5f) / scale - 0.5f;
@@ -290,7 +310,7 @@ void Detector::runFrontEnd(const ImageView &image, int slot)
 {
 	Impl &d = *impl_;
 	d.checkImage(image);
-	Impl::Slot &s = d.slots[slot & 1];
+	Impl::Slot &s = d.slotAt(slot);
 	const auto t0 = Clock::now();
 	float scale;
 	{
@@ -310,9 +330,21 @@ void Detector::runFrontEnd(const ImageView &image, int slot)
 
 const Result &Detector::runBackEnd(const ImageView &image, int slot)
 {
+	runTrace(slot);
+	return runFinish(image, slot);
+}
+
+void Detector::runTrace(int slot)
+{
 	Impl &d = *impl_;
-	Impl::Slot &s = d.slots[slot & 1];
-	d.backEnd(image, s);
+	d.trace(d.slotAt(slot));
+}
+
+const Result &Detector::runFinish(const ImageView &image, int slot)
+{
+	Impl &d = *impl_;
+	Impl::Slot &s = d.slotAt(slot);
+	d.finish(image, s);
 	{
 		std::lock_guard<std::mutex> lock(d.adaptiveLock);
 		d.adaptive.update(s.result.markers);
@@ -337,7 +369,7 @@ void Detector::setFrontEnd(std::unique_ptr<FrontEnd> frontEnd)
 }
 
 const FrontEnd &Detector::frontEnd() const { return *impl_->frontEnd; }
-const EdgeMap &Detector::edgeMap(int slot) const { return impl_->slots[slot & 1].edges; }
+const EdgeMap &Detector::edgeMap(int slot) const { return impl_->slotAt(slot).edges; }
 void Detector::reset()
 {
 	std::lock_guard<std::mutex> lock(impl_->adaptiveLock);

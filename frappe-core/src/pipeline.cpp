@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
-// The pipelined mode: the front end of the next frame on a worker thread,
-// the back end of the current one on the caller's.
+// The pipelined mode, three stages on two threads: each call runs the front
+// end of the new frame and the finish (refine, warp, decode) of the oldest
+// on the worker, while the caller traces the frame in between.
 #include "frappe/pipeline.h"
 
 #include <exception>
@@ -13,80 +14,109 @@ namespace frappe {
 struct Pipeline::Impl {
 	explicit Impl(const Config &config) : detector(config) {}
 
+	struct Frame {
+		ImageView image;
+		int slot = 0;
+		bool traced = false;
+	};
+
 	Detector detector;
 	detail::Worker worker;
-	/* The frame whose front end was started last, and its slot. */
-	ImageView inFlight;
-	int slot = 0;
-	bool pending = false;
+	/* Frames in flight, oldest first; at most one traced and one not. */
+	Frame frames[Detector::kSlots];
+	int count = 0;
 
-	/* What the worker runs; a member so that posting it allocates nothing. */
-	struct FrontEndTask {
+	/* The worker's round: the new frame's front end, then the oldest
+	 * frame's finish when there is one. A member, so posting it allocates
+	 * nothing. */
+	struct Round {
 		Impl *self;
-		void operator()() const
+		const Frame *start = nullptr;
+		const Frame *finish = nullptr;
+		const Result *finished = nullptr;
+		void operator()()
 		{
 			try {
-				self->detector.runFrontEnd(self->inFlight, self->slot);
+				self->detector.runFrontEnd(start->image, start->slot);
+				if (finish)
+					finished = &self->detector.runFinish(finish->image, finish->slot);
 			} catch (...) {
 				self->failure = std::current_exception();
 			}
 		}
-	} frontEndTask{ this };
+	} round{ this };
 	std::exception_ptr failure;
 
-	/* Waits for the worker and hands on what it threw (out of memory). */
-	void join()
+	int freeSlot() const
 	{
-		worker.wait();
-		if (failure) {
-			pending = false;
-			std::rethrow_exception(std::exchange(failure, nullptr));
+		for (int s = 0; s < Detector::kSlots; ++s) {
+			bool used = false;
+			for (int i = 0; i < count; ++i)
+				used |= frames[i].slot == s;
+			if (!used)
+				return s;
 		}
+		return 0; /* not reached: at most kSlots - 1 frames wait */
+	}
+
+	void pop()
+	{
+		for (int i = 1; i < count; ++i)
+			frames[i - 1] = frames[i];
+		--count;
 	}
 };
 
 Pipeline::Pipeline(const Config &config) : impl_(std::make_unique<Impl>(config)) {}
 
-Pipeline::~Pipeline()
-{
-	if (impl_->pending)
-		impl_->worker.wait();
-}
+Pipeline::~Pipeline() = default;
 
 const Result *Pipeline::push(const ImageView &image)
 {
 	Impl &d = *impl_;
 	d.detector.checkImage(image);
-	if (!d.pending) {
-		d.inFlight = image;
-		d.worker.post(d.frontEndTask);
-		d.pending = true;
-		return nullptr;
+
+	d.frames[d.count] = { image, d.freeSlot(), false };
+	Impl::Frame &fresh = d.frames[d.count];
+	Impl::Frame *oldest = d.count > 0 ? &d.frames[0] : nullptr;
+	Impl::Frame *toTrace = nullptr;
+	for (int i = 0; i < d.count; ++i)
+		if (!d.frames[i].traced)
+			toTrace = &d.frames[i];
+	++d.count;
+
+	d.round.start = &fresh;
+	d.round.finish = oldest && oldest->traced ? oldest : nullptr;
+	d.round.finished = nullptr;
+	d.worker.post(d.round);
+	if (toTrace) {
+		d.detector.runTrace(toTrace->slot);
+		toTrace->traced = true;
 	}
-	/* Frame N's front end is done once the worker is idle; start N+1's in
-	 * the other slot and trace N here meanwhile. */
-	d.join();
-	const ImageView previous = d.inFlight;
-	const int previousSlot = d.slot;
-	d.inFlight = image;
-	d.slot ^= 1;
-	d.worker.post(d.frontEndTask);
-	return &d.detector.runBackEnd(previous, previousSlot);
+	d.worker.wait();
+	if (d.failure) {
+		d.count = 0; /* out of memory mid-round: drop the frames in flight */
+		std::rethrow_exception(std::exchange(d.failure, nullptr));
+	}
+	if (!d.round.finish)
+		return nullptr;
+	d.pop();
+	return d.round.finished;
 }
 
 const Result *Pipeline::flush()
 {
 	Impl &d = *impl_;
-	if (!d.pending)
+	if (d.count == 0)
 		return nullptr;
-	d.join();
-	d.pending = false;
-	const Result *result = &d.detector.runBackEnd(d.inFlight, d.slot);
-	d.slot ^= 1;
-	return result;
+	const Impl::Frame oldest = d.frames[0];
+	d.pop();
+	if (!oldest.traced)
+		d.detector.runTrace(oldest.slot);
+	return &d.detector.runFinish(oldest.image, oldest.slot);
 }
 
-bool Pipeline::pending() const { return impl_->pending; }
+bool Pipeline::pending() const { return impl_->count > 0; }
 Detector &Pipeline::detector() { return impl_->detector; }
 
 } // namespace frappe

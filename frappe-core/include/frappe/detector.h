@@ -71,13 +71,23 @@ public:
 	/// Throws std::invalid_argument for an image detect() would refuse.
 	void checkImage(const ImageView &image) const;
 
-	/// Two-stage use for pipelining: the front end of one frame may run on
-	/// one thread while the back end of the frame in the other slot runs on
-	/// another. `slot` is 0 or 1; the image must stay valid until
-	/// runBackEnd() for that slot returns. In AScale mode the scale of a
-	/// frame comes from the last frame whose back end has completed.
+	/// Frames in flight at once in staged use.
+	static constexpr int kSlots = 3;
+
+	/// Staged use for pipelining: each frame goes through a slot (0 ..
+	/// kSlots-1). runFrontEnd() fills the slot's edge map; runBackEnd() then
+	/// traces it and refines, warps and decodes. Stages of different slots
+	/// may run on different threads at once; the image must stay valid
+	/// until the slot's back end (or runFinish()) returns. In AScale mode
+	/// the scale of a frame comes from the last frame finished before its
+	/// front end started. Throws std::invalid_argument for a bad slot.
 	void runFrontEnd(const ImageView &image, int slot);
 	const Result &runBackEnd(const ImageView &image, int slot);
+
+	/// runBackEnd() in two halves, for a three-stage pipeline: the contour
+	/// trace, then refinement, warp and decoding.
+	void runTrace(int slot);
+	const Result &runFinish(const ImageView &image, int slot);
 
 	/// Replaces the front end (for example with the VC4 one). The default
 	/// is the CPU front end.

@@ -10,13 +10,14 @@
 
 namespace frappe {
 
-/// Runs a Detector over a stream with two threads: the front end of frame
-/// N+1 runs on a worker thread while the calling thread traces, refines and
-/// decodes frame N. Results come out one frame late, in order.
+/// Runs a Detector over a stream with two threads, in three stages: while
+/// the calling thread traces the contours of frame N, a worker thread runs
+/// the front end of frame N+1 and then refines, warps and decodes frame N-1.
+/// Results come out two frames late, in order.
 ///
-/// Throughput is bounded by the slower of the two halves instead of their
-/// sum. In AScale mode frame N+1's scale comes from frame N-1, the last one
-/// whose back end had completed.
+/// Throughput is bounded by the slower of the trace and the rest, instead
+/// of their sum. In AScale mode a frame's scale comes from the last frame
+/// finished before its front end started (three frames earlier).
 class Pipeline {
 public:
 	/// Throws std::invalid_argument like Detector's constructor.
@@ -26,17 +27,18 @@ public:
 	Pipeline &operator=(const Pipeline &) = delete;
 
 	/// Starts `image`, which must stay valid until its result has been
-	/// returned, and returns the result of the frame pushed before it, or
-	/// nullptr for the first frame. A returned Result stays valid until the
-	/// next push() or flush(). Throws std::invalid_argument for a bad image,
-	/// before starting it; the frames already in flight are unaffected.
+	/// returned, and returns the result of the frame pushed two calls
+	/// before, or nullptr for the first two frames. A returned Result stays
+	/// valid until the next push() or flush(). Throws std::invalid_argument
+	/// for a bad image, before starting it; the frames already in flight are
+	/// unaffected.
 	const Result *push(const ImageView &image);
 
-	/// At the end of the stream: finishes the frame in flight and returns its
-	/// result, or nullptr when there is none.
+	/// At the end of the stream: finishes the oldest frame in flight and
+	/// returns its result, or nullptr when none is left. Call until nullptr.
 	const Result *flush();
 
-	/// Whether a frame is in flight (pushed, result not yet returned).
+	/// Whether frames are in flight (pushed, results not yet returned).
 	bool pending() const;
 
 	Detector &detector();
