@@ -64,13 +64,26 @@ bool fitSide(const ImageView &img, Point2f a, Point2f b, float search, int maxSa
 		/* Below ~4 grey levels per pixel it is noise, not an edge. */
 		if (best < 2 || best > n - 3 || bestDrop < 4.0f)
 			continue;
-		const float dm = profile[best - 2] - profile[best];
-		const float dp = profile[best] - profile[best + 2];
-		const float denom = dm - 2.0f * bestDrop + dp;
-		float off = 0.0f;
-		if (denom < 0.0f)
-			off = std::clamp(0.5f * (dm - dp) / denom, -0.5f, 0.5f);
-		const float s = (static_cast<float>(best - half) + off) * kProfileStep;
+		/* The edge lies at the centroid of the intensity drop: exact for an
+		 * area-sampled step whatever its sub-pixel phase, and unbiased under
+		 * symmetric blur (a parabola through the peak is not: it pulls the
+		 * estimate towards pixel-grid positions by up to a third of a pixel).
+		 * The window is the run of falling samples around the peak, at most
+		 * 3 px either side, so neighbouring edges stay out. */
+		int lo = best, hi = best;
+		while (lo > 1 && best - lo < 4 && profile[lo - 1] - profile[lo] > 0.0f)
+			--lo;
+		while (hi < n - 2 && hi - best < 4 && profile[hi] - profile[hi + 1] > 0.0f)
+			++hi;
+		float mass = 0.0f, moment = 0.0f;
+		for (int k = lo - 1; k < hi + 1; ++k) {
+			const float fall = profile[k] - profile[k + 1];
+			if (fall <= 0.0f)
+				continue;
+			mass += fall;
+			moment += fall * (static_cast<float>(k - half) + 0.5f);
+		}
+		const float s = moment / mass * kProfileStep;
 		if (std::abs(s) > search)
 			continue;
 		const double ex = px + nx * s, ey = py + ny * s;

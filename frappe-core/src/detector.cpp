@@ -246,6 +246,21 @@ void Detector::Impl::finish(const ImageView &image, Slot &slot)
 		if (b.contrast >= 10.0f && b.border_errors <= borderAllowance)
 			d = detail::decode(*dict, b.code, maxHamming);
 		decodeMs += msSince(t);
+		if (d.id < 0 && refined && b.border_errors < whiteFrame) {
+			/* Refinement can pull a small, blurred marker's sides onto its
+			 * code's edges; the traced outline may still read. */
+			t = Clock::now();
+			std::array<Point2f, 4> traced = outline;
+			if (detail::warpMarker(image, traced, bits, warped)) {
+				const detail::Binarised bt = detail::binarise(warped, bits);
+				if (bt.contrast >= 10.0f && bt.border_errors <= borderAllowance) {
+					d = detail::decode(*dict, bt.code, maxHamming);
+					if (d.id >= 0)
+						q.corners = traced;
+				}
+			}
+			decodeMs += msSince(t);
+		}
 		if (d.id < 0)
 			continue;
 
