@@ -1,0 +1,85 @@
+// SPDX-License-Identifier: MIT
+#include "runtime/os.hpp"
+
+#include <cerrno>
+#include <cstring>
+#include <dirent.h>
+#include <fcntl.h>
+#include <fstream>
+#include <iterator>
+#include <sys/ioctl.h>
+#include <sys/mman.h>
+#include <unistd.h>
+
+namespace frappe::vc4::runtime {
+
+namespace {
+
+class SystemOs final : public Os {
+public:
+	int open(const std::string &path, int flags) override
+	{
+		const int fd = ::open(path.c_str(), flags | O_CLOEXEC);
+		return fd < 0 ? -errno : fd;
+	}
+	int close(int fd) override { return ::close(fd) < 0 ? -errno : 0; }
+	int ioctl(int fd, unsigned long request, void *arg) override
+	{
+		int r;
+		do
+			r = ::ioctl(fd, request, arg);
+		while (r < 0 && errno == EINTR);
+		return r < 0 ? -errno : r;
+	}
+	void *mmap(size_t length, int fd, uint64_t offset, int &error) override
+	{
+		void *p = ::mmap(nullptr, length, PROT_READ | PROT_WRITE, MAP_SHARED, fd,
+		                 static_cast<off_t>(offset));
+		if (p == MAP_FAILED) {
+			error = -errno;
+			return nullptr;
+		}
+		error = 0;
+		return p;
+	}
+	int munmap(void *address, size_t length) override
+	{
+		return ::munmap(address, length) < 0 ? -errno : 0;
+	}
+	std::optional<std::string> readFile(const std::string &path) override
+	{
+		std::ifstream in(path, std::ios::binary);
+		if (!in)
+			return std::nullopt;
+		return std::string(std::istreambuf_iterator<char>(in), {});
+	}
+	std::vector<std::string> listDir(const std::string &path) override
+	{
+		std::vector<std::string> out;
+		DIR *d = ::opendir(path.c_str());
+		if (!d)
+			return out;
+		while (const dirent *e = ::readdir(d)) {
+			const std::string name = e->d_name;
+			if (name != "." && name != "..")
+				out.push_back(name);
+		}
+		::closedir(d);
+		return out;
+	}
+};
+
+} // namespace
+
+Os &systemOs()
+{
+	static SystemOs os;
+	return os;
+}
+
+std::string errorText(int negative_errno)
+{
+	return std::strerror(-negative_errno);
+}
+
+} // namespace frappe::vc4::runtime
