@@ -1,0 +1,193 @@
+#!/bin/bash
+# ARMv6 (Raspberry Pi Zero, ARM1176JZF-S) instruction counts of frappe-core and
+# of OpenCV 4.6's aruco module, per frame and per pixel, per stage.
+#
+# Cross-builds frappe-core for ARMv6KZ + VFPv2 (Debian's armel toolchain,
+# scripts/arm/armv6-armel.ini), runs tests/bench/frappe_count.cpp under
+# `qemu-arm -cpu arm1176` with the instruction-counting TCG plugin
+# scripts/arm/frappecount.c, and prints the tables (see docs/arm.md).
+# Not a test: nothing is asserted. Needs a Debian 12 (bookworm) amd64 host.
+#
+# usage: scripts/arm-count.sh [options]
+#   --list FILE        images, one path a line (the detector contract's list format)
+#   --images DIR       or every *.png / *.jpg in DIR
+#                      (default: ../shared/data/synth/images beside the checkout)
+#   --dictionary NAME  default aruco_mip_36h12
+#   --max N            only the first N images
+#   --no-opencv        count frappe only
+#   --build DIR        cross build dir (default: build-armel in the checkout)
+#   --setup            install missing host packages with apt-get (root) instead of stopping
+#   --jobs N           ninja -j (default 2)
+# env: FRAPPE_ARM_CACHE  where the sysroot, the plugin and the qemu header live
+#                        (default ${XDG_CACHE_HOME:-$HOME/.cache}/frappe-arm)
+#      SYSROOT           an existing armel sysroot to reuse (e.g. /tmp/sysroot-armel
+#                        from the team's make-sysroot.sh; it needs libopencv_aruco
+#                        and libpng/libjpeg headers for the OpenCV part)
+# Output: the tables on stdout, and BUILD/arm-count/{report.md,count.log,...}.
+set -euo pipefail
+
+SRC=$(cd "$(dirname "$0")/.." && pwd)
+HERE=$SRC/scripts/arm
+LIST="" IMAGES="" DICT=aruco_mip_36h12 MAX=0 OPENCV=1 BUILD="" SETUP=0 JOBS=2
+while [ $# -gt 0 ]; do
+	case "$1" in
+	--list) LIST=$2; shift 2;;
+	--images) IMAGES=$2; shift 2;;
+	--dictionary) DICT=$2; shift 2;;
+	--max) MAX=$2; shift 2;;
+	--no-opencv) OPENCV=0; shift;;
+	--build) BUILD=$2; shift 2;;
+	--setup) SETUP=1; shift;;
+	--jobs) JOBS=$2; shift 2;;
+	-h|--help) sed -n '2,/^set -euo/p' "$0" | sed '$d; s/^# \{0,1\}//'; exit 0;;
+	*) echo "arm-count: unknown option $1 (see --help)" >&2; exit 2;;
+	esac
+done
+BUILD=${BUILD:-$SRC/build-armel}
+CACHE=${FRAPPE_ARM_CACHE:-${XDG_CACHE_HOME:-$HOME/.cache}/frappe-arm}
+SYSROOT=${SYSROOT:-$CACHE/sysroot-armel}
+TRIPLET=arm-linux-gnueabi
+OUT=$BUILD/arm-count
+t0=$(date +%s)
+step() { echo "== [$(( $(date +%s) - t0 )) s] $*" >&2; }
+die() { echo "arm-count: $1" >&2; exit "${2:-1}"; }
+
+# ---- the image list ----------------------------------------------------------
+if [ -z "$LIST" ]; then
+	IMAGES=${IMAGES:-$SRC/../shared/data/synth/images}
+	[ -d "$IMAGES" ] || die "no --list given and no image folder $IMAGES (pass --list FILE or --images DIR)" 2
+	IMAGES=$(cd "$IMAGES" && pwd)
+	mkdir -p "$OUT"
+	LIST=$OUT/images.txt
+	find "$IMAGES" -maxdepth 1 -type f \( -iname '*.png' -o -iname '*.jpg' -o -iname '*.jpeg' \) | sort > "$LIST"
+	[ -s "$LIST" ] || die "no .png/.jpg images in $IMAGES" 2
+fi
+[ -r "$LIST" ] || die "cannot read list $LIST" 2
+LIST=$(cd "$(dirname "$LIST")" && pwd)/$(basename "$LIST")
+
+# ---- host tools ---------------------------------------------------------------
+need_pkgs=""
+command -v $TRIPLET-g++ >/dev/null || need_pkgs="$need_pkgs crossbuild-essential-armel"
+command -v qemu-arm >/dev/null || need_pkgs="$need_pkgs qemu-user"
+command -v meson >/dev/null || need_pkgs="$need_pkgs meson"
+command -v ninja >/dev/null || need_pkgs="$need_pkgs ninja-build"
+command -v pkg-config >/dev/null || need_pkgs="$need_pkgs pkgconf"
+command -v python3 >/dev/null || need_pkgs="$need_pkgs python3"
+command -v gcc >/dev/null || need_pkgs="$need_pkgs gcc"
+if [ ! -f "$SYSROOT/usr/lib/$TRIPLET/libstdc++.so.6" ] && ! command -v mmdebstrap >/dev/null; then
+	need_pkgs="$need_pkgs mmdebstrap"
+fi
+if [ -n "$need_pkgs" ]; then
+	if [ "$SETUP" = 1 ] && [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null; then
+		step "apt-get install$need_pkgs"
+		export DEBIAN_FRONTEND=noninteractive
+		{ apt-get update -q && apt-get install -y -q --no-install-recommends $need_pkgs; } >"$CACHE.apt.log" 2>&1 ||
+			die "apt-get install$need_pkgs failed (log: $CACHE.apt.log)" 3
+	else
+		die "missing host packages:$need_pkgs
+  install them with: apt-get install --no-install-recommends$need_pkgs
+  (Debian 12 amd64), or run this script as root with --setup" 3
+	fi
+fi
+# qemu-user-static cannot load plugins; Debian's dynamic qemu-user can.
+if ! ldd "$(command -v qemu-arm)" >/dev/null 2>&1; then
+	die "$(command -v qemu-arm) is a static build, which cannot load TCG plugins: install qemu-user (not only qemu-user-static)" 3
+fi
+
+# ---- the armel sysroot --------------------------------------------------------
+if [ ! -f "$SYSROOT/usr/lib/$TRIPLET/libstdc++.so.6" ]; then
+	[ -e "$SYSROOT" ] && [ -n "$(ls -A "$SYSROOT" 2>/dev/null)" ] &&
+		die "$SYSROOT exists but is not an armel sysroot (no usr/lib/$TRIPLET/libstdc++.so.6); remove it or set SYSROOT" 3
+	step "armel sysroot -> $SYSROOT (mmdebstrap, ~1 min, ~200 MB download)"
+	mkdir -p "$CACHE"
+	"$HERE/make-sysroot-count.sh" "$SYSROOT" >"$CACHE/sysroot.log" 2>&1 || {
+		rm -rf "$SYSROOT"
+		die "making the armel sysroot failed (log: $CACHE/sysroot.log): the Debian archive must be reachable and the armel packages available" 3
+	}
+fi
+SYSLIB=$SYSROOT/usr/lib/$TRIPLET
+[ -f "$SYSROOT/usr/include/png.h" ] && [ -f "$SYSROOT/usr/include/jpeglib.h" ] ||
+	die "the sysroot $SYSROOT has no libpng/libjpeg headers (install libpng-dev and libjpeg62-turbo-dev into it, or use scripts/arm/make-sysroot-count.sh)" 3
+if [ "$OPENCV" = 1 ] && [ ! -e "$SYSLIB/libopencv_aruco.so" ]; then
+	die "the sysroot $SYSROOT has no libopencv_aruco.so (scripts/arm/make-sysroot-count.sh adds it); or pass --no-opencv" 3
+fi
+
+# ---- the counting plugin (needs qemu-plugin.h from Debian's qemu source) ------
+PLUGIN=$CACHE/plugin/libfrappecount.so
+QSRC=$CACHE/qemu-src
+if [ ! -f "$QSRC/include/qemu-plugin.h" ]; then
+	step "qemu-plugin.h from Debian's qemu source package"
+	mkdir -p "$QSRC/lists/partial" "$QSRC/cache/archives/partial" "$QSRC/include"
+	uris=$( { grep -h '^URIs:' /etc/apt/sources.list.d/*.sources 2>/dev/null | awk '{print $2}';
+		  grep -h '^deb ' /etc/apt/sources.list 2>/dev/null | awk '{print $2}'; } | sort -u || true)
+	MAIN=$(echo "$uris" | grep -v security | head -1 || true); SEC=$(echo "$uris" | grep security | head -1 || true)
+	MAIN=${MAIN:-http://deb.debian.org/debian}
+	{ echo "deb-src $MAIN bookworm main"; echo "deb-src $MAIN bookworm-updates main"
+	  [ -n "$SEC" ] && echo "deb-src $SEC bookworm-security main"; } > "$QSRC/sources.list"
+	APTO=(-o Dir::Etc::SourceList="$QSRC/sources.list" -o Dir::Etc::SourceParts=/nonexistent
+	      -o Dir::State::Lists="$QSRC/lists" -o Dir::Cache="$QSRC/cache" -o APT::Sandbox::User=root)
+	VER=$(dpkg-query -W -f='${source:Version}' qemu-user 2>/dev/null || true)
+	( cd "$QSRC" && apt-get "${APTO[@]}" update -qq &&
+	  { [ -n "$VER" ] && apt-get "${APTO[@]}" source -d -qq "qemu=$VER" || apt-get "${APTO[@]}" source -d -qq qemu; } &&
+	  tar -xJf "$(ls qemu_*.orig.tar.* | head -1)" --wildcards '*/include/qemu/qemu-plugin.h' &&
+	  cp qemu-*/include/qemu/qemu-plugin.h include/ && rm -rf qemu_*.orig.tar.* qemu_*.debian.tar.* qemu-*/ ) \
+		>"$CACHE/qemu-src.log" 2>&1 || die "could not get qemu-plugin.h (log: $CACHE/qemu-src.log)" 3
+fi
+if [ ! -f "$PLUGIN" ] || [ "$HERE/frappecount.c" -nt "$PLUGIN" ]; then
+	step "plugin $PLUGIN"
+	mkdir -p "$(dirname "$PLUGIN")"
+	gcc -O2 -Wall -Wextra -Wno-unused-parameter -shared -fPIC -I"$QSRC/include" \
+		"$HERE/frappecount.c" -o "$PLUGIN"
+fi
+
+# ---- cross build of frappe-core (static, scalar front end) --------------------
+mkdir -p "$CACHE"
+XF=$CACHE/sysroot-armel.ini
+printf "[constants]\nsysroot = '%s'\n" "$SYSROOT" > "$XF.tmp"
+cmp -s "$XF.tmp" "$XF" 2>/dev/null && rm "$XF.tmp" || mv "$XF.tmp" "$XF"
+if [ ! -f "$BUILD/build.ninja" ]; then
+	step "meson setup $BUILD (cross, ARMv6KZ + VFPv2)"
+	opts=(--buildtype=release -Ddefault_library=static)
+	# switch off whatever the project can build beside the library
+	for o in simd gst vc4 tests examples cli; do
+		grep -q "option('$o'" "$SRC/meson_options.txt" && opts+=("-D$o=disabled")
+	done
+	meson setup "$BUILD" "$SRC" --cross-file "$XF" --cross-file "$HERE/armv6-armel.ini" "${opts[@]}" \
+		>"$CACHE/meson-setup.log" 2>&1 || { cat "$CACHE/meson-setup.log" >&2; die "meson setup failed" 4; }
+fi
+step "ninja: frappe-core (ARMv6)"
+LIB=frappe-core/libfrappe-core.a
+ninja -C "$BUILD" -j"$JOBS" "$LIB" >&2 || die "cross build of frappe-core failed" 4
+
+step "driver tests/bench/frappe_count.cpp"
+mkdir -p "$OUT"
+CXXFLAGS=(-std=c++20 -O3 -march=armv6kz -mtune=arm1176jzf-s -mfpu=vfp -mfloat-abi=softfp -pthread
+	  -I"$SRC/frappe-core/include" -isystem "$SYSROOT/usr/include" -isystem "$SYSROOT/usr/include/$TRIPLET")
+LIBS=("$BUILD/$LIB")
+if [ "$OPENCV" = 1 ]; then
+	CXXFLAGS+=(-DFRAPPE_COUNT_OPENCV -isystem "$SYSROOT/usr/include/opencv4")
+	LIBS+=(-lopencv_aruco -lopencv_calib3d -lopencv_imgproc -lopencv_core)
+fi
+LIBS+=(-lpng16 -ljpeg -lz)
+# -no-pie: the plugin's addresses then match the executable's symbol table.
+$TRIPLET-g++ "${CXXFLAGS[@]}" -no-pie -o "$OUT/frappe-count" "$SRC/tests/bench/frappe_count.cpp" \
+	-L"$SYSLIB" "${LIBS[@]}" -Wl,-rpath-link,"$SYSLIB" -Wl,-rpath-link,"$SYSROOT/lib/$TRIPLET" \
+	-Wl,-Map,"$OUT/frappe-count.map" || die "building the driver failed" 4
+$TRIPLET-nm -n -S -C "$OUT/frappe-count" > "$OUT/frappe-count.syms"
+
+# ---- count -------------------------------------------------------------------
+n=$(grep -cv '^\s*\(#\|$\)' "$LIST" || true)
+[ "$MAX" -gt 0 ] && [ "$MAX" -lt "$n" ] && n=$MAX
+step "counting $n images under qemu-arm -cpu arm1176 (OpenCV: $([ "$OPENCV" = 1 ] && echo yes || echo no))"
+args=(--list "$LIST" --dictionary "$DICT" --max "$MAX" --out-frappe "$OUT/frappe.jsonl")
+[ "$OPENCV" = 1 ] && args+=(--out-opencv "$OUT/opencv.jsonl") || args+=(--no-opencv)
+# relative paths in the list are relative to the current directory (the contract)
+( qemu-arm -cpu arm1176 -L "$SYSROOT" -d plugin -plugin "$PLUGIN,out=$OUT/count.log" \
+	"$OUT/frappe-count" "${args[@]}" > "$OUT/driver.txt" 2> "$OUT/qemu.log" ) ||
+	{ tail -20 "$OUT/qemu.log" >&2; die "the counting run failed (log: $OUT/qemu.log)" 5; }
+
+step "report"
+python3 "$HERE/arm_count_report.py" --log "$OUT/count.log" --map "$OUT/frappe-count.map" \
+	--syms "$OUT/frappe-count.syms" --driver "$OUT/driver.txt" --md "$OUT/report.md" \
+	--csv "$OUT/frames.csv"
+step "done: $OUT/report.md"

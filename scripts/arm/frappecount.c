@@ -1,0 +1,279 @@
+/*
+ * frappecount: a QEMU 7.2 TCG plugin (plugin API v1, Debian 12's qemu-user)
+ * that counts the guest instructions of a 32-bit ARM (A32) program per
+ * function of the main executable and per interval between marker calls.
+ * Used by scripts/arm-count.sh; based on the team's armcount plugin (same
+ * instruction classes).
+ *
+ * Attribution:
+ *  - an instruction inside a symbol of the main executable (unstripped,
+ *    non-PIE so that addresses match `nm`) counts to that function ("self");
+ *  - an instruction without a symbol (shared libraries: libc, libm,
+ *    libstdc++, OpenCV; PLT stubs) or in a symbol starting with "__" (the
+ *    libgcc helpers linked into the executable: __aeabi_idiv, __divsi3 ...:
+ *    ARMv6 has no divide instruction) counts to the main-executable function
+ *    whose BL/BLX executed last ("lib", i.e. the library code it called).
+ * Markers: a call to a function whose name starts with `armcount_mark_`
+ * (extern "C", noinline) writes one snapshot to the out file:
+ *    M <label> <total insns so far>
+ *    C <12 class deltas> <memory-access delta>
+ *    B <bucket> <self delta> <lib delta>      (only buckets that changed)
+ * where the deltas are counts since the previous marker and <label> is the
+ * function name after the prefix. At exit:
+ *    N <bucket> <entry address hex> <mangled name>
+ * Counters are inline and not atomic: exact for single-threaded guests.
+ *
+ * Compiled against QEMU's qemu-plugin.h and loaded into QEMU:
+ * SPDX-License-Identifier: GPL-2.0-or-later
+ *
+ * Use: qemu-arm -cpu arm1176 -L SYSROOT -d plugin \
+ *          -plugin ./libfrappecount.so,out=FILE ./prog args
+ */
+#include <inttypes.h>
+#include <stdbool.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <qemu-plugin.h>
+
+QEMU_PLUGIN_EXPORT int qemu_plugin_version = QEMU_PLUGIN_VERSION;
+
+enum cls {
+    C_ALU, C_MUL, C_MEDIA, C_BRANCH, C_LOAD, C_STORE, C_LDM, C_STM,
+    C_VFP, C_VFP_LDST, C_THUMB, C_OTHER, C_N
+};
+static const char *const cls_name[C_N] = {
+    "alu", "mul", "media_simd32", "branch", "load", "store", "ldm", "stm",
+    "vfp", "vfp_ldst", "thumb16", "other"
+};
+
+#define MAX_BUCKETS 65536
+#define HASH_SIZE (1 << 17)
+#define MARK_PREFIX "armcount_mark_"
+
+typedef struct {
+    const char *name;      /* NULL for bucket 0: code before any BL attribution */
+    uint64_t entry;        /* lowest address seen */
+    uint64_t self, lib;    /* counters (self: inline) */
+    uint64_t snap_self, snap_lib;
+} Bucket;
+
+static Bucket buckets[MAX_BUCKETS];
+static uint32_t n_buckets = 1;
+static uint32_t hash_tab[HASH_SIZE]; /* bucket index, 0 = empty */
+static uint64_t cls_count[C_N], cls_snap[C_N];
+static uint64_t mem_acc, mem_snap;
+static uint32_t cur_caller;          /* bucket of the last executed BL/BLX */
+static FILE *out;
+
+static enum cls classify_a32(uint32_t i)
+{
+    uint32_t cond = i >> 28, op = (i >> 25) & 7, cp = (i >> 8) & 0xf;
+    bool load = (i >> 20) & 1;
+
+    if (cond == 0xf) {
+        return C_OTHER;            /* unconditional space: PLD, BLX imm, ... */
+    }
+    switch (op) {
+    case 0:
+        if ((i & 0x0ffffff0u) == 0x012fff10u || (i & 0x0ffffff0u) == 0x012fff30u) {
+            return C_BRANCH;       /* BX / BLX register */
+        }
+        if ((i & 0x0f0000f0u) == 0x00000090u) {
+            return C_MUL;          /* MUL, MLA, UMULL, SMLAL, ... */
+        }
+        if ((i & 0x0f900090u) == 0x01000080u) {
+            return C_MUL;          /* SMLAxy, SMULxy, SMULWy, ... */
+        }
+        if ((i & 0x90u) == 0x90u && (i & 0x60u) != 0) {
+            if (!load && (i & 0x60u) == 0x40u) {
+                return C_LOAD;     /* LDRD */
+            }
+            return load ? C_LOAD : C_STORE;
+        }
+        return C_ALU;
+    case 1:
+        return C_ALU;
+    case 2:
+        return load ? C_LOAD : C_STORE;
+    case 3:
+        if (i & 0x10u) {
+            if ((i & 0x0f800010u) == 0x07000010u) {
+                return C_MUL;      /* SMLAD, SMUAD, SMLSD, SMMUL, ... */
+            }
+            return C_MEDIA;        /* ARMv6 SIMD32: UADD8, USAT, SXTB, SEL, USAD8 ... */
+        }
+        return load ? C_LOAD : C_STORE;
+    case 4:
+        return load ? C_LDM : C_STM;
+    case 5:
+        return C_BRANCH;
+    case 6:
+        return (cp == 10 || cp == 11) ? C_VFP_LDST : C_OTHER;
+    default:
+        if (i & (1u << 24)) {
+            return C_OTHER;        /* SVC */
+        }
+        return (cp == 10 || cp == 11) ? C_VFP : C_OTHER;
+    }
+}
+
+static bool is_call_a32(uint32_t i)
+{
+    if ((i >> 28) == 0xf) {
+        return ((i >> 25) & 7) == 5;                    /* BLX imm */
+    }
+    if (((i >> 24) & 0xf) == 0xb) {
+        return true;                                    /* BL */
+    }
+    return (i & 0x0ffffff0u) == 0x012fff30u;           /* BLX reg */
+}
+
+static uint32_t bucket_of(const char *name, uint64_t vaddr)
+{
+    uint32_t h = (uint32_t)(((uintptr_t)name * 0x9E3779B97F4A7C15ull) >> 40) & (HASH_SIZE - 1);
+    while (hash_tab[h]) {
+        Bucket *b = &buckets[hash_tab[h]];
+        if (b->name == name || strcmp(b->name, name) == 0) {
+            if (vaddr < b->entry) {
+                b->entry = vaddr;
+            }
+            return hash_tab[h];
+        }
+        h = (h + 1) & (HASH_SIZE - 1);
+    }
+    if (n_buckets >= MAX_BUCKETS) {
+        return 0;
+    }
+    uint32_t k = n_buckets++;
+    buckets[k].name = name;
+    buckets[k].entry = vaddr;
+    hash_tab[h] = k;
+    return k;
+}
+
+static void on_call(unsigned int vcpu, void *ud)
+{
+    cur_caller = (uint32_t)(uintptr_t)ud;
+}
+
+static void on_lib_tb(unsigned int vcpu, void *ud)
+{
+    buckets[cur_caller].lib += (uint64_t)(uintptr_t)ud;
+}
+
+static void on_mark(unsigned int vcpu, void *ud)
+{
+    uint64_t total = 0;
+    if (!out) {
+        return;
+    }
+    for (int c = 0; c < C_N; c++) {
+        total += cls_count[c];
+    }
+    fprintf(out, "M %s %" PRIu64 "\nC", (const char *)ud, total);
+    for (int c = 0; c < C_N; c++) {
+        fprintf(out, " %" PRIu64, cls_count[c] - cls_snap[c]);
+        cls_snap[c] = cls_count[c];
+    }
+    fprintf(out, " %" PRIu64 "\n", mem_acc - mem_snap);
+    mem_snap = mem_acc;
+    for (uint32_t k = 0; k < n_buckets; k++) {
+        Bucket *b = &buckets[k];
+        if (b->self != b->snap_self || b->lib != b->snap_lib) {
+            fprintf(out, "B %u %" PRIu64 " %" PRIu64 "\n", k, b->self - b->snap_self,
+                    b->lib - b->snap_lib);
+            b->snap_self = b->self;
+            b->snap_lib = b->lib;
+        }
+    }
+}
+
+static void tb_trans(qemu_plugin_id_t id, struct qemu_plugin_tb *tb)
+{
+    size_t n = qemu_plugin_tb_n_insns(tb);
+    size_t lib_insns = 0;
+    const char *prev_sym = NULL;
+    for (size_t k = 0; k < n; k++) {
+        struct qemu_plugin_insn *insn = qemu_plugin_tb_get_insn(tb, k);
+        const char *s = qemu_plugin_insn_symbol(insn);
+        uint64_t va = qemu_plugin_insn_vaddr(insn);
+        uint32_t w = 0;
+        enum cls c = C_THUMB;
+        if (qemu_plugin_insn_size(insn) == 4) {
+            memcpy(&w, qemu_plugin_insn_data(insn), 4);
+            c = classify_a32(w);
+        }
+        qemu_plugin_register_vcpu_insn_exec_inline(insn, QEMU_PLUGIN_INLINE_ADD_U64,
+                                                   &cls_count[c], 1);
+        qemu_plugin_register_vcpu_mem_inline(insn, QEMU_PLUGIN_MEM_RW,
+                                             QEMU_PLUGIN_INLINE_ADD_U64, &mem_acc, 1);
+        /* no symbol (shared libraries, PLT) or a libgcc helper (__aeabi_idiv,
+         * __udivsi3, ...): counted to the caller */
+        if (!s || !*s || (s[0] == '_' && s[1] == '_')) {
+            lib_insns++;
+            prev_sym = NULL;
+            continue;
+        }
+        uint32_t b = bucket_of(s, va);
+        qemu_plugin_register_vcpu_insn_exec_inline(insn, QEMU_PLUGIN_INLINE_ADD_U64,
+                                                   &buckets[b].self, 1);
+        if (qemu_plugin_insn_size(insn) == 4 && is_call_a32(w)) {
+            qemu_plugin_register_vcpu_insn_exec_cb(insn, on_call, QEMU_PLUGIN_CB_NO_REGS,
+                                                   (void *)(uintptr_t)b);
+        }
+        if (strncmp(s, MARK_PREFIX, strlen(MARK_PREFIX)) == 0 && (k == 0 || prev_sym != s)) {
+            qemu_plugin_register_vcpu_insn_exec_cb(insn, on_mark, QEMU_PLUGIN_CB_NO_REGS,
+                                                   (void *)(s + strlen(MARK_PREFIX)));
+        }
+        prev_sym = s;
+    }
+    if (lib_insns) {
+        qemu_plugin_register_vcpu_tb_exec_cb(tb, on_lib_tb, QEMU_PLUGIN_CB_NO_REGS,
+                                             (void *)(uintptr_t)lib_insns);
+    }
+}
+
+static void at_exit(qemu_plugin_id_t id, void *p)
+{
+    uint64_t total = 0;
+    char line[160];
+    for (int c = 0; c < C_N; c++) {
+        total += cls_count[c];
+    }
+    snprintf(line, sizeof line, "frappecount: insns %" PRIu64 ", functions %u\n", total, n_buckets - 1);
+    qemu_plugin_outs(line);
+    if (out) {
+        on_mark(0, (void *)"exit");
+        for (uint32_t k = 1; k < n_buckets; k++) {
+            fprintf(out, "N %u %" PRIx64 " %s\n", k, buckets[k].entry, buckets[k].name);
+        }
+        fclose(out);
+        out = NULL;
+    }
+}
+
+QEMU_PLUGIN_EXPORT int qemu_plugin_install(qemu_plugin_id_t id, const qemu_info_t *info,
+                                           int argc, char **argv)
+{
+    for (int k = 0; k < argc; k++) {
+        if (strncmp(argv[k], "out=", 4) == 0) {
+            out = fopen(argv[k] + 4, "w");
+            if (!out) {
+                fprintf(stderr, "frappecount: cannot write %s\n", argv[k] + 4);
+                return -1;
+            }
+        } else {
+            fprintf(stderr, "frappecount: unknown argument %s\n", argv[k]);
+            return -1;
+        }
+    }
+    if (strcmp(info->target_name, "arm") != 0) {
+        fprintf(stderr, "frappecount: classes assume 32-bit ARM; target is %s\n", info->target_name);
+    }
+    qemu_plugin_register_vcpu_tb_trans_cb(id, tb_trans);
+    qemu_plugin_register_atexit_cb(id, at_exit, NULL);
+    return 0;
+}

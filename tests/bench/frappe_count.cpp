@@ -1,0 +1,318 @@
+// SPDX-License-Identifier: MIT
+// frappe-count: the driver of scripts/arm-count.sh. Runs frappe-core and,
+// when built with FRAPPE_COUNT_OPENCV, OpenCV's aruco module on the images
+// of a list (the detector contract's list format), one detection per image
+// each, interleaved, single-threaded, and brackets every detection with
+// calls to empty marker functions (`armcount_mark_*`). Under qemu-arm with
+// the frappecount plugin each marker call writes a snapshot of the
+// instruction counters, so the counts between two markers are exactly the
+// instructions of one detection (image decoding and the driver's own work
+// fall outside them).
+//
+//   frappe-count --list LIST.txt [--dictionary aruco_mip_36h12] [--max N]
+//                [--no-opencv] [--out-frappe F.jsonl] [--out-opencv O.jsonl]
+//
+// frappe runs as Detector::detect() does, split into its two public halves
+// (runFrontEnd, then runBackEnd) with a marker between them. OpenCV gets the
+// same setup as tests/bench/frappe_bench.cpp: the dictionary as a custom
+// Dictionary, at most 5 corrected bits (capped by the dictionary's safe
+// maximum), no corner refinement. Images: 8-bit PNG (libpng) or JPEG
+// (libjpeg), converted to grey if needed. Prints one line per image on
+// stdout: "image <index> <width> <height> <frappe markers> <opencv markers> <path>".
+// Natively (without the plugin) the markers do nothing.
+#include <algorithm>
+#include <array>
+#include <cstdio>
+#include <cstring>
+#include <cctype>
+#include <csetjmp>
+#include <fstream>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include <jpeglib.h>
+#include <png.h>
+
+#ifdef FRAPPE_COUNT_OPENCV
+#include <opencv2/aruco.hpp>
+#include <opencv2/core/utility.hpp>
+#endif
+
+#include "frappe/frappe.h"
+
+/* The marker functions: the plugin recognises them by name. They must stay
+ * real calls (noinline) and differ in body so the linker does not fold them. */
+#define FRAPPE_COUNT_MARK(name, n)                                                                 \
+	extern "C" __attribute__((noinline, used)) void armcount_mark_##name()                      \
+	{                                                                                          \
+		static volatile int sink;                                                         \
+		sink = n;                                                                          \
+	}
+FRAPPE_COUNT_MARK(warmup, 1)
+FRAPPE_COUNT_MARK(frappe_begin, 2)
+FRAPPE_COUNT_MARK(frappe_front, 3)
+FRAPPE_COUNT_MARK(frappe_back, 4)
+FRAPPE_COUNT_MARK(opencv_begin, 5)
+FRAPPE_COUNT_MARK(opencv_end, 6)
+
+namespace {
+
+struct Gray {
+	std::vector<std::uint8_t> pixels;
+	int width = 0, height = 0;
+};
+
+bool endsWith(const std::string &s, const char *suffix)
+{
+	const std::size_t n = std::strlen(suffix);
+	if (s.size() < n)
+		return false;
+	for (std::size_t i = 0; i < n; ++i)
+		if (std::tolower(static_cast<unsigned char>(s[s.size() - n + i])) != suffix[i])
+			return false;
+	return true;
+}
+
+bool readPng(const std::string &path, Gray &g)
+{
+	png_image img;
+	std::memset(&img, 0, sizeof img);
+	img.version = PNG_IMAGE_VERSION;
+	if (!png_image_begin_read_from_file(&img, path.c_str()))
+		return false;
+	img.format = PNG_FORMAT_GRAY; /* libpng converts colour and strips alpha */
+	g.width = static_cast<int>(img.width);
+	g.height = static_cast<int>(img.height);
+	g.pixels.resize(PNG_IMAGE_SIZE(img));
+	if (!png_image_finish_read(&img, nullptr, g.pixels.data(), 0, nullptr)) {
+		png_image_free(&img);
+		return false;
+	}
+	return true;
+}
+
+struct JpegError {
+	jpeg_error_mgr mgr;
+	std::jmp_buf jump;
+};
+
+bool readJpeg(const std::string &path, Gray &g)
+{
+	FILE *f = std::fopen(path.c_str(), "rb");
+	if (!f)
+		return false;
+	jpeg_decompress_struct cinfo;
+	JpegError err;
+	cinfo.err = jpeg_std_error(&err.mgr);
+	err.mgr.error_exit = [](j_common_ptr c) { std::longjmp(reinterpret_cast<JpegError *>(c->err)->jump, 1); };
+	if (setjmp(err.jump)) {
+		jpeg_destroy_decompress(&cinfo);
+		std::fclose(f);
+		return false;
+	}
+	jpeg_create_decompress(&cinfo);
+	jpeg_stdio_src(&cinfo, f);
+	jpeg_read_header(&cinfo, TRUE);
+	cinfo.out_color_space = JCS_GRAYSCALE;
+	jpeg_start_decompress(&cinfo);
+	g.width = static_cast<int>(cinfo.output_width);
+	g.height = static_cast<int>(cinfo.output_height);
+	g.pixels.resize(static_cast<std::size_t>(g.width) * g.height);
+	while (cinfo.output_scanline < cinfo.output_height) {
+		JSAMPROW row = g.pixels.data() + static_cast<std::size_t>(cinfo.output_scanline) * g.width;
+		jpeg_read_scanlines(&cinfo, &row, 1);
+	}
+	jpeg_finish_decompress(&cinfo);
+	jpeg_destroy_decompress(&cinfo);
+	std::fclose(f);
+	return true;
+}
+
+bool readImage(const std::string &path, Gray &g)
+{
+	if (endsWith(path, ".jpg") || endsWith(path, ".jpeg"))
+		return readJpeg(path, g);
+	return readPng(path, g);
+}
+
+void writeLine(std::ofstream &out, const std::string &image, const std::vector<int> &ids,
+	       const std::vector<std::array<frappe::Point2f, 4>> &corners)
+{
+	if (!out.is_open())
+		return;
+	out << "{\"image\": \"" << image << "\", \"markers\": [";
+	char buf[200];
+	for (std::size_t i = 0; i < ids.size(); ++i) {
+		const auto &c = corners[i];
+		std::snprintf(buf, sizeof(buf),
+			      "%s{\"id\": %d, \"corners\": [[%.3f, %.3f], [%.3f, %.3f], [%.3f, %.3f], [%.3f, %.3f]]}",
+			      i ? ", " : "", ids[i], c[0].x, c[0].y, c[1].x, c[1].y, c[2].x, c[2].y, c[3].x, c[3].y);
+		out << buf;
+	}
+	out << "], \"time_ms\": 0}\n";
+}
+
+#ifdef FRAPPE_COUNT_OPENCV
+cv::Ptr<cv::aruco::Dictionary> opencvDictionary(const frappe::Dictionary &d, int maxCorrection)
+{
+	auto dict = cv::makePtr<cv::aruco::Dictionary>();
+	dict->markerSize = d.bits;
+	dict->maxCorrectionBits = maxCorrection;
+	const int n = d.bits;
+	for (int id = 0; id < d.size(); ++id) {
+		cv::Mat bits(n, n, CV_8UC1);
+		for (int r = 0; r < n; ++r)
+			for (int c = 0; c < n; ++c)
+				bits.at<std::uint8_t>(r, c) =
+					static_cast<std::uint8_t>((d.codes[id] >> (n * n - 1 - (r * n + c))) & 1u);
+		dict->bytesList.push_back(cv::aruco::Dictionary::getByteListFromBits(bits));
+	}
+	return dict;
+}
+#endif
+
+} // namespace
+
+int main(int argc, char **argv)
+{
+	std::string dictName = "aruco_mip_36h12", list, outF, outO;
+	int maxImages = 0;
+	bool useOpencv = true;
+	for (int i = 1; i < argc; ++i) {
+		const std::string a = argv[i];
+		auto value = [&]() -> std::string {
+			if (i + 1 >= argc) {
+				std::cerr << a << " needs a value\n";
+				std::exit(2);
+			}
+			return argv[++i];
+		};
+		if (a == "--dictionary")
+			dictName = value();
+		else if (a == "--list")
+			list = value();
+		else if (a == "--max")
+			maxImages = std::stoi(value());
+		else if (a == "--no-opencv")
+			useOpencv = false;
+		else if (a == "--out-frappe")
+			outF = value();
+		else if (a == "--out-opencv")
+			outO = value();
+		else {
+			std::cerr << "usage: frappe-count --list L [--dictionary D] [--max N] [--no-opencv] "
+				     "[--out-frappe F] [--out-opencv O]\n";
+			return 2;
+		}
+	}
+#ifndef FRAPPE_COUNT_OPENCV
+	useOpencv = false;
+#endif
+	const frappe::Dictionary *dict = frappe::findDictionary(dictName);
+	if (!dict || list.empty()) {
+		std::cerr << "frappe-count: need a known --dictionary and a --list\n";
+		return 2;
+	}
+	std::vector<std::string> paths;
+	std::vector<Gray> images;
+	{
+		std::ifstream in(list);
+		if (!in) {
+			std::cerr << "frappe-count: cannot read " << list << "\n";
+			return 2;
+		}
+		for (std::string line; std::getline(in, line);) {
+			while (!line.empty() && (line.back() == '\r' || line.back() == ' '))
+				line.pop_back();
+			if (line.empty() || line[0] == '#')
+				continue;
+			if (maxImages > 0 && static_cast<int>(images.size()) >= maxImages)
+				break;
+			Gray g;
+			if (!readImage(line, g)) {
+				std::cerr << "frappe-count: cannot read " << line << "\n";
+				continue;
+			}
+			paths.push_back(line);
+			images.push_back(std::move(g));
+		}
+	}
+	if (images.empty()) {
+		std::cerr << "frappe-count: no images\n";
+		return 2;
+	}
+
+	frappe::Config cfg;
+	cfg.dictionary = dictName;
+	cfg.threads = 1;
+	frappe::Detector det(cfg);
+	std::ofstream fo, oo;
+	if (!outF.empty())
+		fo.open(outF);
+	if (!outO.empty())
+		oo.open(outO);
+
+#ifdef FRAPPE_COUNT_OPENCV
+	cv::setNumThreads(1);
+	const auto cvDict = opencvDictionary(*dict, std::min(5, det.maxHamming()));
+	auto params = cv::aruco::DetectorParameters::create();
+	params->cornerRefinementMethod = cv::aruco::CORNER_REFINE_NONE;
+	std::vector<int> ids;
+	std::vector<std::vector<cv::Point2f>> cvCorners;
+#endif
+
+	/* One uncounted warm-up detection each: buffers are sized on the first
+	 * frame of a size, dictionaries and lazy tables are built. */
+	{
+		const Gray &g = images[0];
+		det.detect(frappe::ImageView(g.pixels.data(), g.width, g.height));
+#ifdef FRAPPE_COUNT_OPENCV
+		if (useOpencv) {
+			cv::Mat m(g.height, g.width, CV_8UC1, const_cast<std::uint8_t *>(g.pixels.data()));
+			cv::aruco::detectMarkers(m, cvDict, cvCorners, ids, params);
+		}
+#endif
+		armcount_mark_warmup();
+	}
+
+	for (std::size_t k = 0; k < images.size(); ++k) {
+		const Gray &g = images[k];
+		const frappe::ImageView view(g.pixels.data(), g.width, g.height);
+		armcount_mark_frappe_begin();
+		det.runFrontEnd(view, 0);
+		armcount_mark_frappe_front();
+		const frappe::Result &res = det.runBackEnd(view, 0);
+		armcount_mark_frappe_back();
+		const int nf = static_cast<int>(res.markers.size());
+		if (fo.is_open()) {
+			std::vector<int> fid;
+			std::vector<std::array<frappe::Point2f, 4>> fc;
+			for (const auto &m : res.markers) {
+				fid.push_back(m.id);
+				fc.push_back(m.corners);
+			}
+			writeLine(fo, paths[k], fid, fc);
+		}
+		int no = -1;
+#ifdef FRAPPE_COUNT_OPENCV
+		if (useOpencv) {
+			cv::Mat m(g.height, g.width, CV_8UC1, const_cast<std::uint8_t *>(g.pixels.data()));
+			armcount_mark_opencv_begin();
+			cv::aruco::detectMarkers(m, cvDict, cvCorners, ids, params);
+			armcount_mark_opencv_end();
+			no = static_cast<int>(ids.size());
+			if (oo.is_open()) {
+				std::vector<std::array<frappe::Point2f, 4>> oc;
+				for (const auto &c : cvCorners)
+					oc.push_back({ frappe::Point2f{ c[0].x, c[0].y }, { c[1].x, c[1].y },
+						       { c[2].x, c[2].y }, { c[3].x, c[3].y } });
+				writeLine(oo, paths[k], ids, oc);
+			}
+		}
+#endif
+		std::printf("image %zu %d %d %d %d %s\n", k, g.width, g.height, nf, no, paths[k].c_str());
+	}
+	std::fflush(stdout);
+	return 0;
+}
