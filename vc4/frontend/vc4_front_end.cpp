@@ -1,0 +1,314 @@
+// SPDX-License-Identifier: MIT
+#include "frontend/vc4_front_end.hpp"
+
+#include <algorithm>
+#include <cstring>
+#include <stdexcept>
+#include <vector>
+
+#include "emu/device.hpp"
+#include "isa/setup_words.hpp"
+#include "kernels/kernels.hpp"
+#if FRAPPE_VC4_HAVE_RUNTIME
+#include "runtime/gpu_device.hpp"
+#endif
+
+namespace frappe::vc4 {
+
+namespace {
+
+using kernels::kTileH;
+using kernels::kTileW;
+
+constexpr unsigned kPrograms = 12;
+constexpr uint32_t kCodeSlack = 1u << 16;
+
+uint32_t roundUp(uint32_t v, uint32_t m) { return (v + m - 1) / m * m; }
+
+// What a frame needs from the device, sized once per frame geometry.
+struct Geometry {
+	int src_w = 0, src_h = 0, w = 0, h = 0;
+	bool operator==(const Geometry &) const = default;
+	uint32_t srcStride() const { return roundUp(static_cast<uint32_t>(src_w), 4); }
+	uint32_t paddedW() const { return roundUp(static_cast<uint32_t>(w), kTileW); }
+	uint32_t paddedH() const { return roundUp(static_cast<uint32_t>(h), kTileH); }
+	uint32_t tilesX() const { return paddedW() / kTileW; }
+	uint32_t tilesY() const { return paddedH() / kTileH; }
+	uint32_t tiles() const { return tilesX() * tilesY(); }
+	uint32_t gradPitch() const { return 16 * paddedW(); }
+	uint32_t srcBytes() const { return srcStride() * static_cast<uint32_t>(src_h) + 64; }
+	uint32_t gradBytes() const { return gradPitch() * paddedH(); }
+	uint32_t edgeBytes() const { return paddedW() * paddedH(); }
+	uint32_t maskBytes() const { return 128 * tiles(); }
+	uint32_t uniformWords(unsigned per_tile) const
+	{
+		return (per_tile + 1) * ((tiles() + kPrograms - 1) / kPrograms);
+	}
+};
+
+template <class Device>
+struct Buffers {
+	typename Device::Buffer src, grad, edge, mask, code[2];
+	typename Device::Buffer unif[2][kPrograms];
+};
+
+// Device adapters: the emulator owns its memory (re-created when the geometry grows);
+// the GPU releases buffers one by one.
+struct EmuBackend {
+	using Device = emu::Device;
+	FrontEndOptions options;
+	std::unique_ptr<emu::Device> device;
+	FrameCounts counts;
+	bool counted = false;
+
+	static const char *name() { return "vc4-emu"; }
+	Device &open(uint32_t bytes, Buffers<Device> &)
+	{
+		emu::Config config;
+		config.strict = options.strict;
+		config.tmu_fifo_limit = 4; // what the hardware does reliably (vc4asm addendum)
+		device = std::make_unique<emu::Device>(config, roundUp(bytes + (1u << 20), 1u << 20));
+		return *device;
+	}
+	void run(std::span<const emu::Job> jobs, PassCounts &c)
+	{
+		emu::LaunchOptions lo;
+		if (options.seed) {
+			lo.schedule = emu::Schedule::Random;
+			lo.seed = options.seed;
+		}
+		const emu::LaunchStats s = device->wait(device->launch(jobs, lo));
+		if (s.host_interrupts != jobs.size())
+			throw std::runtime_error("vc4-emu: a QPU program ended without raising the host interrupt");
+		c.instructions = s.instructions;
+		c.slowest_cycles = s.cycles;
+		c.programs = static_cast<unsigned>(jobs.size());
+	}
+};
+
+#if FRAPPE_VC4_HAVE_RUNTIME
+struct GpuBackend {
+	using Device = runtime::GpuDevice;
+	std::unique_ptr<runtime::GpuDevice> device;
+
+	static const char *name() { return "vc4"; }
+	Device &open(uint32_t, Buffers<Device> &old)
+	{
+		if (!device)
+			device = std::make_unique<runtime::GpuDevice>();
+		for (auto *b : {&old.src, &old.grad, &old.edge, &old.mask}) {
+			if (b->bus)
+				device->release(*b);
+			*b = {};
+		}
+		for (auto &pass : old.unif)
+			for (auto &b : pass) {
+				if (b.bus)
+					device->release(b);
+				b = {};
+			}
+		return *device;
+	}
+	void run(std::span<const runtime::Job> jobs, PassCounts &c)
+	{
+		device->wait(device->launch(jobs));
+		c.programs = static_cast<unsigned>(jobs.size());
+	}
+};
+#endif
+
+template <class Backend>
+class Vc4FrontEnd final : public FrontEnd {
+public:
+	using Device = typename Backend::Device;
+
+	explicit Vc4FrontEnd(Backend backend) : backend_(std::move(backend))
+	{
+		programs_[0] = kernels::gradientPass().program;
+		programs_[1] = kernels::edgePass().program;
+	}
+	const char *name() const override { return Backend::name(); }
+	const Backend &backend() const { return backend_; }
+
+	void run(const ImageView &image, float scale, const FrontEndParams &params, EdgeMap &out) override
+	{
+		Geometry g;
+		g.src_w = image.width;
+		g.src_h = image.height;
+		g.w = scale < 1.0f ? scaledLength(image.width, scale) : image.width;
+		g.h = scale < 1.0f ? scaledLength(image.height, scale) : image.height;
+		if (g.w < 3 || g.h < 3 || g.w > kernels::kMaxWidth) {
+			// Nothing for the QPUs (an all-zero map) or wider than the VDW stride allows.
+			if (!cpu_)
+				cpu_ = makeCpuFrontEnd(1);
+			cpu_->run(image, scale, params, out);
+			return;
+		}
+		prepare(g);
+		out.resize(g.w, g.h);
+		out.scale = scale < 1.0f ? scale : 1.0f;
+
+		// The source frame, rows 4-aligned.
+		const uint32_t stride = g.srcStride();
+		for (int y = 0; y < g.src_h; ++y)
+			std::memcpy(buf_.src.cpu.data() + static_cast<size_t>(y) * stride, image.row(y),
+			            static_cast<size_t>(g.src_w));
+
+		const uint32_t stepX = static_cast<uint32_t>((static_cast<uint64_t>(g.src_w) * 65536u + g.w / 2) / g.w);
+		const uint32_t stepY = static_cast<uint32_t>((static_cast<uint64_t>(g.src_h) * 65536u + g.h / 2) / g.h);
+		const int64_t thr = std::clamp<int64_t>(params.edge_threshold_sq, -1, int64_t{1} << 22);
+		const uint32_t edgeThr = static_cast<uint32_t>(thr) << 2 | 3u;
+		const uint32_t cornerC = 2u * static_cast<uint32_t>(static_cast<int32_t>(params.corner_threshold));
+		const uint32_t pitch = g.gradPitch(), pw = g.paddedW();
+
+		const unsigned tiles = g.tiles();
+		const unsigned programs = std::min(kPrograms, tiles);
+		std::vector<uint32_t> p1, p2;
+		for (unsigned p = 0; p < programs; ++p) {
+			p1.clear();
+			p2.clear();
+			for (unsigned t = p; t < tiles; t += kPrograms) {
+				const uint32_t x0 = (t % g.tilesX()) * kTileW, y0 = (t / g.tilesX()) * kTileH;
+				const kernels::GradientUniforms u1{
+					buf_.src.bus, stride, static_cast<uint32_t>(g.src_w - 1), static_cast<uint32_t>(g.src_h - 1),
+					stepX, stepY, static_cast<uint32_t>(g.w - 1), static_cast<uint32_t>(g.h - 1), x0, y0,
+					buf_.grad.bus + y0 * pitch + 4 * x0, pitch,
+					isa::VdwStride{.stride = static_cast<uint16_t>(pitch / 4 - 64)}.word()};
+				const kernels::EdgeUniforms u2{
+					buf_.grad.bus, pitch, pitch / 4, static_cast<uint32_t>(g.w - 2), static_cast<uint32_t>(g.h - 2),
+					x0, y0, edgeThr, cornerC, buf_.edge.bus + y0 * pw + x0,
+					isa::VdwStride{.stride = static_cast<uint16_t>(pw - 64)}.word(), 4 * pw,
+					buf_.mask.bus + 128 * t};
+				append(p1, &u1, kernels::kGradientUniforms, t + kPrograms < tiles);
+				append(p2, &u2, kernels::kEdgeUniforms, t + kPrograms < tiles);
+			}
+			std::memcpy(buf_.unif[0][p].cpu.data(), p1.data(), 4 * p1.size());
+			std::memcpy(buf_.unif[1][p].cpu.data(), p2.data(), 4 * p2.size());
+		}
+		for (int pass = 0; pass < 2; ++pass) {
+			std::vector<JobType> jobs;
+			for (unsigned p = 0; p < programs; ++p)
+				jobs.push_back({buf_.unif[pass][p].bus, buf_.code[pass].bus});
+			counts_.pass[pass].tiles = tiles;
+			backend_.run(jobs, counts_.pass[pass]);
+		}
+		counted_ = true;
+
+		for (int y = 0; y < g.h; ++y)
+			std::memcpy(out.pixels.data() + static_cast<size_t>(y) * g.w,
+			            buf_.edge.cpu.data() + static_cast<size_t>(y) * pw, static_cast<size_t>(g.w));
+		std::fill(out.tiles.begin(), out.tiles.end(), 0);
+		for (unsigned t = 0; t < tiles; ++t) {
+			uint32_t words[32];
+			std::memcpy(words, buf_.mask.cpu.data() + 128 * t, sizeof(words));
+			const int tx = static_cast<int>(t % g.tilesX()), ty = static_cast<int>(t / g.tilesX());
+			for (int half = 0; half < 2; ++half)
+				for (int b = 0; b < 4; ++b) {
+					const int bx = 4 * tx + b, by = 2 * ty + half;
+					if (bx >= out.tiles_x || by >= out.tiles_y)
+						continue;
+					const uint32_t *w4 = words + 16 * half + 4 * b;
+					if (w4[0] | w4[1] | w4[2] | w4[3])
+						out.tiles[static_cast<size_t>(by) * out.tiles_x + bx] = 1;
+				}
+		}
+	}
+
+	bool counts(FrameCounts &out) const
+	{
+		if (!counted_)
+			return false;
+		out = counts_;
+		return true;
+	}
+
+private:
+	using JobType = std::conditional_t<std::is_same_v<Device, emu::Device>, emu::Job,
+#if FRAPPE_VC4_HAVE_RUNTIME
+	                                   runtime::Job
+#else
+	                                   emu::Job
+#endif
+	                                   >;
+
+	static void append(std::vector<uint32_t> &v, const void *block, unsigned words, bool more)
+	{
+		const auto *w = static_cast<const uint32_t *>(block);
+		v.insert(v.end(), w, w + words);
+		v.push_back(more ? 1u : 0u);
+	}
+
+	// Device buffers for this geometry; kept while the geometry does not change.
+	void prepare(const Geometry &g)
+	{
+		if (device_ && g == geometry_)
+			return;
+		const uint32_t u1 = 4 * g.uniformWords(kernels::kGradientUniforms);
+		const uint32_t u2 = 4 * g.uniformWords(kernels::kEdgeUniforms);
+		const uint32_t total = g.srcBytes() + g.gradBytes() + g.edgeBytes() + g.maskBytes() +
+		                       kPrograms * (u1 + u2 + 2 * 4096) + 6 * 4096 + 2 * kCodeSlack;
+		device_ = &backend_.open(total, buf_);
+		buf_.src = device_->alloc(g.srcBytes());
+		buf_.grad = device_->alloc(g.gradBytes());
+		buf_.edge = device_->alloc(g.edgeBytes());
+		buf_.mask = device_->alloc(g.maskBytes());
+		for (int pass = 0; pass < 2; ++pass) {
+			if (!buf_.code[pass].bus || std::is_same_v<Device, emu::Device>)
+				buf_.code[pass] = device_->upload(programs_[pass].code);
+			for (unsigned p = 0; p < kPrograms; ++p)
+				buf_.unif[pass][p] = device_->alloc(pass ? u2 : u1, 64);
+		}
+		geometry_ = g;
+	}
+
+	Backend backend_;
+	qasm::Program programs_[2];
+	Device *device_ = nullptr;
+	Buffers<Device> buf_;
+	Geometry geometry_;
+	FrameCounts counts_;
+	bool counted_ = false;
+	std::unique_ptr<FrontEnd> cpu_;
+};
+
+} // namespace
+
+std::unique_ptr<frappe::FrontEnd> makeFrontEnd(const FrontEndOptions &options)
+{
+	if (options.emulate) {
+		EmuBackend b;
+		b.options = options;
+		return std::make_unique<Vc4FrontEnd<EmuBackend>>(std::move(b));
+	}
+#if FRAPPE_VC4_HAVE_RUNTIME
+	const runtime::ProbeReport report = runtime::GpuDevice::probe();
+	if (!report.usable)
+		throw std::runtime_error(report.reason);
+	return std::make_unique<Vc4FrontEnd<GpuBackend>>(GpuBackend{});
+#else
+	throw std::runtime_error("the VideoCore IV runtime is only built for Linux.");
+#endif
+}
+
+std::string probeGpu()
+{
+#if FRAPPE_VC4_HAVE_RUNTIME
+	try {
+		const runtime::ProbeReport report = runtime::GpuDevice::probe();
+		return report.usable ? std::string() : report.reason;
+	} catch (const std::exception &e) {
+		return e.what();
+	}
+#else
+	return "the VideoCore IV runtime is only built for Linux.";
+#endif
+}
+
+bool lastFrameCounts(const frappe::FrontEnd &front_end, FrameCounts &out)
+{
+	if (const auto *fe = dynamic_cast<const Vc4FrontEnd<EmuBackend> *>(&front_end))
+		return fe->counts(out);
+	return false;
+}
+
+} // namespace frappe::vc4

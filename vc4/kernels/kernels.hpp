@@ -1,0 +1,98 @@
+// SPDX-License-Identifier: MIT
+// The QPU kernels of Frappe's front end (issue 6), reproducing frappe-core's CPU front end
+// (frappe-core/src/front_end_cpu.cpp) byte for byte.
+//
+// Two passes over 64x32-pixel tiles of the scaled frame. A program invocation takes a list
+// of tiles: its uniform stream is one block per tile (the structs below, in order), each
+// followed by a `more` word, non-zero when another block follows. One launch of 12 programs
+// covers a frame (tile t goes to program t % 12).
+//
+//  pass 1, gradientPass(): nearest-neighbour scaled fetch (per-lane TMU gathers whose
+//    addresses implement scaleNearest's fixed-point mapping and the edge replication),
+//    binomial smoothing, separable Sobel, squared magnitude, the four-way direction, and
+//    the structure tensor's products summed over the three rows y-1 .. y+1.
+//  pass 2, edgePass(): non-maximum suppression and the edge threshold, the Shi-Tomasi
+//    minimum-eigenvalue test and corner threshold, and the 16x16 empty-tile mask.
+//
+// Gradient buffer (pass 1 -> pass 2): four 32-bit planes per pixel of the scaled frame,
+// rows interleaved so that one 4-row VDW stores one image row of a 16-pixel strip:
+//   byte offset of plane k at (x, y) = y * gradPitch + k * gradPitch / 4 + 4 x
+//   gradPitch = 16 * paddedWidth (paddedWidth = width rounded up to 64), rows up to the
+//   height rounded up to 32.
+//   plane 0: B = m << 2 | dir      m = gx^2 + gy^2 < 2^21
+//   plane 1..3: Vxx, Vyy, Vxy = sum over rows y-1 .. y+1 of gx^2, gy^2, gx*gy (signed)
+//   dir: 0 horizontal (compare left/right), 1 vertical (up/down),
+//        2 diagonal with gx*gy > 0 (up-left/down-right), 3 the other diagonal.
+// gx = gy = 0 on the outermost rows and columns, as in the CPU's gradient rows. B keeps the
+// direction beside m: B > thr << 2 | 3 decides m > thr without unpacking. Products go
+// through mul24 on |gx|, |gy| (24-bit unsigned operands) with the sign put back, so every
+// value is exact.
+//
+// Edge output: one byte per pixel (EdgeMap::kEdge | kCorner), rows of paddedWidth bytes.
+// Pass 2 lanes hold pixels 4i + j (j = 0..3 in four sub-passes), so four bytes pack into the
+// lane's word and a 16-word VPM row is a 64-pixel image row.
+// Mask output: per tile two rows of 16 words (rows 0-15 and 16-31 of the tile); word i is
+// the OR of the edge words of lane i over those 16 rows, so 16x16 block t of the tile is
+// non-empty when words 4t .. 4t+3 are not all zero (maskBlocks() reduces them).
+//
+// VPM: each QPU uses the 8 rows starting at 8 * qpu_num (96 of the 192 rows), so twelve
+// invocations run at once with no locking of VPM space; VDW setup and start are done under
+// the hardware mutex, as GPU_FFT does, because the guide does not say that the VCD's setup
+// registers are per QPU. Limits: width <= 2048 (the VDW stride field holds 13 bits).
+#pragma once
+
+#include <cstdint>
+
+#include "asm/program.hpp"
+
+namespace frappe::vc4::kernels {
+
+inline constexpr int kTileW = 64;
+inline constexpr int kTileH = 32;
+inline constexpr int kMaxWidth = 2048;
+
+/// Pass 1 uniforms of one tile, in stream order (then `more`).
+struct GradientUniforms {
+	uint32_t src;        ///< bus address of the full-resolution 8-bit image (4-aligned)
+	uint32_t src_stride; ///< bytes, a multiple of 4
+	uint32_t src_wmax;   ///< full width - 1
+	uint32_t src_hmax;   ///< full height - 1
+	uint32_t step_x;     ///< round(65536 * full width / scaled width), as scaleNearest
+	uint32_t step_y;
+	uint32_t wmax;       ///< scaled width - 1
+	uint32_t hmax;       ///< scaled height - 1
+	uint32_t x0;         ///< tile origin in the scaled frame
+	uint32_t y0;
+	uint32_t dst;        ///< bus address of plane 0 at (x0, y0) in the gradient buffer
+	uint32_t dst_pitch;  ///< gradPitch
+	uint32_t vdw_stride; ///< VdwStride word: gradPitch / 4 - 64
+};
+inline constexpr unsigned kGradientUniforms = sizeof(GradientUniforms) / 4;
+
+/// Pass 2 uniforms of one tile, in stream order (then `more`).
+struct EdgeUniforms {
+	uint32_t grad;       ///< bus address of the gradient buffer (plane 0 at (0, 0))
+	uint32_t grad_pitch; ///< gradPitch
+	uint32_t plane;      ///< gradPitch / 4
+	uint32_t wm2;        ///< scaled width - 2
+	uint32_t hm2;        ///< scaled height - 2
+	uint32_t x0;
+	uint32_t y0;
+	uint32_t edge_thr;   ///< clamp(edge_threshold_sq, -1, 2^22) << 2 | 3
+	uint32_t corner_c;   ///< 2 * corner_threshold (int32 arithmetic, as the CPU)
+	uint32_t edge_dst;   ///< bus address of byte (x0, y0) of the edge buffer
+	uint32_t vdw_stride; ///< VdwStride word: edge pitch - 64
+	uint32_t edge_pitch4;///< 4 * edge pitch: one block of four rows
+	uint32_t mask_dst;   ///< bus address of this tile's 2 x 16 mask words
+};
+inline constexpr unsigned kEdgeUniforms = sizeof(EdgeUniforms) / 4;
+
+struct Built {
+	qasm::Program program;
+	unsigned nops = 0; ///< slots the builder filled with nops (hazards it could not fill)
+};
+
+Built gradientPass();
+Built edgePass();
+
+} // namespace frappe::vc4::kernels

@@ -1,0 +1,273 @@
+// SPDX-License-Identifier: MIT
+// Pass 1: scaled fetch, smoothing, Sobel, magnitude, direction and the vertical sums of the
+// structure tensor's products over one 64x32 tile (layout: kernels.hpp).
+//
+// Lanes hold 16 horizontally adjacent pixels; the tile is four 16-pixel strips, each
+// swept top to bottom with a sliding window. For input row R of a strip every lane
+// gathers the five source pixels at scaled columns x-2 .. x+2 through the TMUs (one
+// request per column, 16 per-lane addresses: this is where nearest scaling and edge
+// replication happen, so both are free), and the window turns them into:
+//   t_k(R-1) = I_k(R-2) + 2 I_k(R-1) + I_k(R)            vertical binomial, k = -2..2
+//   p_j(R-1) = (t_{j-1} + 2 t_j + t_{j+1} + 8) >> 4        smoothed, j = -1..1
+//   hs = p_-1 + 2 p_0 + p_1,  hd = p_1 - p_-1              horizontal Sobel parts
+//   gx(R-2) = hd(R-3) + 2 hd(R-2) + hd(R-1),  gy(R-2) = hs(R-1) - hs(R-3)
+// the same integers as frappe-core's smoothRow / gradientRow (linear, so the order of
+// the sums does not matter). The running sums keep two generations only (q = I + I',
+// G = hd + hd', F = hs - hs'), so the window needs no register rotation. The tensor's
+// vertical sums lag one more row: V(g-1) = S' + P(g), S = P' + P, P' = P.
+// The next row's gathers are issued as soon as this row's are popped: a whole row of
+// work hides the TMU latency, with at most 3 requests per TMU outstanding (the addendum's
+// limit is 4). Each output row (4 planes) leaves by one VDW, double-buffered in the QPU's
+// 8 VPM rows.
+#include "isa/setup_words.hpp"
+#include "kernels/builder.hpp"
+#include "kernels/kernels.hpp"
+
+namespace frappe::vc4::kernels {
+
+namespace {
+
+// Registers. Port rule: one read of file A and one of file B per instruction (a small
+// immediate takes B's), and ADD and MUL results of one instruction go to different files.
+constexpr Reg SRC = A(0), SWMAX = A(1), STEPX = A(2), WMAX = A(3), RN = A(4), ROWADDR = A(5),
+	      DSTS = A(6), VPMW = A(7), C106 = A(8), HS = A(22), FP = A(23), G = A(24),
+	      COLTERM = A(25), PXX = A(26), SYY = A(27), PXY = A(28), CNT = A(29),
+	      STRIPCNT = A(30), VDWTOG = A(31);
+constexpr Reg SSTRIDE = B(0), SHMAX = B(1), STEPY = B(2), HMAX = B(3), DPITCH = B(4),
+	      HM2 = B(5), Y0M4 = B(6), DSTBASE = B(7), HD = B(20), GP = B(21), SXX = B(22),
+	      PYY = B(23), SXY = B(24), BPREV = B(25), VDWSTRIDE = B(26), VDWS = B(27),
+	      TMPB = B(29), XS = B(30);
+constexpr Reg COLOFF[5] = {B(8), B(9), B(10), B(11), B(12)};
+constexpr Reg COLSH[5] = {A(9), A(10), A(11), A(12), A(13)};
+constexpr Reg T[5] = {A(14), B(13), A(15), B(14), A(16)};
+constexpr Reg Q[5] = {B(15), A(17), B(16), A(18), B(17)};
+constexpr Reg I[5] = {A(19), B(18), A(20), B(19), A(21)};
+
+Dst tmuS(int k) { return (k & 1) ? reg::tmu1_s : reg::tmu0_s; }
+
+// ROWADDR = src + stride * min(H-1, ((2 clamp(RN, 0, h-1) + 1) * step_y) >> 17); RN += 1.
+void rowAddress(Builder &b)
+{
+	b.op(max(r0, RN, imm(0)));
+	b.op(min(r0, r0, HMAX));
+	b.op(shl(r0, r0, imm(1)));
+	b.op(add(r0, r0, imm(1)));
+	b.op(mul24(r1, r0, STEPY));
+	b.op(shr(r1, r1, imm(-15))); // 17: shift counts use the low 5 bits
+	b.op(min(r1, r1, SHMAX));
+	b.op(mul24(r1, r1, SSTRIDE));
+	b.op(add(RN, RN, imm(1)));
+	b.op(add(ROWADDR, r1, SRC));
+}
+
+// One input row: pop the five gathers of row R, issue row R+1's, and compute the
+// vertical sums t_k into T[k]; then smoothing and the horizontal Sobel parts, leaving
+// gx in r2 and gy in r3 (garbage until the window is full).
+void rowBody(Builder &b)
+{
+	rowAddress(b);
+	for (int k = 0; k < 5; ++k) {
+		if (k == 0)
+			b.ldtmu(0);
+		b.op(shr(r2, r4, COLSH[k]));
+		b.op(add(tmuS(k), ROWADDR, COLOFF[k]), v8min(r2, r2, r5)); // r5 = 0xff: byte mask
+		b.op(add(r3, I[k], r2), mmov(I[k], r2));                  // q = I(R-1) + I(R)
+		if (k < 4)
+			b.ldtmu((k + 1) & 1, add(T[k], Q[k], r3), mmov(Q[k], r3)); // t = q' + q
+		else
+			b.op(add(T[k], Q[k], r3), mmov(Q[k], r3));
+	}
+	// Horizontal binomial with rounding: e_k = t_k + t_k+1, p_j = (e_j-1 + e_j + 8) >> 4.
+	b.op(add(r0, T[0], T[1]));
+	b.op(add(r1, T[1], T[2]));
+	b.op(add(r2, T[2], T[3]));
+	b.op(add(r3, T[3], T[4]));
+	b.op(add(r1, r1, imm(8)));
+	b.op(add(r3, r3, imm(8)));
+	b.op(add(r0, r0, r1));
+	b.op(add(r1, r1, r2));
+	b.op(add(r2, r2, r3));
+	b.op(shr(r0, r0, imm(4)));
+	b.op(shr(r1, r1, imm(4)));
+	b.op(shr(r2, r2, imm(4)));
+	// hs = p-1 + 2 p0 + p1 (r3), hd = p1 - p-1 (r2).
+	b.op(add(r3, r0, r2), mul24(r1, r1, imm(2)));
+	b.op(sub(r2, r2, r0));
+	b.op(add(r3, r3, r1));
+	// Two-generation window: F = hs - hs', G = hd + hd'; gy = F' + F, gx = G' + G.
+	b.op(sub(r0, r3, HS), mmov(HS, r3));
+	b.op(add(r1, r2, HD), mmov(HD, r2));
+	b.op(add(r3, r0, FP), mmov(FP, r0));
+	b.op(add(r2, r1, GP), mmov(GP, r1));
+}
+
+// gx in r2, gy in r3 of gradient row G: zero them off the interior; B(G) and the tensor
+// products P(G); write row G-1 (B, Vxx, Vyy, Vxy) to the VPM; G += 1.
+void rowOutput(Builder &b)
+{
+	// Interior: G - 1 >= 0, h - 2 - G >= 0, and the column's term (same sign test).
+	b.op(sub(r0, G, imm(1)));
+	b.op(sub(r1, HM2, G));
+	b.op(bor(r0, r0, r1));
+	b.op(bor(r0, r0, COLTERM));
+	b.op(asr(r0, r0, imm(-1)));                     // -1 off the interior
+	b.op(bnot(r0, r0));
+	b.op(band(r2, r2, r0));
+	b.op(band(r3, r3, r0));
+	b.op(add(G, G, imm(1)));
+	b.op(sub(r0, imm(0), r2));
+	b.op(max(r0, r2, r0));                          // |gx|
+	b.op(sub(r1, imm(0), r3));
+	b.op(max(r1, r3, r1), mul24(T[0], r0, r0));     // |gy|, gx^2
+	b.op(bxor(r2, r2, r3), mul24(T[1], r1, r1));    // gy^2
+	b.op(asr(r2, r2, imm(-1)), mul24(r3, r0, r1));  // sign of gx*gy (-1 / 0); |gx gy|
+	b.op(bxor(r3, r3, r2));
+	b.op(sub(T[2], r3, r2));                        // gx*gy
+	b.op(shr(r2, r2, imm(-1)), mul24(r3, r0, C106)); // 1 when gx*gy < 0; 106|gx|
+	b.op(add(r2, r2, imm(2)), mul24(TMPB, r1, C106)); // diagonal code 2 or 3; 106|gy|
+	b.op(shl(r0, r0, imm(8)));
+	b.op(shl(r1, r1, imm(8)));
+	b.op(sub(reg::nop, TMPB, r0).setFlags());       // 256|gx| <= 106|gy|: vertical
+	b.op(mov(r2, imm(1)).ifnn());
+	b.op(sub(reg::nop, r3, r1).setFlags());         // 256|gy| <= 106|gx|: horizontal wins
+	b.op(mov(r2, imm(0)).ifnn());
+	b.op(add(r0, T[0], T[1]));
+	b.op(shl(r0, r0, imm(2)));
+	b.op(bor(r2, r0, r2));                          // B(G) = m << 2 | dir
+	b.op(mov(r0, T[0]), mmov(r1, T[1]));
+	b.op(mov(r3, T[2]));
+	// Row G-1 to the VPM: B(G-1), then V = S' + P, S = P' + P, P' = P per product.
+	b.op(mov(reg::vw_setup, VPMW));
+	b.op(mov(reg::vpm_write, BPREV), mmov(BPREV, r2));
+	b.op(add(reg::vpm_write, SXX, r0));
+	b.op(add(SXX, PXX, r0), mmov(PXX, r0));
+	b.op(add(reg::vpm_write, SYY, r1));
+	b.op(add(SYY, PYY, r1), mmov(PYY, r1));
+	b.op(add(reg::vpm_write, SXY, r3));
+	b.op(add(SXY, PXY, r3), mmov(PXY, r3));
+}
+
+// Store the finished row: wait for the previous row's VDW (it had a whole row of compute
+// to finish), then start this one and flip to the other VPM half.
+void storeRow(Builder &b)
+{
+	b.op(mov(reg::nop, reg::vw_wait));
+	b.op(mov(reg::nop, reg::mutex_acq));
+	b.op(mov(reg::vw_setup, VDWSTRIDE));
+	b.op(mov(reg::vw_setup, VDWS));
+	b.op(mov(reg::vw_addr, DSTS));
+	b.op(mov(reg::mutex_rel, imm(1)));
+	b.op(add(DSTS, DSTS, DPITCH));
+	b.op(bxor(VDWS, VDWS, VDWTOG));
+	b.op(bxor(VPMW, VPMW, imm(4)));
+}
+
+Built build()
+{
+	Builder b("frappe_gradient_pass");
+	b.ldi(reg::r5rep, 0xff); // the byte mask of the gathers, in r5 for a free read port
+	b.ldi(C106, 106);
+	b.ldi(VDWTOG, 4u << 7); // VDW VPM base Y sits at bit 7: flip between the two halves
+	// VPM rows 8q .. 8q+7 of QPU q: generic write setup (stride 1) and VDW of 4 rows.
+	b.op(mov(r0, reg::qpu_num));
+	b.op(shl(r1, r0, imm(3)));
+	b.ldi(r2, isa::VpmWriteSetup{.stride = 1, .horizontal = true, .laned = false,
+	                             .size = isa::VpmSize::Bits32, .addr = 0}.word());
+	b.op(add(VPMW, r2, r1));
+	b.ldi(r2, isa::VdwSetup{.units = 4, .depth = 16, .horizontal = true, .vpm_base = 0, .modew = 0}.word());
+	b.op(shl(r1, r0, imm(10))); // Y = 8q at bit 7
+	b.op(add(VDWS, r2, r1));
+
+	Label tile = b.label();
+	b.op(mov(SRC, b.uniform("src", UniformKind::Address)));
+	b.op(mov(SSTRIDE, b.uniform("src_stride")));
+	b.op(mov(SWMAX, b.uniform("src_wmax")));
+	b.op(mov(SHMAX, b.uniform("src_hmax")));
+	b.op(mov(STEPX, b.uniform("step_x")));
+	b.op(mov(STEPY, b.uniform("step_y")));
+	b.op(mov(WMAX, b.uniform("wmax")));
+	b.op(mov(r0, b.uniform("hmax")));
+	b.op(mov(HMAX, r0));
+	b.op(sub(HM2, r0, imm(1)));
+	b.op(mov(XS, b.uniform("x0")));
+	b.op(mov(r0, b.uniform("y0")));
+	b.op(sub(Y0M4, r0, imm(4)));
+	b.op(mov(DSTBASE, b.uniform("dst", UniformKind::Address)));
+	b.op(mov(DPITCH, b.uniform("dst_pitch")));
+	b.op(mov(VDWSTRIDE, b.uniform("vdw_stride")));
+	b.ldi(STRIPCNT, 4);
+
+	Label strip = b.label();
+	{
+		// Per-lane source columns of x-2 .. x+2 (clamped to the scaled frame, then
+		// mapped like scaleNearest) and the interior-column term (x-1) | (w-2-x).
+		b.op(add(r0, XS, reg::elem_num));
+		for (int k = 0; k < 5; ++k) {
+			b.op(add(r1, r0, imm(k - 2)));
+			b.op(max(r1, r1, imm(0)));
+			b.op(min(r1, r1, WMAX));
+			b.op(shl(r1, r1, imm(1)));
+			b.op(add(r1, r1, imm(1)));
+			b.op(mul24(r1, r1, STEPX));
+			b.op(shr(r1, r1, imm(-15)));
+			b.op(min(r1, r1, SWMAX));
+			b.op(band(COLOFF[k], r1, imm(-4)));
+			b.op(band(r2, r1, imm(3)));
+			b.op(shl(COLSH[k], r2, imm(3)));
+		}
+		b.op(sub(r1, r0, imm(1)));
+		b.op(sub(r2, WMAX, r0));
+		b.op(sub(r2, r2, imm(1)));
+		b.op(bor(COLTERM, r1, r2));
+		b.op(mov(RN, Y0M4));
+		b.op(mov(DSTS, DSTBASE));
+		b.op(sub(G, RN, imm(2)));
+		// Prefetch row y0-4.
+		rowAddress(b);
+		for (int k = 0; k < 5; ++k)
+			b.op(add(tmuS(k), ROWADDR, COLOFF[k]));
+		// Prologue: rows y0-4 .. y0+2 fill the window (gradient rows y0-1 and y0 are the
+		// first needed: by row y0's tensor sum).
+		b.ldi(CNT, 7);
+		Label pro = b.label();
+		rowBody(b);
+		rowOutput(b);
+		b.loopEnd(pro, CNT);
+		// Main loop: one output row and one VDW per trip.
+		b.ldi(CNT, kTileH);
+		Label main = b.label();
+		rowBody(b);
+		rowOutput(b);
+		storeRow(b);
+		b.loopEnd(main, CNT);
+		// The last trip gathered one row beyond the window: drain it.
+		b.ldtmu(0);
+		b.ldtmu(1);
+		b.ldtmu(0);
+		b.ldtmu(1);
+		b.ldtmu(0);
+		// Next strip: 16 columns to the right.
+		b.ldi(r0, 64);
+		b.op(add(DSTBASE, DSTBASE, r0));
+		b.ldi(r1, 16);
+		b.op(add(XS, XS, r1));
+	}
+	b.loopEnd(strip, STRIPCNT);
+	// Another tile follows when `more` is non-zero.
+	b.op(mov(r0, b.uniform("more")).setFlags());
+	b.assembler().branch(tile, isa::BranchCond::AnyZClear);
+	b.nop();
+	b.nop();
+	b.nop();
+	b.op(mov(reg::nop, reg::vw_wait));
+	Built out;
+	out.nops = b.nops();
+	out.program = b.finish();
+	return out;
+}
+
+} // namespace
+
+Built gradientPass() { return build(); }
+
+} // namespace frappe::vc4::kernels
