@@ -2,14 +2,8 @@
  *
  * gstfrappedetect.cpp: the frappedetect element.
  *
- * \todo Backends vc4 and vc4-emu (arrive with the vc4 issues).
  * \todo GstAnalyticsRelationMeta output behind a >= 1.24 meson feature.
  * \todo An overlay-composition path for GL/compositor consumers.
- * \todo Overlap in pipelined AScale mode: frappe-core's Detector reads the
- *       adaptive scale in runFrontEnd() and writes it in runBackEnd() without
- *       a lock, so in AScale mode the element waits for the held back end
- *       before the next front end (correct, but no overlap) until the core
- *       makes that hand-over thread-safe.
  */
 
 /**
@@ -784,12 +778,10 @@ static GstFlowReturn process(GstFrappeDetect *self, GstBuffer *input)
 			f.result = &detector.runBackEnd(f.image, 0);
 		} else {
 			f.slot = priv->held ? 1 - priv->held->slot : 0;
-			/* frappe-core's adaptive scale state is shared by the two
-			 * slots without a lock: in AScale mode the back end of the
-			 * held frame must complete before the next front end starts. */
-			if (priv->active.mode == GST_FRAPPE_MODE_ASCALE)
-				priv->worker.wait();
-			detector.runFrontEnd(f.image, f.slot); /* overlaps the held back end */
+			/* Overlaps the held back end. In AScale mode the scale comes
+			 * from the last frame finished before this front end starts
+			 * (frappe-core locks that hand-over), as on live video. */
+			detector.runFrontEnd(f.image, f.slot);
 		}
 	} catch (const std::exception &e) {
 		gst_video_frame_unmap(&f.frame);
