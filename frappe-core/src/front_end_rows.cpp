@@ -64,7 +64,7 @@ void gradientRow(const std::uint8_t *a, const std::uint8_t *b, const std::uint8_
 
 void zeroGradientRow(int w, std::int16_t *gx, std::int16_t *gy, std::int32_t *mag, TensorRow tensor)
 {
-	std::memset(gx, 0, sizeof(*gx) * w);
+	std::memset(gx, 0, sizeof(*gx) * 2 * w);
 	std::memset(gy, 0, sizeof(*gy) * w);
 	std::memset(mag, 0, sizeof(*mag) * w);
 	std::memset(tensor.xx, 0, sizeof(*tensor.xx) * w);
@@ -170,7 +170,11 @@ const RowKernels &scalarRowKernels()
 #ifndef FRAPPE_HAVE_HWY
 const RowKernels &bestRowKernels()
 {
+#ifdef FRAPPE_HAVE_ARMV6_KERNELS
+	return armv6RowKernels();
+#else
 	return scalarRowKernels();
+#endif
 }
 #endif
 

@@ -32,6 +32,7 @@ struct RowScratch {
 	std::vector<std::uint8_t> smooth[4];
 	std::vector<std::uint16_t> columns;    ///< smoothRow's vertical pass
 	std::vector<std::int16_t> separable;   ///< gradientRow's two column passes
+	/// gx holds 2w values: the ARMv6 kernels store (gx, gy) pairs in it.
 	std::vector<std::int16_t> gx[3], gy[3];
 	std::vector<std::int32_t> mag[3];
 	std::vector<std::int32_t> txx[3], tyy[3], txy[3];
@@ -45,7 +46,7 @@ struct RowScratch {
 		separable.resize(2 * static_cast<std::size_t>(w));
 		products.resize(3 * static_cast<std::size_t>(w));
 		for (int i = 0; i < 3; ++i) {
-			gx[i].resize(w);
+			gx[i].resize(2 * static_cast<std::size_t>(w));
 			gy[i].resize(w);
 			mag[i].resize(w);
 			txx[i].resize(w);
@@ -71,7 +72,7 @@ void gradientRow(const std::uint8_t *a, const std::uint8_t *b, const std::uint8_
 		 std::int16_t *gx, std::int16_t *gy, std::int32_t *mag, std::int16_t *tmp,
 		 TensorRow tensor);
 
-/// The gradient row of the outermost image rows: all zero.
+/// The gradient row of the outermost image rows: all zero (2w values of gx).
 void zeroGradientRow(int w, std::int16_t *gx, std::int16_t *gy, std::int32_t *mag, TensorRow tensor);
 
 /// Non-maximum suppression, edge threshold and corner test of the middle
@@ -99,8 +100,15 @@ struct RowKernels {
 /// The scalar kernels: the reference, and the ARMv6 path.
 const RowKernels &scalarRowKernels();
 /// The fastest kernels for this CPU (Highway's runtime dispatch), or the
-/// scalar ones when the build has no Highway.
+/// ARMv6 SIMD32 ones, or the scalar ones.
 const RowKernels &bestRowKernels();
+
+#if defined(__ARM_FEATURE_SIMD32) && defined(__ARM_FEATURE_DSP)
+#define FRAPPE_HAVE_ARMV6_KERNELS 1
+/// ARMv6 SIMD32 kernels (front_end_armv6.cpp): the scalar kernels' bytes,
+/// but the gradient row stores (gx, gy) int16 pairs in `gx` and leaves `gy`.
+const RowKernels &armv6RowKernels();
+#endif
 
 /// A CPU front end with the given kernels (tests compare them).
 std::unique_ptr<FrontEnd> makeCpuFrontEnd(int threads, const RowKernels &kernels);

@@ -1,0 +1,316 @@
+// SPDX-License-Identifier: MIT
+// The CPU front end's row kernels for ARMv6 with the SIMD32 ("media")
+// instructions and no NEON: the Raspberry Pi Zero's ARM1176. They compute
+// exactly what the scalar kernels in front_end_rows.cpp compute (the
+// arithmetic is defined at the top of front_end_cpu.cpp); the EdgeMap is the
+// same byte for byte (tests/armv6 checks it under qemu-arm -cpu arm1176).
+//
+// Two 16-bit lanes per 32-bit register: four pixels of a row are split into
+// the even pixels (bytes 0 and 2 of the little-endian word, UXTB16) and the
+// odd ones (bytes 1 and 3, UXTB16 with ROR #8). A pixel's left and right
+// neighbours are then the other parity's lanes, and the neighbour across a
+// word boundary is one shift and one ORR away.
+//
+// One difference in the rows between the kernels (they are a set, never
+// mixed with others): the gradient row stores (gx, gy) as one int16 pair per
+// pixel in the `gx` buffer (2w int16 values, see RowScratch), so that
+// gx^2 + gy^2 is one SMUAD and the corner test's sums are SMLAD / SMLSD /
+// SMLATB on the same words; the `gy` buffer is not used.
+#include "front_end_rows.h"
+
+#if defined(__ARM_FEATURE_SIMD32) && defined(__ARM_FEATURE_DSP)
+
+#include <arm_acle.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <cstring>
+
+namespace frappe::detail {
+
+namespace {
+
+using u32 = std::uint32_t;
+
+inline u32 load32(const void *p)
+{
+	u32 v;
+	std::memcpy(&v, p, 4); /* LDR: ARMv6 allows unaligned word loads */
+	return v;
+}
+
+inline void store32(void *p, u32 v)
+{
+	std::memcpy(p, &v, 4);
+}
+
+/* Bytes 0 and 2 into two 16-bit lanes; bytes 1 and 3. */
+inline u32 evenBytes(u32 v)
+{
+	return __uxtb16(v);
+}
+
+inline u32 oddBytes(u32 v)
+{
+	u32 r;
+	__asm__("uxtb16 %0, %1, ror #8" : "=r"(r) : "r"(v));
+	return r;
+}
+
+/* UXTAB16 with ROR #8: the odd bytes of v added to the lanes of acc. */
+inline u32 uxtab16ror8(u32 acc, u32 v)
+{
+	u32 r;
+	__asm__("uxtab16 %0, %1, %2, ror #8" : "=r"(r) : "r"(acc), "r"(v));
+	return r;
+}
+
+/* (lo.lo, hi.lo): low lane of `lo`, low lane of `hi` in the high lane. */
+inline u32 pkhbt16(u32 lo, u32 hi)
+{
+	u32 r;
+	__asm__("pkhbt %0, %1, %2, lsl #16" : "=r"(r) : "r"(lo), "r"(hi));
+	return r;
+}
+
+/* (lo.hi, hi.hi): high lane of `lo` in the low lane, high lane of `hi`. */
+inline u32 pkhtb16(u32 hi, u32 lo)
+{
+	u32 r;
+	__asm__("pkhtb %0, %1, %2, asr #16" : "=r"(r) : "r"(hi), "r"(lo));
+	return r;
+}
+
+inline u32 sadd16(u32 a, u32 b)
+{
+	return static_cast<u32>(__sadd16(static_cast<int16x2_t>(a), static_cast<int16x2_t>(b)));
+}
+
+inline u32 ssub16(u32 a, u32 b)
+{
+	return static_cast<u32>(__ssub16(static_cast<int16x2_t>(a), static_cast<int16x2_t>(b)));
+}
+
+inline std::int32_t smuad(u32 a)
+{
+	return __smuad(static_cast<int16x2_t>(a), static_cast<int16x2_t>(a));
+}
+
+/* The (gx, gy) pair of pixel x of the middle of rows a, b, c, for the first
+ * and last few pixels (x in 1 .. w-2). */
+inline u32 gradientPair(const std::uint8_t *a, const std::uint8_t *b, const std::uint8_t *c, int x,
+			std::int32_t &mag)
+{
+	auto vs = [&](int i) { return a[i] + 2 * b[i] + c[i]; };
+	auto vd = [&](int i) { return c[i] - a[i]; };
+	const std::int32_t sx = vs(x + 1) - vs(x - 1);
+	const std::int32_t sy = vd(x - 1) + 2 * vd(x) + vd(x + 1);
+	mag = sx * sx + sy * sy;
+	return static_cast<std::uint16_t>(sx) | static_cast<u32>(static_cast<std::uint16_t>(sy)) << 16;
+}
+
+void smoothRowV6(const std::uint8_t *a, const std::uint8_t *b, const std::uint8_t *c, int w,
+		 std::uint8_t *out, std::uint16_t *tmp)
+{
+	if (w < 16) {
+		smoothRow(a, b, c, w, out, tmp);
+		return;
+	}
+	auto t = [&](int x) {
+		x = std::clamp(x, 0, w - 1);
+		return a[x] + 2 * b[x] + c[x];
+	};
+	/* Vertical sums of four pixels plus 2 (the rounding: the horizontal
+	 * weights add up to 4): E = (t0, t2) + 2, O = (t1, t3) + 2, each below
+	 * 1024, so plain 32-bit adds cannot carry from one lane into the other.
+	 * UXTAB16 extends two bytes and adds them to two lanes in one go. */
+	const u32 kMask = 0x00FF00FF, kOne = 0x00010001;
+	auto even = [&](u32 wa, u32 wb, u32 wc) {
+		return __uxtab16(__uxtb16(wa), wc) + (__uxtab16(kOne, wb) << 1);
+	};
+	auto odd = [&](u32 wa, u32 wb, u32 wc) {
+		return uxtab16ror8(oddBytes(wa), wc) + (uxtab16ror8(kOne, wb) << 1);
+	};
+	u32 E = even(load32(a), load32(b), load32(c));
+	u32 O = odd(load32(a), load32(b), load32(c));
+	u32 prevHi = static_cast<u32>(t(0)) + 2; /* t[-1] = t[0] */
+	/* Word k needs word k+1's first pixel: whole words up to w-1. */
+	const int words = (w - 4) / 4;
+	for (int k = 0; k < words; ++k) {
+		const int xn = 4 * k + 4;
+		const u32 wa = load32(a + xn), wb = load32(b + xn), wc = load32(c + xn);
+		const u32 En = even(wa, wb, wc), On = odd(wa, wb, wc);
+		/* Even pixels: left (t[-1], t1), right (t1, t3) = O. Odd pixels:
+		 * left E, right (t2, t4). The sums stay below 4096. */
+		const u32 sE = (prevHi | (O << 16)) + O + (E << 1);
+		const u32 sO = ((E >> 16) | (En << 16)) + E + (O << 1);
+		store32(out + 4 * k, ((sE >> 4) & kMask) | (((sO >> 4) & kMask) << 8));
+		prevHi = O >> 16;
+		E = En;
+		O = On;
+	}
+	for (int x = 4 * words; x < w; ++x)
+		out[x] = static_cast<std::uint8_t>((t(x - 1) + 2 * t(x) + t(x + 1) + 8) >> 4);
+}
+
+void gradientRowV6(const std::uint8_t *a, const std::uint8_t *b, const std::uint8_t *c, int w,
+		   std::int16_t *gx, std::int16_t * /* gy: the pairs hold it */, std::int32_t *mag,
+		   std::int16_t *tmp, TensorRow /* the corner test sums on demand */)
+{
+	std::uint8_t *pairs = reinterpret_cast<std::uint8_t *>(gx);
+	auto storePair = [&](int x, u32 p) { store32(pairs + 4 * x, p); };
+	storePair(0, 0);
+	mag[0] = 0;
+	storePair(w - 1, 0);
+	mag[w - 1] = 0;
+	int x = 1;
+	if (w >= 16) {
+		/* Pass 1, per word of four pixels: the column sums vs = a + 2b + c
+		 * and differences vd = c - a, even and odd lanes: VSE VSO VDE VDO. */
+		std::uint8_t *cols = reinterpret_cast<std::uint8_t *>(tmp); /* 2w int16 = w words */
+		const int words = w / 4;
+		for (int k = 0; k < words; ++k) {
+			const u32 wa = load32(a + 4 * k), wb = load32(b + 4 * k), wc = load32(c + 4 * k);
+			const u32 ea = evenBytes(wa), eb = evenBytes(wb), ec = evenBytes(wc);
+			const u32 oa = oddBytes(wa), ob = oddBytes(wb), oc = oddBytes(wc);
+			std::uint8_t *o = cols + 16 * k;
+			store32(o, ea + ec + (eb << 1));
+			store32(o + 4, oa + oc + (ob << 1));
+			store32(o + 8, ssub16(ec, ea));
+			store32(o + 12, ssub16(oc, oa));
+		}
+		/* Pass 2: gx = vs[x+1] - vs[x-1], gy = vd[x-1] + 2 vd[x] + vd[x+1],
+		 * in signed lanes; word k needs word k+1's first column. Pixel 0
+		 * is computed from garbage and overwritten below. */
+		u32 prevS = 0, prevD = 0;
+		u32 se = load32(cols), so = load32(cols + 4), de = load32(cols + 8), dO = load32(cols + 12);
+		for (int k = 0; k + 1 < words; ++k) {
+			const std::uint8_t *n = cols + 16 * (k + 1);
+			const u32 nse = load32(n), nso = load32(n + 4), nde = load32(n + 8), ndo = load32(n + 12);
+			const u32 gxE = ssub16(so, prevS | (so << 16));
+			const u32 gyE = sadd16(sadd16(prevD | (dO << 16), dO), sadd16(de, de));
+			const u32 gxO = ssub16((se >> 16) | (nse << 16), se);
+			const u32 gyO = sadd16(sadd16(de, (de >> 16) | (nde << 16)), sadd16(dO, dO));
+			const u32 p0 = pkhbt16(gxE, gyE), p2 = pkhtb16(gyE, gxE);
+			const u32 p1 = pkhbt16(gxO, gyO), p3 = pkhtb16(gyO, gxO);
+			std::uint8_t *pp = pairs + 16 * k;
+			store32(pp, p0);
+			store32(pp + 4, p1);
+			store32(pp + 8, p2);
+			store32(pp + 12, p3);
+			std::int32_t *m = mag + 4 * k;
+			m[0] = smuad(p0);
+			m[1] = smuad(p1);
+			m[2] = smuad(p2);
+			m[3] = smuad(p3);
+			prevS = so >> 16;
+			prevD = dO >> 16;
+			se = nse;
+			so = nso;
+			de = nde;
+			dO = ndo;
+		}
+		storePair(0, 0);
+		mag[0] = 0;
+		x = std::max(1, 4 * (words - 1));
+	}
+	for (; x < w - 1; ++x)
+		storePair(x, gradientPair(a, b, c, x, mag[x]));
+}
+
+inline u32 pairAt(const std::int16_t *row, int x)
+{
+	return load32(reinterpret_cast<const std::uint8_t *>(row) + 4 * x);
+}
+
+/* isCorner on the pair rows: Sxx + Syy by SMLAD, Sxx - Syy by SMLSD, Sxy
+ * by SMLATB; then the scalar kernel's int32 test. */
+inline bool isCornerV6(const GradRows &rows, int x, std::int32_t twoT)
+{
+	std::int32_t s = 0, d = 0, xy = 0;
+	for (int r = 0; r < 3; ++r) {
+		const std::uint8_t *p = reinterpret_cast<const std::uint8_t *>(rows.gx[r]) + 4 * (x - 1);
+		for (int i = 0; i < 3; ++i) {
+			const auto v = static_cast<int16x2_t>(load32(p + 4 * i));
+			s = __smlad(v, v, s);
+			d = __smlsd(v, v, d);
+			xy = __smlatb(static_cast<std::int32_t>(v), static_cast<std::int32_t>(v), xy);
+		}
+	}
+	const std::int32_t c = (s - twoT) >> 9;
+	if (c <= 0)
+		return false;
+	const std::int32_t a = std::abs(d) >> 9;
+	const std::int32_t b = std::abs(xy) >> 8;
+	return c * c > a * a + b * b;
+}
+
+bool edgeRowV6(const GradRows &rows, int w, const FrontEndParams &params, std::uint8_t *out)
+{
+	out[0] = 0;
+	out[w - 1] = 0;
+	const std::int32_t *up = rows.mag[0];
+	const std::int32_t *mid = rows.mag[1];
+	const std::int32_t *down = rows.mag[2];
+	const std::int16_t *pr = rows.gx[1];
+	/* m >= 0 and m < 2^31: clamping the threshold keeps m > thr. */
+	const std::int32_t thr = static_cast<std::int32_t>(
+		std::clamp<std::int64_t>(params.edge_threshold_sq, -1, INT32_MAX));
+	const std::int32_t twoT = 2 * static_cast<std::int32_t>(params.corner_threshold);
+	u32 any = 0;
+	auto pixel = [&](int x) -> std::uint8_t {
+		const std::int32_t m = mid[x];
+		if (m <= thr)
+			return 0;
+		const u32 p = pairAt(pr, x);
+		const int gx = static_cast<std::int16_t>(p), gy = static_cast<std::int32_t>(p) >> 16;
+		const int ax = std::abs(gx), ay = std::abs(gy);
+		std::int32_t prev, next;
+		if (256 * ay <= 106 * ax) {
+			prev = mid[x - 1];
+			next = mid[x + 1];
+		} else if (256 * ax <= 106 * ay) {
+			prev = up[x];
+			next = down[x];
+		} else if ((gx > 0) == (gy > 0)) {
+			prev = up[x - 1];
+			next = down[x + 1];
+		} else {
+			prev = up[x + 1];
+			next = down[x - 1];
+		}
+		if (!(m > prev && m >= next))
+			return 0;
+		any = 1;
+		return isCornerV6(rows, x, twoT) ? EdgeMap::kEdge | EdgeMap::kCorner : EdgeMap::kEdge;
+	};
+	const int x1 = w - 1;
+	int x = 1;
+	for (; x + 4 <= x1; x += 4) {
+		/* Most pixels are far below the threshold: the OR of four
+		 * non-negative magnitudes bounds their maximum. */
+		const std::int32_t *m = mid + x;
+		if ((m[0] | m[1] | m[2] | m[3]) <= thr) {
+			store32(out + x, 0);
+			continue;
+		}
+		const u32 v = static_cast<u32>(pixel(x)) | static_cast<u32>(pixel(x + 1)) << 8 |
+			      static_cast<u32>(pixel(x + 2)) << 16 | static_cast<u32>(pixel(x + 3)) << 24;
+		store32(out + x, v);
+	}
+	for (; x < x1; ++x)
+		out[x] = pixel(x);
+	return any != 0;
+}
+
+} // namespace
+
+const RowKernels &armv6RowKernels()
+{
+	static constexpr RowKernels kArmv6{ "armv6-simd32", smoothRowV6, gradientRowV6, edgeRowV6 };
+	return kArmv6;
+}
+
+} // namespace frappe::detail
+
+#endif

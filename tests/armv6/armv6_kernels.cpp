@@ -1,0 +1,247 @@
+// SPDX-License-Identifier: MIT
+// The ARMv6 SIMD32 row kernels (frappe-core/src/front_end_armv6.cpp) against
+// the scalar reference, byte for byte. Built for the ARM1176 by the cross
+// compiler and run under `qemu-arm -cpu arm1176` (see meson.build here), so
+// an ARMv7 or NEON instruction would also fail it (SIGILL).
+//
+// usage: armv6-kernels [--quick] [image.pgm ...]
+// Checks smoothRow and gradientRow on random rows (all widths 1..96 and
+// some large ones, unaligned inputs, extreme values), then the whole CPU
+// front end (EdgeMap pixels and tiles) on constructed images with several
+// thresholds, and on each binary PGM (P5) given.
+#include <algorithm>
+#include <cinttypes>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "frappe/edge_map.h"
+#include "front_end_rows.h"
+
+using namespace frappe;
+using namespace frappe::detail;
+
+#ifndef FRAPPE_HAVE_ARMV6_KERNELS
+int main()
+{
+	std::puts("armv6-kernels: not an ARMv6 SIMD32 build; skipped");
+	return 77;
+}
+#else
+
+namespace {
+
+int failures = 0;
+
+#define CHECK(cond, ...)                                                     \
+	do {                                                                 \
+		if (!(cond)) {                                               \
+			std::printf("FAIL %s:%d: ", __FILE__, __LINE__);   \
+			std::printf(__VA_ARGS__);                            \
+			std::printf("\n");                                   \
+			if (++failures > 20)                                 \
+				std::exit(1);                                \
+		}                                                            \
+	} while (0)
+
+std::mt19937 rng(12345);
+
+/* A row of random bytes: uniform, or only the extremes, or a smooth ramp
+ * with noise (the realistic case). */
+void fillRow(std::uint8_t *p, int w, int kind)
+{
+	std::uniform_int_distribution<int> u(0, 255);
+	int v = u(rng);
+	for (int x = 0; x < w; ++x) {
+		switch (kind) {
+		case 0: p[x] = static_cast<std::uint8_t>(u(rng)); break;
+		case 1: p[x] = (u(rng) & 1) ? 255 : 0; break;
+		default:
+			v = std::clamp(v + u(rng) % 9 - 4, 0, 255);
+			p[x] = static_cast<std::uint8_t>(v);
+		}
+	}
+}
+
+void checkRows(const RowKernels &ref, const RowKernels &k, int w, int kind, int misalign)
+{
+	/* Three input rows at an unaligned offset, with guard bytes. */
+	std::vector<std::uint8_t> buf(3 * (w + 16));
+	std::uint8_t *a = buf.data() + misalign;
+	std::uint8_t *b = a + w + 16 - misalign;
+	std::uint8_t *c = b + w + 16;
+	fillRow(a, w, kind);
+	fillRow(b, w, kind);
+	fillRow(c, w, kind);
+	std::vector<std::uint16_t> tmp(w);
+	std::vector<std::uint8_t> o1(w + 4, 0xAB), o2(w + 4, 0xAB);
+	ref.smooth(a, b, c, w, o1.data(), tmp.data());
+	k.smooth(a, b, c, w, o2.data(), tmp.data());
+	for (int x = 0; x < w + 4; ++x)
+		CHECK(o1[x] == o2[x], "smoothRow w=%d kind=%d x=%d: %d vs %d", w, kind, x, o1[x], o2[x]);
+	if (w < 3)
+		return;
+
+	std::vector<std::int16_t> gx(2 * w + 8, 0x5555), gy(2 * w + 8, 0x5555), rgx(w), rgy(w), sep(2 * w);
+	std::vector<std::int32_t> mag(w + 4, 0x55555555), rmag(w);
+	std::vector<std::int32_t> t0(w), t1(w), t2(w), prod(3 * w);
+	const TensorRow tensor{ t0.data(), t1.data(), t2.data(), prod.data() };
+	ref.gradient(a, b, c, w, rgx.data(), rgy.data(), rmag.data(), sep.data(), tensor);
+	k.gradient(a, b, c, w, gx.data(), gy.data(), mag.data(), sep.data(), tensor);
+	for (int x = 0; x < w; ++x) {
+		/* The ARMv6 kernel stores (gx, gy) pairs in the gx buffer. */
+		CHECK(gx[2 * x] == rgx[x] && gx[2 * x + 1] == rgy[x] && mag[x] == rmag[x],
+		      "gradientRow w=%d kind=%d x=%d: (%d,%d,%" PRId32 ") vs (%d,%d,%" PRId32 ")", w, kind, x,
+		      gx[2 * x], gx[2 * x + 1], mag[x], rgx[x], rgy[x], rmag[x]);
+	}
+	for (int i = 2 * w; i < 2 * w + 8; ++i)
+		CHECK(gx[i] == 0x5555, "gradientRow w=%d wrote past the row", w);
+	for (int x = w; x < w + 4; ++x)
+		CHECK(mag[x] == 0x55555555, "gradientRow w=%d wrote past mag", w);
+}
+
+struct Gray {
+	int w = 0, h = 0;
+	std::vector<std::uint8_t> px;
+};
+
+/* Blurred bright and dark rectangles, a checkerboard patch and noise: edges
+ * in every direction, corners, flat areas. */
+Gray constructed(int w, int h, int noise, unsigned seed)
+{
+	std::mt19937 r(seed);
+	Gray g{ w, h, std::vector<std::uint8_t>(static_cast<std::size_t>(w) * h) };
+	std::vector<float> f(g.px.size(), 128.0f);
+	std::uniform_int_distribution<int> ux(0, w - 1), uy(0, h - 1), uv(0, 255);
+	for (int n = 0; n < 12; ++n) {
+		const int x0 = ux(r), y0 = uy(r), x1 = std::min(w, x0 + 8 + ux(r) / 3), y1 = std::min(h, y0 + 8 + uy(r) / 3);
+		const float v = static_cast<float>(uv(r));
+		for (int y = y0; y < y1; ++y)
+			for (int x = x0; x < x1; ++x)
+				f[static_cast<std::size_t>(y) * w + x] = v;
+	}
+	for (int y = h / 3; y < std::min(h, h / 3 + 40); ++y)
+		for (int x = w / 2; x < std::min(w, w / 2 + 40); ++x)
+			f[static_cast<std::size_t>(y) * w + x] = (((x / 7) + (y / 5)) & 1) ? 230.0f : 20.0f;
+	/* A diagonal edge. */
+	for (int y = 0; y < h; ++y)
+		for (int x = 0; x < w / 4; ++x)
+			if (x + y < w / 4)
+				f[static_cast<std::size_t>(y) * w + x] = 250.0f;
+	std::normal_distribution<float> nd(0.0f, static_cast<float>(noise));
+	for (std::size_t i = 0; i < f.size(); ++i)
+		g.px[i] = static_cast<std::uint8_t>(std::clamp(f[i] + (noise ? nd(r) : 0.0f), 0.0f, 255.0f));
+	return g;
+}
+
+bool readPgm(const char *path, Gray &g)
+{
+	FILE *f = std::fopen(path, "rb");
+	if (!f)
+		return false;
+	int maxv = 0;
+	const bool ok = std::fscanf(f, "P5 %d %d %d", &g.w, &g.h, &maxv) == 3 && maxv == 255 && g.w > 0 && g.h > 0 &&
+			std::fgetc(f) != EOF;
+	if (ok) {
+		g.px.resize(static_cast<std::size_t>(g.w) * g.h);
+		if (std::fread(g.px.data(), 1, g.px.size(), f) != g.px.size()) {
+			std::fclose(f);
+			return false;
+		}
+	}
+	std::fclose(f);
+	return ok;
+}
+
+std::size_t compareFrontEnds(const Gray &g, const FrontEndParams &params, float scale, const char *what)
+{
+	auto ref = makeCpuFrontEnd(1, scalarRowKernels());
+	auto v6 = makeCpuFrontEnd(1, armv6RowKernels());
+	EdgeMap e1, e2;
+	const ImageView view(g.px.data(), g.w, g.h, g.w);
+	ref->run(view, scale, params, e1);
+	v6->run(view, scale, params, e2);
+	CHECK(e1.width == e2.width && e1.height == e2.height, "%s: sizes differ", what);
+	std::size_t edges = 0, diff = 0;
+	for (std::size_t i = 0; i < e1.pixels.size(); ++i) {
+		edges += e1.pixels[i] != 0;
+		if (e1.pixels[i] != e2.pixels[i] && diff++ < 3)
+			CHECK(false, "%s: pixel (%zu, %zu): %d vs %d", what, i % e1.width, i / e1.width, e1.pixels[i],
+			      e2.pixels[i]);
+	}
+	CHECK(diff == 0, "%s: %zu pixels differ", what, diff);
+	CHECK(e1.tiles == e2.tiles, "%s: tile masks differ", what);
+	return edges;
+}
+
+} // namespace
+
+int main(int argc, char **argv)
+{
+	int first = 1;
+	bool quick = false;
+	if (argc > 1 && std::strcmp(argv[1], "--quick") == 0) {
+		quick = true;
+		first = 2;
+	}
+	const RowKernels &ref = scalarRowKernels();
+	const RowKernels &k = armv6RowKernels();
+	CHECK(&bestRowKernels() == &k, "bestRowKernels() is not the ARMv6 set on this build");
+
+	int rowCases = 0;
+	for (int w = 1; w <= 96; ++w)
+		for (int kind = 0; kind < 3; ++kind)
+			for (int mis = 0; mis < 4; ++mis, ++rowCases)
+				checkRows(ref, k, w, kind, mis);
+	for (int w : { 127, 128, 129, 320, 639, 640, 641, 1283 })
+		for (int rep = 0; rep < (quick ? 3 : 30); ++rep, ++rowCases)
+			checkRows(ref, k, w, rep % 3, rep % 4);
+	std::printf("rows: %d random cases\n", rowCases);
+
+	/* Thresholds: the defaults (edge 0.27, corner 0.19), none, tiny, huge,
+	 * negative. */
+	const FrontEndParams params[] = {
+		{ 4740, 12354 }, { 0, 0 }, { 1, 1 }, { 400, 1000 }, { 40000, 200000 },
+		{ -5, -7 }, { INT64_C(1) << 40, INT64_C(1) << 40 }, { 2080799, 12354 },
+	};
+	int imageCases = 0;
+	for (const auto &[w, h] : { std::pair{ 640, 480 }, std::pair{ 37, 23 }, std::pair{ 3, 3 }, std::pair{ 4, 17 },
+				   std::pair{ 17, 5 }, std::pair{ 161, 97 } }) {
+		for (int noise : { 0, 3, 12 }) {
+			const Gray g = constructed(w, h, noise, static_cast<unsigned>(w * 131 + h * 7 + noise));
+			for (const FrontEndParams &p : params) {
+				char what[96];
+				std::snprintf(what, sizeof what, "constructed %dx%d noise %d thr %" PRId64 "/%" PRId64, w, h,
+					      noise, p.edge_threshold_sq, p.corner_threshold);
+				compareFrontEnds(g, p, 1.0f, what);
+				++imageCases;
+			}
+			if (w == 640) {
+				compareFrontEnds(g, params[0], 0.5f, "constructed 640x480 at scale 0.5");
+				compareFrontEnds(g, params[0], 0.37f, "constructed 640x480 at scale 0.37");
+				imageCases += 2;
+			}
+		}
+	}
+	std::printf("front end: %d constructed images\n", imageCases);
+
+	std::size_t files = 0, edges = 0;
+	for (int i = first; i < argc; ++i) {
+		Gray g;
+		if (!readPgm(argv[i], g)) {
+			CHECK(false, "cannot read %s (binary PGM, maxval 255)", argv[i]);
+			continue;
+		}
+		edges += compareFrontEnds(g, params[0], 1.0f, argv[i]);
+		++files;
+	}
+	if (files)
+		std::printf("front end: %zu images, %zu edge pixels\n", files, edges);
+	std::printf("%s\n", failures ? "FAILED" : "ok: the ARMv6 kernels equal the scalar ones");
+	return failures ? 1 : 0;
+}
+
+#endif
