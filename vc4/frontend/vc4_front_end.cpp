@@ -9,6 +9,8 @@
 #include "emu/device.hpp"
 #include "isa/setup_words.hpp"
 #include "kernels/kernels.hpp"
+
+static_assert(frappe::vc4::kMaxQpuWidth == frappe::vc4::kernels::kMaxWidth);
 #if FRAPPE_VC4_HAVE_RUNTIME
 #include "runtime/gpu_device.hpp"
 #endif
@@ -137,8 +139,9 @@ public:
 		g.src_h = image.height;
 		g.w = scale < 1.0f ? scaledLength(image.width, scale) : image.width;
 		g.h = scale < 1.0f ? scaledLength(image.height, scale) : image.height;
-		if (g.w < 3 || g.h < 3 || g.w > kernels::kMaxWidth) {
+		if (g.w < 3 || g.h < 3 || g.w > kMaxQpuWidth) {
 			// Nothing for the QPUs (an all-zero map) or wider than the VDW stride allows.
+			counted_ = false;
 			if (!cpu_)
 				cpu_ = makeCpuFrontEnd(1);
 			cpu_->run(image, scale, params, out);
@@ -212,6 +215,16 @@ public:
 						out.tiles[static_cast<size_t>(by) * out.tiles_x + bx] = 1;
 				}
 		}
+	}
+
+	bool gradient(std::vector<uint32_t> &words, int &pitch_words) const
+	{
+		if (!counted_)
+			return false;
+		words.resize(geometry_.gradBytes() / 4);
+		std::memcpy(words.data(), buf_.grad.cpu.data(), geometry_.gradBytes());
+		pitch_words = static_cast<int>(geometry_.gradPitch() / 4);
+		return true;
 	}
 
 	bool counts(FrameCounts &out) const
@@ -308,6 +321,13 @@ bool lastFrameCounts(const frappe::FrontEnd &front_end, FrameCounts &out)
 {
 	if (const auto *fe = dynamic_cast<const Vc4FrontEnd<EmuBackend> *>(&front_end))
 		return fe->counts(out);
+	return false;
+}
+
+bool lastGradientBuffer(const frappe::FrontEnd &front_end, std::vector<uint32_t> &words, int &pitch_words)
+{
+	if (const auto *fe = dynamic_cast<const Vc4FrontEnd<EmuBackend> *>(&front_end))
+		return fe->gradient(words, pitch_words);
 	return false;
 }
 

@@ -7,10 +7,14 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "frappe/edge_map.h"
 
 namespace frappe::vc4 {
+
+// Wider scaled frames run on the CPU front end (the VDW stride field holds 13 bits).
+inline constexpr int kMaxQpuWidth = 2048;
 
 struct FrontEndOptions {
 	bool emulate = true; // true: run the kernels on the emulator (backend "vc4-emu"); false: on the real GPU (backend "vc4")
@@ -38,5 +42,9 @@ struct FrameCounts {
 };
 // False when `front_end` is not an emulated VC4 front end or has not run a QPU frame.
 bool lastFrameCounts(const frappe::FrontEnd &front_end, FrameCounts &out);
+
+// The gradient buffer of the last QPU frame (pass 1's output, layout in
+// kernels/kernels.hpp): `pitch_words` 32-bit words per image row. Emulator only; for tests.
+bool lastGradientBuffer(const frappe::FrontEnd &front_end, std::vector<uint32_t> &words, int &pitch_words);
 
 } // namespace frappe::vc4

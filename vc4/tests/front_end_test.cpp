@@ -2,13 +2,24 @@
 // The VC4 front end on the emulator against frappe-core's CPU front end, byte for byte.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
 #include <random>
 
+#include "asm/text.hpp"
 #include "frappe/edge_map.h"
+#include "front_end_rows.h" // frappe-core's row kernels (internal header)
+#include "isa/disasm.hpp"
+#include "kernels/kernels.hpp"
 #include "frappe/dictionary.h"
 #include "frappe/render.h"
 #include "frontend/vc4_front_end.hpp"
+#if FRAPPE_VC4_TEST_OPENCV
+#include <opencv2/imgcodecs.hpp>
+#endif
 
 using namespace frappe;
 
@@ -76,6 +87,131 @@ void compare(const Img &img, float scale, const FrontEndParams &p, unsigned seed
 	last_corners = corners;
 }
 
+// Pass 1's planes from frappe-core's own scaling, smoothing and Sobel rows: B = m << 2 | dir
+// and the tensor products summed over rows y-1 .. y+1 (zero beyond the frame).
+struct Planes {
+	int w = 0, h = 0;
+	std::vector<uint32_t> b, xx, yy, xy;
+};
+
+Planes referencePlanes(const Img &img, float scale)
+{
+	Planes r;
+	r.w = scale < 1.0f ? scaledLength(img.width, scale) : img.width;
+	r.h = scale < 1.0f ? scaledLength(img.height, scale) : img.height;
+	const int w = r.w, h = r.h;
+	std::vector<uint8_t> src(static_cast<size_t>(w) * h);
+	detail::scaleNearest(img.view(), w, h, src.data());
+	std::vector<uint8_t> sm(static_cast<size_t>(w) * h);
+	std::vector<uint16_t> tmp(w);
+	auto row = [&](int y) { return src.data() + static_cast<size_t>(std::clamp(y, 0, h - 1)) * w; };
+	for (int y = 0; y < h; ++y)
+		detail::smoothRow(row(y - 1), row(y), row(y + 1), w, sm.data() + static_cast<size_t>(y) * w, tmp.data());
+	std::vector<int32_t> gx(static_cast<size_t>(w) * h, 0), gy(gx.size(), 0);
+	std::vector<int16_t> gxr(w), gyr(w), sep(2 * w);
+	std::vector<int32_t> mag(w), t0(w), t1(w), t2(w), t3(3 * w);
+	for (int y = 1; y < h - 1; ++y) {
+		detail::gradientRow(sm.data() + static_cast<size_t>(y - 1) * w, sm.data() + static_cast<size_t>(y) * w,
+		                    sm.data() + static_cast<size_t>(y + 1) * w, w, gxr.data(), gyr.data(), mag.data(),
+		                    sep.data(), {t0.data(), t1.data(), t2.data(), t3.data()});
+		for (int x = 0; x < w; ++x) {
+			gx[static_cast<size_t>(y) * w + x] = gxr[x];
+			gy[static_cast<size_t>(y) * w + x] = gyr[x];
+		}
+	}
+	const size_t n = static_cast<size_t>(w) * h;
+	r.b.assign(n, 0);
+	r.xx.assign(n, 0);
+	r.yy.assign(n, 0);
+	r.xy.assign(n, 0);
+	for (int y = 0; y < h; ++y)
+		for (int x = 0; x < w; ++x) {
+			const size_t i = static_cast<size_t>(y) * w + x;
+			const int ax = std::abs(gx[i]), ay = std::abs(gy[i]);
+			const uint32_t dir = 256 * ay <= 106 * ax ? 0 : 256 * ax <= 106 * ay ? 1 : (gx[i] > 0) == (gy[i] > 0) ? 2 : 3;
+			r.b[i] = static_cast<uint32_t>(gx[i] * gx[i] + gy[i] * gy[i]) << 2 | dir;
+			for (int yy = std::max(0, y - 1); yy <= std::min(h - 1, y + 1); ++yy) {
+				const size_t j = static_cast<size_t>(yy) * w + x;
+				r.xx[i] += static_cast<uint32_t>(gx[j] * gx[j]);
+				r.yy[i] += static_cast<uint32_t>(gy[j] * gy[j]);
+				r.xy[i] += static_cast<uint32_t>(gx[j] * gy[j]);
+			}
+		}
+	return r;
+}
+
+// Pass 1 alone: its gradient buffer against referencePlanes(); then pass 2, whose input is
+// thereby the reference, against the CPU's EdgeMap (expectSame in compare()).
+void comparePass1(const Img &img, float scale, unsigned seed, const std::string &what)
+{
+	auto fe = vc4::makeFrontEnd({.emulate = true, .seed = seed, .strict = true});
+	EdgeMap got;
+	fe->run(img.view(), scale, params(), got);
+	std::vector<uint32_t> buf;
+	int pitch = 0;
+	ASSERT_TRUE(vc4::lastGradientBuffer(*fe, buf, pitch)) << what;
+	const Planes ref = referencePlanes(img, scale);
+	ASSERT_EQ(got.width, ref.w);
+	size_t bad = 0;
+	std::string first;
+	for (int y = 0; y < ref.h; ++y)
+		for (int x = 0; x < ref.w; ++x) {
+			const size_t i = static_cast<size_t>(y) * ref.w + x;
+			const uint32_t *p = buf.data() + static_cast<size_t>(y) * pitch + x;
+			const uint32_t want[4] = {ref.b[i], ref.xx[i], ref.yy[i], ref.xy[i]};
+			for (int k = 0; k < 4; ++k)
+				if (p[k * pitch / 4] != want[k] && bad++ == 0)
+					first = "plane " + std::to_string(k) + " at (" + std::to_string(x) + ", " + std::to_string(y) +
+					        ") got " + std::to_string(p[k * pitch / 4]) + " want " + std::to_string(want[k]);
+		}
+	EXPECT_EQ(bad, 0u) << what << ": " << first;
+}
+
+TEST(Vc4Kernels, GradientPassMatchesCoreRows)
+{
+	comparePass1(scene(67, 33, 1, 1), 1.0f, 0, "67x33");
+	comparePass1(scene(3, 3, 2, 0), 1.0f, 0, "3x3");
+	comparePass1(scene(7, 5, 3, 0), 1.0f, 1, "7x5");
+	comparePass1(scene(130, 70, 4, 2, 3), 1.0f, 2, "130x70 stride 133");
+	comparePass1(scene(200, 150, 5, 2), 0.5f, 3, "200x150 scale 0.5");
+	comparePass1(scene(161, 97, 6, 2), 0.7f, 4, "161x97 scale 0.7");
+}
+
+// The kernels survive a round trip through their vc4asm-syntax listings (what vc4asm
+// reads), and their hazard lint is clean (finish() throws otherwise).
+TEST(Vc4Kernels, ListingsRoundTrip)
+{
+	for (const auto &built : {vc4::kernels::gradientPass(), vc4::kernels::edgePass()}) {
+		EXPECT_EQ(vc4::qasm::assembleText(vc4::isa::disassembleProgram(built.program.code)), built.program.code)
+			<< built.program.name;
+		std::printf("%s: %zu instructions, %u nops the builder could not fill\n", built.program.name.c_str(),
+		            built.program.code.size(), built.nops);
+	}
+}
+
+// Instruction and modelled-cycle counts of both passes on a 640x480 frame (README table).
+TEST(Vc4Kernels, FrameCounts)
+{
+	const Img img = scene(640, 480, 21, 6);
+	auto fe = vc4::makeFrontEnd({});
+	EdgeMap got, want;
+	fe->run(img.view(), 1.0f, params(4740, 12354), got);
+	makeCpuFrontEnd(1)->run(img.view(), 1.0f, params(4740, 12354), want);
+	expectSame(got, want, "640x480");
+	vc4::FrameCounts c;
+	ASSERT_TRUE(vc4::lastFrameCounts(*fe, c));
+	for (int pass = 0; pass < 2; ++pass) {
+		const auto &p = c.pass[pass];
+		const unsigned perQpu = (p.tiles + p.programs - 1) / p.programs;
+		std::printf("pass %d: %u tiles on %u QPUs; %.0f instructions/tile; slowest QPU %llu cycles "
+		            "(%u tiles, %.0f cycles/tile) = %.3f ms at 250 MHz, %.3f ms at 300 MHz\n",
+		            pass + 1, p.tiles, p.programs, double(p.instructions) / p.tiles,
+		            static_cast<unsigned long long>(p.slowest_cycles), perQpu, double(p.slowest_cycles) / perQpu,
+		            p.slowest_cycles / 250e3, p.slowest_cycles / 300e3);
+		EXPECT_GT(p.instructions, 0u);
+	}
+}
+
 TEST(Vc4FrontEnd, SmallScene)
 {
 	const Img img = scene(67, 33, 1, 1);
@@ -136,3 +272,47 @@ TEST(Vc4FrontEnd, ReusesBuffersAcrossFrames)
 }
 
 } // namespace
+
+#if FRAPPE_VC4_TEST_OPENCV
+// The shared data set (../shared/data, not shipped to users): a bounded subset by default,
+// every image with FRAPPE_VC4_ALL=1. Each image runs at full size and scaled to about 320
+// pixels wide, under a seed that changes from image to image.
+TEST(Vc4FrontEnd, SharedImages)
+{
+	const char *shared = std::getenv("FRAPPE_SHARED");
+	const std::filesystem::path root = shared ? std::filesystem::path(shared) / "data" : std::filesystem::path();
+	if (root.empty() || !std::filesystem::is_directory(root))
+		GTEST_SKIP() << "no shared data at " << root;
+	std::vector<std::filesystem::path> files;
+	for (const auto &e : std::filesystem::recursive_directory_iterator(root)) {
+		const auto ext = e.path().extension().string();
+		if (e.is_regular_file() && (ext == ".png" || ext == ".jpg"))
+			files.push_back(e.path());
+	}
+	std::sort(files.begin(), files.end());
+	const bool all = std::getenv("FRAPPE_VC4_ALL") && std::string(std::getenv("FRAPPE_VC4_ALL")) == "1";
+	const size_t limit = all ? files.size() : 10;
+	const size_t step = all ? 1 : std::max<size_t>(1, files.size() / limit);
+	const FrontEndParams p = params(4740, 12354); // Config's defaults 0.27 and 0.19
+	size_t runs = 0, fallback = 0, frames = 0;
+	auto cpu = makeCpuFrontEnd(1);
+	for (size_t i = 0; i < files.size() && frames < limit; i += step, ++frames) {
+		const cv::Mat m = cv::imread(files[i].string(), cv::IMREAD_GRAYSCALE);
+		ASSERT_FALSE(m.empty()) << files[i];
+		const ImageView view(m.data, m.cols, m.rows, static_cast<int>(m.step));
+		const unsigned seed = static_cast<unsigned>(i % 5); // 0: round robin
+		auto fe = vc4::makeFrontEnd({.emulate = true, .seed = seed, .strict = true});
+		for (const float scale : {1.0f, std::min(1.0f, 320.0f / static_cast<float>(m.cols))}) {
+			EdgeMap want, got;
+			cpu->run(view, scale, p, want);
+			fe->run(view, scale, p, got);
+			expectSame(got, want, files[i].string() + " scale " + std::to_string(scale) + " seed " + std::to_string(seed));
+			if (want.width > vc4::kMaxQpuWidth)
+				++fallback;
+			++runs;
+		}
+	}
+	std::printf("shared images: %zu frames, %zu comparisons (%zu wider than the QPU limit, on the CPU)\n", frames, runs,
+	            fallback);
+}
+#endif
