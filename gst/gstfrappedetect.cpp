@@ -47,6 +47,13 @@
  * right, y down, z forward) for the marker frame of OpenCV aruco: origin at
  * the marker centre, x right, y up, z out of the marker towards the camera.
  *
+ * #GstFrappeDetect:backend chooses where the front end (Sobel, edges,
+ * corners, empty tiles) runs: `cpu`; `vc4`, the QPUs of a Raspberry Pi Zero,
+ * 1, 2 or 3 (it fails to start when they cannot be used, e.g. while the vc4
+ * KMS driver owns the GPU); `vc4-emu`, the same QPU programs on an emulator,
+ * bit-exact and slow, for testing anywhere; `auto` (the default), the QPUs
+ * when the probe succeeds, else the CPU with one warning on a Pi.
+ *
  * With #GstFrappeDetect:pipelined, the front end of frame N+1 runs while the
  * back end of frame N runs on a worker thread. The element then holds one
  * buffer, answers the LATENCY query with one extra frame, asks upstream
@@ -91,6 +98,9 @@
 #include <gst/video/video.h>
 
 #include <frappe/frappe.h>
+#ifdef FRAPPE_HAVE_VC4
+#include "frontend/backend.hpp"
+#endif
 
 #include "annotate.h"
 #include "gstfrappemeta.h"
@@ -130,6 +140,8 @@ typedef enum {
 typedef enum {
 	GST_FRAPPE_BACKEND_AUTO,
 	GST_FRAPPE_BACKEND_CPU,
+	GST_FRAPPE_BACKEND_VC4,
+	GST_FRAPPE_BACKEND_VC4_EMU,
 } GstFrappeBackend;
 
 #define DEFAULT_DICTIONARY_NAME "aruco_mip_36h12"
@@ -169,8 +181,12 @@ static GType gst_frappe_backend_get_type(void)
 {
 	static GType type = 0;
 	static const GEnumValue values[] = {
-		{ GST_FRAPPE_BACKEND_AUTO, "The fastest backend available (the CPU for now)", "auto" },
+		{ GST_FRAPPE_BACKEND_AUTO,
+		  "The Raspberry Pi's QPUs when they can be used, else the CPU (with one warning on a Pi)", "auto" },
 		{ GST_FRAPPE_BACKEND_CPU, "The reference CPU front end", "cpu" },
+		{ GST_FRAPPE_BACKEND_VC4, "The QPU kernels on the VideoCore IV GPU (Pi Zero, 1, 2, 3)", "vc4" },
+		{ GST_FRAPPE_BACKEND_VC4_EMU,
+		  "The QPU kernels on an emulator: bit-exact with vc4, slow; for testing", "vc4-emu" },
 		{ 0, nullptr, nullptr },
 	};
 	if (g_once_init_enter(&type)) {
@@ -337,6 +353,7 @@ struct FrappeDetectPrivate {
 	Worker worker;
 	bool loggedMemory = false;
 	bool warnedStride = false;
+	bool warnedFallback = false;
 	guint64 frames = 0;
 	frappe::StageTimes windowTimes; /* sums over the current 100 frames */
 	double windowPoseMs = 0.0;
@@ -380,6 +397,48 @@ static frappe::Config make_config(const Settings &s)
 	return config;
 }
 
+static const char *backend_name(GstFrappeBackend backend)
+{
+	GEnumClass *klass = G_ENUM_CLASS(g_type_class_ref(GST_TYPE_FRAPPE_BACKEND));
+	const GEnumValue *v = g_enum_get_value(klass, backend);
+	const char *name = v ? v->value_nick : "auto";
+	g_type_class_unref(klass);
+	return name;
+}
+
+/* Puts the front end the backend property asks for into the detector. The
+ * element only names it; vc4/ decides what runs. */
+static bool select_front_end(GstFrappeDetect *self, frappe::Detector &detector)
+{
+	FrappeDetectPrivate *priv = self->priv;
+	const GstFrappeBackend backend = priv->active.backend;
+	if (backend == GST_FRAPPE_BACKEND_CPU)
+		return true;
+	const char *name = backend_name(backend);
+#ifdef FRAPPE_HAVE_VC4
+	try {
+		frappe::vc4::BackendChoice choice = frappe::vc4::selectFrontEnd(name, 1);
+		if (!choice.fallback.empty() && !priv->warnedFallback) {
+			priv->warnedFallback = true;
+			GST_ELEMENT_WARNING(self, RESOURCE, NOT_FOUND, ("The GPU cannot be used; detecting on the CPU"),
+					    ("backend=auto: %s", choice.fallback.c_str()));
+		}
+		detector.setFrontEnd(std::move(choice.frontEnd));
+	} catch (const std::exception &e) {
+		GST_ELEMENT_ERROR(self, RESOURCE, OPEN_READ, ("Backend %s cannot be used", name), ("%s", e.what()));
+		return false;
+	}
+#else
+	(void)detector;
+	if (backend != GST_FRAPPE_BACKEND_AUTO) {
+		GST_ELEMENT_ERROR(self, LIBRARY, SETTINGS, ("Backend %s is not in this build", name),
+				  ("the plugin was built without vc4/"));
+		return false;
+	}
+#endif
+	return true;
+}
+
 static bool ensure_detector(GstFrappeDetect *self)
 {
 	FrappeDetectPrivate *priv = self->priv;
@@ -390,6 +449,10 @@ static bool ensure_detector(GstFrappeDetect *self)
 		priv->detector = std::make_unique<frappe::Detector>(config);
 	} catch (const std::exception &e) {
 		GST_ELEMENT_ERROR(self, LIBRARY, SETTINGS, ("Invalid detector settings"), ("%s", e.what()));
+		return false;
+	}
+	if (!select_front_end(self, *priv->detector)) {
+		priv->detector.reset();
 		return false;
 	}
 	GST_DEBUG_OBJECT(self, "detector for %s, mode %s, max-hamming %d, front end %s",

@@ -18,6 +18,9 @@
 
 #include "annotate.h"
 #include "frappe/frappe.h"
+#ifdef FRAPPE_HAVE_VC4
+#include "frontend/backend.hpp"
+#endif
 
 namespace {
 
@@ -38,7 +41,8 @@ const char kUsage[] =
 	"      --edge-threshold E  Sobel magnitude for an edge, intensities in [0,1] (default 0.27)\n"
 	"      --corner-threshold C  Shi-Tomasi threshold for a corner (default 0.19)\n"
 	"      --max-hamming H     bits corrected (default: the dictionary's safe maximum)\n"
-	"      --backend B         front end: auto, cpu (default auto)\n"
+	"      --backend B         front end: auto, cpu, vc4 (the Pi's QPUs), vc4-emu (the QPU\n"
+	"                          kernels on an emulator: slow, bit-exact) (default auto)\n"
 	"  -a, --annotate PATH     write the image with the markers drawn (a folder for several images)\n"
 	"      --json              print one JSON line per image instead of text\n"
 	"      --stats             print per-stage timings\n"
@@ -116,8 +120,8 @@ Options parse(int argc, char **argv)
 			o.config.max_hamming = parseNumber<int>(a, value());
 		} else if (a == "--backend") {
 			o.backend = value();
-			if (o.backend != "auto" && o.backend != "cpu")
-				usageError("--backend takes auto or cpu in this build, got '" + o.backend + "'");
+			if (o.backend != "auto" && o.backend != "cpu" && o.backend != "vc4" && o.backend != "vc4-emu")
+				usageError("--backend takes auto, cpu, vc4 or vc4-emu, got '" + o.backend + "'");
 		} else if (a == "-a" || a == "--annotate") {
 			o.annotate = value();
 		} else if (a == "--json") {
@@ -227,6 +231,23 @@ int main(int argc, char **argv)
 	std::unique_ptr<Detector> detector;
 	try {
 		detector = std::make_unique<Detector>(opt.config);
+		if (opt.backend != "cpu") {
+#ifdef FRAPPE_HAVE_VC4
+			frappe::vc4::BackendChoice choice;
+			try {
+				choice = frappe::vc4::selectFrontEnd(opt.backend, opt.config.threads);
+			} catch (const std::exception &e) {
+				throw std::runtime_error("backend " + opt.backend + " cannot be used: " + e.what());
+			}
+			if (!choice.fallback.empty())
+				std::cerr << "frappe-detect: the QPUs cannot be used (" << choice.fallback
+					  << "); using the CPU front end\n";
+			detector->setFrontEnd(std::move(choice.frontEnd));
+#else
+			if (opt.backend != "auto")
+				throw std::runtime_error("backend " + opt.backend + " needs the vc4 part, which this build lacks");
+#endif
+		}
 	} catch (const std::exception &e) {
 		std::cerr << "frappe-detect: " << e.what() << "\n";
 		return 2;

@@ -73,6 +73,24 @@ def main():
         check(r.returncode == 0 and 'apriltag_36h11' in r.stdout, '--dictionaries lists them')
         r = run(exe, '--list', os.path.join(tmp, 'nolist.txt'), '--out', out)
         check(r.returncode == 2, 'missing list file is an error')
+        r = run(exe, '--backend', 'gpu', sample)
+        check(r.returncode == 2 and 'vc4-emu' in r.stderr, 'unknown backend: the known ones named')
+
+        # The QPU front end on the emulator gives exactly the CPU's markers.
+        if os.environ.get('FRAPPE_HAVE_VC4') == '1':
+            outs = {}
+            for backend in ('cpu', 'vc4-emu'):
+                r = run(exe, '--backend', backend, '--json', sample)
+                check(r.returncode == 0, '--backend %s exits 0' % backend)
+                outs[backend] = json.loads(r.stdout)['markers']
+            check(len(outs['cpu']) == len(expected['markers']), 'cpu finds every sample marker')
+            check(outs['vc4-emu'] == outs['cpu'], '--backend vc4-emu: the same ids and corners as cpu')
+            r = run(exe, '--backend', 'vc4', sample)
+            if r.returncode == 0:
+                print('ok: --backend vc4 runs (the QPUs are usable here)')
+            else:
+                check(r.returncode == 2 and 'cannot' in r.stderr.lower() and len(r.stderr) > 40,
+                      '--backend vc4 without a usable GPU: exit 2 with the reason (%s)' % r.stderr.strip())
     return 0
 
 

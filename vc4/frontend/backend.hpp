@@ -1,0 +1,33 @@
+// SPDX-License-Identifier: MIT
+// Choosing a front end by the name a user gives it (the CLI's --backend, the
+// element's backend property): auto, cpu, vc4, vc4-emu. The caller sees only
+// frappe::FrontEnd; what runs behind it stays in vc4/.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <string_view>
+
+#include "frappe/edge_map.h"
+
+namespace frappe::vc4 {
+
+struct BackendChoice {
+	std::unique_ptr<frappe::FrontEnd> frontEnd;
+	/// Set when "auto" fell back to the CPU: why the QPUs were not used, in
+	/// one sentence, for a single warning.
+	std::string fallback;
+};
+
+/// The names selectFrontEnd() takes, for usage texts.
+inline constexpr std::string_view kBackendNames = "auto, cpu, vc4, vc4-emu";
+
+/// "cpu": the reference CPU front end with `threads` bands. "vc4": the QPU
+/// kernels on the real GPU; throws std::runtime_error with the probe's reason
+/// when it cannot be used. "vc4-emu": the same kernels on the emulator, bit
+/// for bit what the GPU computes (slow: for tests and estimates). "auto": vc4
+/// when the probe succeeds, else the CPU with `fallback` set. Throws
+/// std::invalid_argument for any other name.
+BackendChoice selectFrontEnd(std::string_view name, int threads);
+
+} // namespace frappe::vc4
