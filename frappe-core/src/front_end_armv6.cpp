@@ -225,11 +225,11 @@ inline u32 pairAt(const std::int16_t *row, int x)
 
 /* isCorner on the pair rows: Sxx + Syy by SMLAD, Sxx - Syy by SMLSD, Sxy
  * by SMLATB; then the scalar kernel's int32 test. */
-inline bool isCornerV6(const GradRows &rows, int x, std::int32_t twoT)
+__attribute__((noinline)) bool isCornerV6(const std::int16_t *const pairRows[3], int x, std::int32_t twoT)
 {
 	std::int32_t s = 0, d = 0, xy = 0;
 	for (int r = 0; r < 3; ++r) {
-		const std::uint8_t *p = reinterpret_cast<const std::uint8_t *>(rows.gx[r]) + 4 * (x - 1);
+		const std::uint8_t *p = reinterpret_cast<const std::uint8_t *>(pairRows[r]) + 4 * (x - 1);
 		for (int i = 0; i < 3; ++i) {
 			const auto v = static_cast<int16x2_t>(load32(p + 4 * i));
 			s = __smlad(v, v, s);
@@ -245,61 +245,76 @@ inline bool isCornerV6(const GradRows &rows, int x, std::int32_t twoT)
 	return c * c > a * a + b * b;
 }
 
+struct EdgeRowCtx {
+	const std::int32_t *up, *mid, *down;
+	const std::int16_t *pairs[3];
+	std::int32_t twoT;
+};
+
+/* One pixel whose magnitude m is above the threshold: non-maximum
+ * suppression along the gradient direction, then the corner test. Out of
+ * line, so that the scan over the (mostly empty) row keeps its registers. */
+__attribute__((noinline)) u32 edgePixel(const EdgeRowCtx &e, int x, std::int32_t m)
+{
+	const u32 p = pairAt(e.pairs[1], x);
+	const int gx = static_cast<std::int16_t>(p), gy = static_cast<std::int32_t>(p) >> 16;
+	const int ax = std::abs(gx), ay = std::abs(gy);
+	std::int32_t prev, next;
+	if (256 * ay <= 106 * ax) {
+		prev = e.mid[x - 1];
+		next = e.mid[x + 1];
+	} else if (256 * ax <= 106 * ay) {
+		prev = e.up[x];
+		next = e.down[x];
+	} else if ((gx > 0) == (gy > 0)) {
+		prev = e.up[x - 1];
+		next = e.down[x + 1];
+	} else {
+		prev = e.up[x + 1];
+		next = e.down[x - 1];
+	}
+	if (!(m > prev && m >= next))
+		return 0;
+	return isCornerV6(e.pairs, x, e.twoT) ? EdgeMap::kEdge | EdgeMap::kCorner : EdgeMap::kEdge;
+}
+
 bool edgeRowV6(const GradRows &rows, int w, const FrontEndParams &params, std::uint8_t *out)
 {
 	out[0] = 0;
 	out[w - 1] = 0;
-	const std::int32_t *up = rows.mag[0];
+	const EdgeRowCtx e{ rows.mag[0], rows.mag[1], rows.mag[2], { rows.gx[0], rows.gx[1], rows.gx[2] },
+			    2 * static_cast<std::int32_t>(params.corner_threshold) };
 	const std::int32_t *mid = rows.mag[1];
-	const std::int32_t *down = rows.mag[2];
-	const std::int16_t *pr = rows.gx[1];
 	/* m >= 0 and m < 2^31: clamping the threshold keeps m > thr. */
 	const std::int32_t thr = static_cast<std::int32_t>(
 		std::clamp<std::int64_t>(params.edge_threshold_sq, -1, INT32_MAX));
-	const std::int32_t twoT = 2 * static_cast<std::int32_t>(params.corner_threshold);
 	u32 any = 0;
-	auto pixel = [&](int x) -> std::uint8_t {
-		const std::int32_t m = mid[x];
-		if (m <= thr)
-			return 0;
-		const u32 p = pairAt(pr, x);
-		const int gx = static_cast<std::int16_t>(p), gy = static_cast<std::int32_t>(p) >> 16;
-		const int ax = std::abs(gx), ay = std::abs(gy);
-		std::int32_t prev, next;
-		if (256 * ay <= 106 * ax) {
-			prev = mid[x - 1];
-			next = mid[x + 1];
-		} else if (256 * ax <= 106 * ay) {
-			prev = up[x];
-			next = down[x];
-		} else if ((gx > 0) == (gy > 0)) {
-			prev = up[x - 1];
-			next = down[x + 1];
-		} else {
-			prev = up[x + 1];
-			next = down[x - 1];
-		}
-		if (!(m > prev && m >= next))
-			return 0;
-		any = 1;
-		return isCornerV6(rows, x, twoT) ? EdgeMap::kEdge | EdgeMap::kCorner : EdgeMap::kEdge;
-	};
 	const int x1 = w - 1;
 	int x = 1;
 	for (; x + 4 <= x1; x += 4) {
 		/* Most pixels are far below the threshold: the OR of four
 		 * non-negative magnitudes bounds their maximum. */
-		const std::int32_t *m = mid + x;
-		if ((m[0] | m[1] | m[2] | m[3]) <= thr) {
-			store32(out + x, 0);
-			continue;
+		const std::int32_t m0 = mid[x], m1 = mid[x + 1], m2 = mid[x + 2], m3 = mid[x + 3];
+		u32 v = 0;
+		if ((m0 | m1 | m2 | m3) > thr) {
+			if (m0 > thr)
+				v = edgePixel(e, x, m0);
+			if (m1 > thr)
+				v |= edgePixel(e, x + 1, m1) << 8;
+			if (m2 > thr)
+				v |= edgePixel(e, x + 2, m2) << 16;
+			if (m3 > thr)
+				v |= edgePixel(e, x + 3, m3) << 24;
+			any |= v;
 		}
-		const u32 v = static_cast<u32>(pixel(x)) | static_cast<u32>(pixel(x + 1)) << 8 |
-			      static_cast<u32>(pixel(x + 2)) << 16 | static_cast<u32>(pixel(x + 3)) << 24;
 		store32(out + x, v);
 	}
-	for (; x < x1; ++x)
-		out[x] = pixel(x);
+	for (; x < x1; ++x) {
+		const std::int32_t m = mid[x];
+		const u32 v = m > thr ? edgePixel(e, x, m) : 0;
+		out[x] = static_cast<std::uint8_t>(v);
+		any |= v;
+	}
 	return any != 0;
 }
 
