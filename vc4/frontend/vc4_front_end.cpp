@@ -40,6 +40,8 @@ struct Geometry {
 	uint32_t gradPitch() const { return 16 * paddedW(); }
 	uint32_t srcBytes() const { return srcStride() * static_cast<uint32_t>(src_h) + 64; }
 	uint32_t gradBytes() const { return gradPitch() * paddedH(); }
+	/// Pass 2 reads border pixels' neighbours unclamped: a margin of a row and more.
+	uint32_t gradMargin() const { return gradPitch() + 64; }
 	uint32_t edgeBytes() const { return paddedW() * paddedH(); }
 	uint32_t maskBytes() const { return 128 * tiles(); }
 	uint32_t uniformWords(unsigned per_tile) const
@@ -163,6 +165,7 @@ public:
 		const uint32_t edgeThr = static_cast<uint32_t>(thr) << 2 | 3u;
 		const uint32_t cornerC = 2u * static_cast<uint32_t>(static_cast<int32_t>(params.corner_threshold));
 		const uint32_t pitch = g.gradPitch(), pw = g.paddedW();
+		const uint32_t grad = buf_.grad.bus + g.gradMargin();
 
 		const unsigned tiles = g.tiles();
 		const unsigned programs = std::min(kPrograms, tiles);
@@ -175,10 +178,10 @@ public:
 				const kernels::GradientUniforms u1{
 					buf_.src.bus, stride, static_cast<uint32_t>(g.src_w - 1), static_cast<uint32_t>(g.src_h - 1),
 					stepX, stepY, static_cast<uint32_t>(g.w - 1), static_cast<uint32_t>(g.h - 1), x0, y0,
-					buf_.grad.bus + y0 * pitch + 4 * x0, pitch,
+					grad + y0 * pitch + 4 * x0, pitch,
 					isa::VdwStride{.stride = static_cast<uint16_t>(pitch / 4 - 64)}.word()};
 				const kernels::EdgeUniforms u2{
-					buf_.grad.bus, pitch, pitch / 4, static_cast<uint32_t>(g.w - 2), static_cast<uint32_t>(g.h - 2),
+					grad, pitch, pitch / 4, static_cast<uint32_t>(g.w - 2), static_cast<uint32_t>(g.h - 2),
 					x0, y0, edgeThr, cornerC, buf_.edge.bus + y0 * pw + x0,
 					isa::VdwStride{.stride = static_cast<uint16_t>(pw - 64)}.word(), 4 * pw,
 					buf_.mask.bus + 128 * t};
@@ -222,7 +225,7 @@ public:
 		if (!counted_)
 			return false;
 		words.resize(geometry_.gradBytes() / 4);
-		std::memcpy(words.data(), buf_.grad.cpu.data(), geometry_.gradBytes());
+		std::memcpy(words.data(), buf_.grad.cpu.data() + geometry_.gradMargin(), geometry_.gradBytes());
 		pitch_words = static_cast<int>(geometry_.gradPitch() / 4);
 		return true;
 	}
@@ -258,11 +261,11 @@ private:
 			return;
 		const uint32_t u1 = 4 * g.uniformWords(kernels::kGradientUniforms);
 		const uint32_t u2 = 4 * g.uniformWords(kernels::kEdgeUniforms);
-		const uint32_t total = g.srcBytes() + g.gradBytes() + g.edgeBytes() + g.maskBytes() +
+		const uint32_t total = g.srcBytes() + g.gradBytes() + 2 * g.gradMargin() + g.edgeBytes() + g.maskBytes() +
 		                       kPrograms * (u1 + u2 + 2 * 4096) + 6 * 4096 + 2 * kCodeSlack;
 		device_ = &backend_.open(total, buf_);
 		buf_.src = device_->alloc(g.srcBytes());
-		buf_.grad = device_->alloc(g.gradBytes());
+		buf_.grad = device_->alloc(g.gradBytes() + 2 * g.gradMargin());
 		buf_.edge = device_->alloc(g.edgeBytes());
 		buf_.mask = device_->alloc(g.maskBytes());
 		for (int pass = 0; pass < 2; ++pass) {

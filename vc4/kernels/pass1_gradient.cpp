@@ -34,7 +34,7 @@ constexpr Reg SRC = A(0), SWMAX = A(1), STEPX = A(2), WMAX = A(3), RN = A(4), RO
 	      COLTERM = A(25), PXX = A(26), SYY = A(27), PXY = A(28), CNT = A(29),
 	      STRIPCNT = A(30), VDWTOG = A(31);
 constexpr Reg SSTRIDE = B(0), SHMAX = B(1), STEPY = B(2), HMAX = B(3), DPITCH = B(4),
-	      HM2 = B(5), Y0M4 = B(6), DSTBASE = B(7), HD = B(20), GP = B(21), SXX = B(22),
+	      HM2 = B(5), Y0M3 = B(6), DSTBASE = B(7), HD = B(20), GP = B(21), SXX = B(22),
 	      PYY = B(23), SXY = B(24), BPREV = B(25), VDWSTRIDE = B(26), VDWS = B(27),
 	      TMPB = B(29), XS = B(30);
 constexpr Reg COLOFF[5] = {B(8), B(9), B(10), B(11), B(12)};
@@ -191,7 +191,7 @@ Built build()
 	b.op(sub(HM2, r0, imm(1)));
 	b.op(mov(XS, b.uniform("x0")));
 	b.op(mov(r0, b.uniform("y0")));
-	b.op(sub(Y0M4, r0, imm(4)));
+	b.op(sub(Y0M3, r0, imm(3)));
 	b.op(mov(DSTBASE, b.uniform("dst", UniformKind::Address)));
 	b.op(mov(DPITCH, b.uniform("dst_pitch")));
 	b.op(mov(VDWSTRIDE, b.uniform("vdw_stride")));
@@ -219,16 +219,16 @@ Built build()
 		b.op(sub(r2, WMAX, r0));
 		b.op(sub(r2, r2, imm(1)));
 		b.op(bor(COLTERM, r1, r2));
-		b.op(mov(RN, Y0M4));
+		b.op(mov(RN, Y0M3));
 		b.op(mov(DSTS, DSTBASE));
 		b.op(sub(G, RN, imm(2)));
-		// Prefetch row y0-4.
+		// Prefetch row y0-3.
 		rowAddress(b);
 		for (int k = 0; k < 5; ++k)
 			b.op(add(tmuS(k), ROWADDR, COLOFF[k]));
-		// Prologue: rows y0-4 .. y0+2 fill the window (gradient rows y0-1 and y0 are the
+		// Prologue: rows y0-3 .. y0+2 fill the window (gradient rows y0-1 and y0 are the
 		// first needed: by row y0's tensor sum).
-		b.ldi(CNT, 7);
+		b.ldi(CNT, 6);
 		Label pro = b.label();
 		rowBody(b);
 		rowOutput(b);

@@ -6,8 +6,9 @@
 // result bytes pack into the lane's word and one 16-word VPM row is a 64-pixel image row.
 // Each pixel gathers 18 words through the TMUs: plane 0 (B = m << 2 | dir) of its 3x3
 // neighbourhood and the three column sums Vxx, Vyy, Vxy of columns x-1 .. x+1, at most 4
-// requests per TMU in flight. Addresses are clamped to the interior, so no read leaves the
-// frame; pixels off the interior are forced to zero. The decisions are those of
+// requests per TMU in flight. The four sub-passes are unrolled so that their addresses are
+// small-immediate offsets from six row bases. Pixels off the interior are forced to zero
+// (their reads land in the gradient buffer's margin). The decisions are those of
 // frappe-core's edgeSpan/isCorner:
 //   edge   : B > thr << 2 | 3, m > m(prev), m >= m(next)
 //   corner : c = (Sxx + Syy - 2T) >> 9, a = |Sxx - Syy| >> 9, b = |Sxy| >> 8,
@@ -22,13 +23,14 @@ namespace frappe::vc4::kernels {
 
 namespace {
 
-constexpr Reg GRAD = A(0), X0 = A(1), EDST = A(2), MDST = A(3), VPMROW = A(4), O = A(6),
-	      HALFCNT = A(7), GRPCNT = A(8), ROWCNT = A(9), JCNT = A(10), X = A(11), SH = A(12),
-	      RU = A(14), RC = A(15), RD = A(16), RXX = A(17), RYY = A(18), RXY = A(19),
-	      SXX = A(20), SXY = A(21), BAD = A(23), BC = A(5), MASKACC = A(25), VDWTOG = A(13), UNITDIFF = A(22);
-constexpr Reg PITCH = B(0), PLANE = B(1), WM2 = B(2), HM2 = B(3), CC = B(5), VDWSTRIDE = B(6),
-	      EPITCH4 = B(7), VDWS = B(8), OUTW = B(11),
-	      LANE4 = B(12), THR = B(4), SYY = B(22);
+constexpr Reg GRAD = A(0), LANEADDR = A(1), EDST = A(2), MDST = A(3), VPMROW = A(4), BC = A(5),
+	      O = A(6), HALFCNT = A(7), GRPCNT = A(8), ROWCNT = A(9), PITCHA = A(10), ROWTERM = A(11),
+	      VDWTOG = A(13), RU = A(14), RC = A(15), RD = A(16), RXX = A(17), RYY = A(18),
+	      RXY = A(19), SXX = A(20), SXY = A(21), UNITDIFF = A(22), MASKACC = A(25);
+constexpr Reg PITCH = B(0), PLANE = B(1), WM2 = B(2), HM2 = B(3), THR = B(4), CC = B(5),
+	      VDWSTRIDE = B(6), EPITCH4 = B(7), VDWS = B(8), ROWOFF = B(9), OUTW = B(11), SYY = B(22);
+// (x - 1) | (w - 2 - x) of sub-pass j's pixel: sign set off the interior columns.
+constexpr Reg COLTERM[4] = {B(18), B(19), B(20), B(21)};
 // Neighbours: up-left, up, up-right, left | right, down-left, down, down-right. Each
 // direction's pair (prev, next) sits in different files so one instruction moves both.
 constexpr Reg NB[8] = {A(26), A(27), A(28), A(29), B(14), B(15), B(16), B(17)};
@@ -40,58 +42,64 @@ struct Request {
 	int offset;
 };
 
-// One pixel per lane at (X, O): gathers, decisions, and the byte ORed into OUTW at SH.
-void pixel(Builder &b)
+// The row bases: RC = plane 0 at (x0 + 4 lane + 1, O) (the pixel of sub-pass 1), RU/RD the
+// rows above and below, RXX/RYY/RXY planes 1..3; and the row's interior term.
+void rowSetup(Builder &b)
 {
-	// Interior term (sign set off the interior) and the clamped address of (x, y).
-	b.op(sub(r0, X, imm(1)));
-	b.op(sub(r1, WM2, X));
-	b.op(bor(r0, r0, r1));
-	b.op(sub(r1, O, imm(1)));
-	b.op(bor(r0, r0, r1));
-	b.op(sub(r1, HM2, O));
-	b.op(bor(BAD, r0, r1));
-	b.op(max(r0, X, imm(1)));
-	b.op(min(r0, r0, WM2));
-	b.op(max(r1, O, imm(1)));
-	b.op(min(r1, r1, HM2));
-	b.op(shl(r0, r0, imm(2)));
-	b.op(mul24(r1, r1, PITCH));
-	b.op(add(r0, r0, r1));
-	b.op(add(RC, r0, GRAD));
+	b.op(add(RC, LANEADDR, ROWOFF));
 	b.op(sub(RU, RC, PITCH));
 	b.op(add(RD, RC, PITCH));
 	b.op(add(RXX, RC, PLANE));
 	b.op(add(RYY, RXX, PLANE));
 	b.op(add(RXY, RYY, PLANE));
+	b.op(add(ROWOFF, ROWOFF, PITCHA));
+	b.op(sub(r0, O, imm(1)));
+	b.op(sub(r1, HM2, O));
+	b.op(bor(ROWTERM, r0, r1));
+}
 
+// Sub-pass j: one pixel per lane at (x0 + 4 lane + j, O): gathers, decisions, and the
+// byte ORed into OUTW at bit 8j. The gradient buffer has a margin of one row and more on
+// each side, so the unclamped addresses of border pixels stay inside it; those pixels are
+// forced to zero.
+void pixel(Builder &b, int j)
+{
+	const int d = 4 * (j - 1);
 	const Request req[18] = {
-		{RC, 0},   {RU, -4},  {RU, 0},  {RU, 4},  {RC, -4}, {RC, 4},
-		{RD, -4},  {RD, 0},   {RD, 4},  {RXX, -4}, {RXX, 0}, {RXX, 4},
-		{RYY, -4}, {RYY, 0},  {RYY, 4}, {RXY, -4}, {RXY, 0}, {RXY, 4},
+		{RC, d},       {RU, d - 4},   {RU, d},      {RU, d + 4},   {RC, d - 4},  {RC, d + 4},
+		{RD, d - 4},   {RD, d},       {RD, d + 4},  {RXX, d - 4},  {RXX, d},     {RXX, d + 4},
+		{RYY, d - 4},  {RYY, d},      {RYY, d + 4}, {RXY, d - 4},  {RXY, d},     {RXY, d + 4},
 	};
-	auto issue = [&](int k) { b.op(add(tmuS(k), req[k].base, imm(req[k].offset))); };
-	auto pop = [&](int i) {
+	auto dest = [&](int i) { return i == 0 ? BC : NB[i - 1]; };
+	auto issue = [&](int k, bool consume) {
+		// A plane-0 pop's move rides along in the MUL pipe.
+		if (consume)
+			b.op(add(tmuS(k), req[k].base, imm(req[k].offset)), mmov(dest(k - 8), r4));
+		else
+			b.op(add(tmuS(k), req[k].base, imm(req[k].offset)));
+	};
+	auto pop = [&](int i, bool consumed_later) {
 		b.ldtmu(i & 1);
-		if (i == 0)
-			b.op(mov(BC, r4));
-		else if (i <= 8)
-			b.op(mov(NB[i - 1], r4));
-		else {
-			const Reg sum = i < 12 ? SXX : i < 15 ? SYY : SXY;
-			if ((i - 9) % 3 == 0)
-				b.op(mov(sum, r4));
-			else
-				b.op(add(sum, sum, r4));
+		if (consumed_later)
+			return;
+		if (i <= 8) {
+			b.op(mov(dest(i), r4));
+			return;
 		}
+		const Reg sum = i < 12 ? SXX : i < 15 ? SYY : SXY;
+		if ((i - 9) % 3 == 0)
+			b.op(mov(sum, r4));
+		else
+			b.op(add(sum, sum, r4));
 	};
 	for (int k = 0; k < 18; ++k) {
+		const bool merge = k >= 8 && k - 8 <= 8;
 		if (k >= 8)
-			pop(k - 8);
-		issue(k);
+			pop(k - 8, merge);
+		issue(k, merge);
 	}
 	for (int i = 10; i < 18; ++i)
-		pop(i);
+		pop(i, false);
 
 	// Neighbours along the direction: prev in r1, next in r2.
 	b.op(band(r3, BC, imm(3)));
@@ -112,7 +120,8 @@ void pixel(Builder &b)
 	b.op(band(r1, r1, r2));
 	b.op(sub(r2, THR, BC));
 	b.op(band(r1, r1, r2));
-	b.op(bnot(r2, BAD));
+	b.op(bor(r2, ROWTERM, COLTERM[j]));
+	b.op(bnot(r2, r2));
 	b.op(band(r1, r1, r2));
 	b.op(shr(r1, r1, imm(-1)));                              // edge: 0 / 1
 	// Corner: c in r0, a in r2, b in r3.
@@ -135,10 +144,12 @@ void pixel(Builder &b)
 	b.op(band(r2, r2, r1));
 	b.op(shl(r2, r2, imm(1)));
 	b.op(bor(r1, r1, r2));
-	b.op(shl(r1, r1, SH));
-	b.op(bor(OUTW, OUTW, r1));
-	b.op(add(SH, SH, imm(8)));
-	b.op(add(X, X, imm(1)));
+	if (j == 0) {
+		b.op(mov(OUTW, r1));
+	} else {
+		b.op(shl(r1, r1, imm(j == 2 ? -16 : j == 3 ? -8 : 8))); // 8j: shift counts use 5 bits
+		b.op(bor(OUTW, OUTW, r1));
+	}
 }
 
 Built build()
@@ -146,8 +157,6 @@ Built build()
 	Builder b("frappe_edge_pass");
 	b.ldi(VDWTOG, 4u << 7);
 	b.ldi(UNITDIFF, 3u << 23); // VDW units 4 -> 1
-	b.op(mov(r0, reg::elem_num));
-	b.op(shl(LANE4, r0, imm(2)));
 	b.op(mov(r0, reg::qpu_num));
 	b.op(shl(r1, r0, imm(3)));
 	b.ldi(r2, isa::VpmWriteSetup{.stride = 1, .horizontal = true, .laned = false,
@@ -159,12 +168,28 @@ Built build()
 
 	Label tile = b.label();
 	b.op(mov(GRAD, b.uniform("grad", UniformKind::Address)));
-	b.op(mov(PITCH, b.uniform("grad_pitch")));
+	b.op(mov(r0, b.uniform("grad_pitch")));
+	b.op(mov(PITCH, r0), mmov(PITCHA, r0));
 	b.op(mov(PLANE, b.uniform("plane")));
 	b.op(mov(WM2, b.uniform("wm2")));
 	b.op(mov(HM2, b.uniform("hm2")));
-	b.op(mov(X0, b.uniform("x0")));
-	b.op(mov(O, b.uniform("y0")));
+	// x of sub-pass j: x0 + 4 lane + j; LANEADDR = grad + 4 (x0 + 4 lane + 1).
+	b.op(mov(r0, b.uniform("x0")));
+	b.op(mov(r1, reg::elem_num));
+	b.op(shl(r1, r1, imm(2)));
+	b.op(add(r0, r0, r1));
+	for (int j = 0; j < 4; ++j) {
+		b.op(sub(r1, r0, imm(1 - j)));                   // x - 1
+		b.op(sub(r2, WM2, r0));
+		b.op(sub(r2, r2, imm(j)));                       // w - 2 - x
+		b.op(bor(COLTERM[j], r1, r2));
+	}
+	b.op(shl(r0, r0, imm(2)));
+	b.op(add(r0, r0, GRAD));
+	b.op(add(LANEADDR, r0, imm(4)));
+	b.op(mov(r0, b.uniform("y0")));
+	b.op(mov(O, r0), mul24(r1, r0, PITCH));
+	b.op(mov(ROWOFF, r1));
 	b.op(mov(THR, b.uniform("edge_thr")));
 	b.op(mov(CC, b.uniform("corner_c")));
 	b.op(mov(EDST, b.uniform("edge_dst", UniformKind::Address)));
@@ -181,12 +206,9 @@ Built build()
 			b.ldi(ROWCNT, 4);
 			Label row = b.label();
 			{
-				b.op(mov(OUTW, imm(0)), mmov(SH, imm(0)));
-				b.op(add(X, X0, LANE4));
-				b.ldi(JCNT, 4);
-				Label sub4 = b.label();
-				pixel(b);
-				b.loopEnd(sub4, JCNT);
+				rowSetup(b);
+				for (int j = 0; j < 4; ++j)
+					pixel(b, j);
 				b.op(mov(reg::vw_setup, VPMROW));
 				b.op(add(VPMROW, VPMROW, imm(1)));
 				b.op(mov(reg::vpm_write, OUTW));

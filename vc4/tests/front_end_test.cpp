@@ -296,7 +296,15 @@ TEST(Vc4FrontEnd, SharedImages)
 	const FrontEndParams p = params(4740, 12354); // Config's defaults 0.27 and 0.19
 	size_t runs = 0, fallback = 0, frames = 0;
 	auto cpu = makeCpuFrontEnd(1);
-	for (size_t i = 0; i < files.size() && frames < limit; i += step, ++frames) {
+	// FRAPPE_VC4_SHARD=k/n: only images i with i % n == k (to spread a full run over cores).
+	size_t shard = 0, shards = 1;
+	if (const char *sh = std::getenv("FRAPPE_VC4_SHARD"))
+		if (std::sscanf(sh, "%zu/%zu", &shard, &shards) != 2 || shards == 0 || shard >= shards)
+			shard = 0, shards = 1;
+	for (size_t i = 0; i < files.size() && frames < limit; i += step) {
+		if (i % shards != shard)
+			continue;
+		++frames;
 		const cv::Mat m = cv::imread(files[i].string(), cv::IMREAD_GRAYSCALE);
 		ASSERT_FALSE(m.empty()) << files[i];
 		const ImageView view(m.data, m.cols, m.rows, static_cast<int>(m.step));
@@ -311,6 +319,8 @@ TEST(Vc4FrontEnd, SharedImages)
 				++fallback;
 			++runs;
 		}
+		if (all && frames % 100 == 0)
+			std::printf("... %zu frames\n", frames), std::fflush(stdout);
 	}
 	std::printf("shared images: %zu frames, %zu comparisons (%zu wider than the QPU limit, on the CPU)\n", frames, runs,
 	            fallback);
