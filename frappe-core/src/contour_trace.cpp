@@ -56,6 +56,20 @@ float cross(Point2f o, Point2f a, Point2f b)
 /* More corner clusters than this on one border: clutter, not a marker. */
 constexpr std::size_t kMaxClusters = 12;
 
+/* A key that orders directions (x, y) as atan2(y, x) does, over (-pi, pi],
+ * without libm: y / (|x| + |y|) is monotonic in the angle on either side
+ * of the y axis; the left half is shifted to (1, 2] and [-2, -1). */
+float pseudoAngle(float y, float x)
+{
+	const float s = std::abs(x) + std::abs(y);
+	if (s == 0.0f)
+		return 0.0f;
+	const float p = y / s;
+	if (x >= 0.0f)
+		return p;
+	return std::signbit(y) ? -2.0f - p : 2.0f - p;
+}
+
 float dist2(Point2f a, Point2f b)
 {
 	const float dx = a.x - b.x, dy = a.y - b.y;
@@ -74,13 +88,25 @@ void ContourTracer::trace(const EdgeMap &edges, const TraceParams &params, std::
 	stride_ = w;
 	radius2_ = params.cluster_radius * params.cluster_radius;
 	labels_.resize(static_cast<std::size_t>(w) * h);
-	/* Label 1 for every edge pixel; a plain loop over local pointers that
-	 * the compiler vectorises. */
+	/* Label 1 for every edge pixel: a machine word of pixels at a time (the
+	 * compiler vectorises this where it can; without SIMD, as on ARMv6, it
+	 * still does 4 or 8 pixels per step instead of one). */
 	{
 		const std::uint8_t *src = edges.pixels.data();
 		std::uint8_t *dst = labels_.data();
 		const std::size_t n = labels_.size();
-		for (std::size_t i = 0; i < n; ++i)
+		using Word = std::uintptr_t;
+		constexpr Word kEdges = static_cast<Word>(~Word{ 0 }) / 0xFF * EdgeMap::kEdge;
+		constexpr std::size_t kStep = sizeof(Word);
+		const std::size_t whole = n / kStep * kStep;
+		const std::uint8_t *s = src;
+		for (std::uint8_t *d = dst; s != src + whole; s += kStep, d += kStep) {
+			Word a;
+			std::memcpy(&a, s, sizeof a);
+			a &= kEdges;
+			std::memcpy(d, &a, sizeof a);
+		}
+		for (std::size_t i = whole; i < n; ++i)
 			dst[i] = src[i] & EdgeMap::kEdge;
 	}
 
@@ -256,7 +282,7 @@ bool ContourTracer::quadFromClusters(Quad &quad) const
 	}
 	std::array<std::pair<float, Point2f>, kMaxClusters> byAngle{};
 	for (int i = 0; i < n; ++i)
-		byAngle[i] = { std::atan2(c[i].y - my, c[i].x - mx), c[i] };
+		byAngle[i] = { pseudoAngle(c[i].y - my, c[i].x - mx), c[i] };
 	std::sort(byAngle.begin(), byAngle.begin() + n,
 		  [](const auto &p, const auto &q) { return p.first < q.first; });
 	for (int i = 0; i < n; ++i)
@@ -292,36 +318,46 @@ bool ContourTracer::quadFromOutline(Quad &quad) const
 	}
 	mx /= static_cast<double>(n);
 	my /= static_cast<double>(n);
-	auto farthestFrom = [&](double x, double y) {
-		std::size_t best = 0;
-		double bd = -1;
-		for (std::size_t i = 0; i < n; ++i) {
-			const double dx = points_[i].x - x, dy = points_[i].y - y;
-			if (dx * dx + dy * dy > bd) {
-				bd = dx * dx + dy * dy;
-				best = i;
-			}
-		}
-		return best;
-	};
-	const std::size_t i0 = farthestFrom(mx, my);
-	const std::size_t i2 = farthestFrom(points_[i0].x, points_[i0].y);
-	const Point2f p0{ static_cast<float>(points_[i0].x), static_cast<float>(points_[i0].y) };
-	const Point2f p2{ static_cast<float>(points_[i2].x), static_cast<float>(points_[i2].y) };
-	float most = 0.0f, least = 0.0f;
-	Point2f p1{}, p3{};
-	for (const Pixel &q : points_) {
-		const Point2f p{ static_cast<float>(q.x), static_cast<float>(q.y) };
-		const float c = cross(p0, p2, p);
-		if (c > most) {
-			most = c;
-			p1 = p;
-		} else if (c < least) {
-			least = c;
-			p3 = p;
+	std::size_t i0 = 0;
+	double bd = -1;
+	for (std::size_t i = 0; i < n; ++i) {
+		const double dx = points_[i].x - mx, dy = points_[i].y - my;
+		if (dx * dx + dy * dy > bd) {
+			bd = dx * dx + dy * dy;
+			i0 = i;
 		}
 	}
-	if (most <= 0.0f || least >= 0.0f)
+	/* The rest in integers (coordinates below 2^15, so squares and cross
+	 * products fit an int32; in float they were exact too). */
+	const int x0 = points_[i0].x, y0 = points_[i0].y;
+	std::size_t i2 = 0;
+	std::int32_t bd2 = -1;
+	for (std::size_t i = 0; i < n; ++i) {
+		const std::int32_t dx = points_[i].x - x0, dy = points_[i].y - y0;
+		if (dx * dx + dy * dy > bd2) {
+			bd2 = dx * dx + dy * dy;
+			i2 = i;
+		}
+	}
+	const int ex = points_[i2].x - x0, ey = points_[i2].y - y0;
+	std::int32_t most = 0, least = 0;
+	std::size_t i1 = 0, i3 = 0;
+	for (std::size_t i = 0; i < n; ++i) {
+		/* cross(p0, p2, p) */
+		const std::int32_t c = ex * (points_[i].y - y0) - ey * (points_[i].x - x0);
+		if (c > most) {
+			most = c;
+			i1 = i;
+		} else if (c < least) {
+			least = c;
+			i3 = i;
+		}
+	}
+	auto pt = [&](std::size_t i) {
+		return Point2f{ static_cast<float>(points_[i].x), static_cast<float>(points_[i].y) };
+	};
+	const Point2f p0 = pt(i0), p1 = pt(i1), p2 = pt(i2), p3 = pt(i3);
+	if (most <= 0 || least >= 0)
 		return false;
 	quad.corners = { p0, p1, p2, p3 };
 	return true;

@@ -37,7 +37,11 @@ bool fitSide(const ImageView &img, Point2f a, Point2f b, float search, int maxSa
 	if (usable <= 0.0f)
 		return false;
 	const int nSamples = std::clamp(static_cast<int>(usable / 1.5f), 3, maxSamples);
-	const int half = std::min(kMaxProfile / 2 - 1, static_cast<int>(std::ceil(search / kProfileStep)) + 1);
+	/* ceil without libm (ARMv6 has no rounding instruction) */
+	const float steps = search / kProfileStep;
+	int stepsUp = static_cast<int>(steps);
+	stepsUp += static_cast<float>(stepsUp) < steps;
+	const int half = std::min(kMaxProfile / 2 - 1, stepsUp + 1);
 
 	double sw = 0, sx = 0, sy = 0, sxx = 0, syy = 0, sxy = 0;
 	int used = 0;
@@ -102,9 +106,24 @@ bool fitSide(const ImageView &img, Point2f a, Point2f b, float search, int maxSa
 	 * eigenvector of the smaller eigenvalue. */
 	const double mx = sx / sw, my = sy / sw;
 	const double cxx = sxx / sw - mx * mx, cyy = syy / sw - my * my, cxy = sxy / sw - mx * my;
-	const double theta = 0.5 * std::atan2(2.0 * cxy, cxx - cyy); /* major axis */
-	line.nx = -std::sin(theta);
-	line.ny = std::cos(theta);
+	/* The major axis is at theta = atan2(2 cxy, cxx - cyy) / 2, in
+	 * (-pi/2, pi/2]; its cosine and sine from the half-angle formulas, with
+	 * square roots only (one VFP instruction each; atan2, sin and cos are
+	 * thousands of instructions in a soft-float libm). */
+	const double d = cxx - cyy, e = 2.0 * cxy;
+	const double r = std::sqrt(d * d + e * e);
+	double cosT = 1.0, sinT = 0.0;
+	if (r > 0.0) {
+		if (d >= 0.0) {
+			cosT = std::sqrt((r + d) / (2.0 * r));
+			sinT = e / (2.0 * r * cosT);
+		} else {
+			sinT = std::copysign(std::sqrt((r - d) / (2.0 * r)), e);
+			cosT = e / (2.0 * r * sinT);
+		}
+	}
+	line.nx = -sinT;
+	line.ny = cosT;
 	line.c = line.nx * mx + line.ny * my;
 	return true;
 }
