@@ -424,6 +424,7 @@ static bool select_front_end(GstFrappeDetect *self, frappe::Detector &detector)
 					    ("backend=auto: %s", choice.fallback.c_str()));
 		}
 		detector.setFrontEnd(std::move(choice.frontEnd));
+		detector.setWarper(std::move(choice.warper));
 	} catch (const std::exception &e) {
 		GST_ELEMENT_ERROR(self, RESOURCE, OPEN_READ, ("Backend %s cannot be used", name), ("%s", e.what()));
 		return false;

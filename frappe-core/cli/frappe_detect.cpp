@@ -243,6 +243,7 @@ int main(int argc, char **argv)
 				std::cerr << "frappe-detect: the QPUs cannot be used (" << choice.fallback
 					  << "); using the CPU front end\n";
 			detector->setFrontEnd(std::move(choice.frontEnd));
+			detector->setWarper(std::move(choice.warper));
 #else
 			if (opt.backend != "auto")
 				throw std::runtime_error("backend " + opt.backend + " needs the vc4 part, which this build lacks");

@@ -14,10 +14,14 @@ namespace frappe::detail {
 bool warpMarker(const ImageView &image, const std::array<Point2f, 4> &corners, int bits,
 		WarpedMarker &out)
 {
+	return warpToGrid(image, corners, (bits + 2) * kSamplesPerCell, out);
+}
+
+bool warpToGrid(const ImageView &image, const std::array<Point2f, 4> &corners, int side, WarpedMarker &out)
+{
 	const auto H = Homography::fromUnitSquare(corners);
 	if (!H)
 		return false;
-	const int side = (bits + 2) * kSamplesPerCell;
 	out.side = side;
 	const double step = 1.0 / side;
 	for (int j = 0; j < side; ++j) {
@@ -129,3 +133,27 @@ Decoded decode(const Dictionary &dict, std::uint64_t code, int maxHamming)
 }
 
 } // namespace frappe::detail
+
+namespace frappe {
+
+namespace {
+
+class CpuWarper final : public CandidateWarper {
+public:
+	const char *name() const override { return "cpu"; }
+	void warp(const ImageView &image, std::span<const std::array<Point2f, 4>> quads, int side,
+		  std::span<CandidateSamples> out, std::span<std::uint8_t> ok) override
+	{
+		for (std::size_t k = 0; k < quads.size(); ++k)
+			ok[k] = detail::warpToGrid(image, quads[k], side, out[k]) ? 1 : 0;
+	}
+};
+
+} // namespace
+
+std::unique_ptr<CandidateWarper> makeCpuWarper()
+{
+	return std::make_unique<CpuWarper>();
+}
+
+} // namespace frappe

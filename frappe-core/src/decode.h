@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "frappe/candidate_warp.h"
 #include "frappe/dictionary.h"
 #include "frappe/image.h"
 
@@ -15,13 +16,12 @@ namespace frappe::detail {
 constexpr int kSamplesPerCell = 2;
 
 /// The warped samples of one candidate: (bits + 2) cells a side, 2x2 samples
-/// a cell (16x16 for 6x6 codes), row-major, sample (i, j) at cell
-/// coordinates ((i + 0.5) / 2, (j + 0.5) / 2).
-struct WarpedMarker {
-	int side = 0; ///< samples per side
-	std::array<float, 20 * 20> samples{};
-	float at(int x, int y) const { return samples[static_cast<std::size_t>(y) * side + x]; }
-};
+/// a cell (16x16 for 6x6 codes).
+using WarpedMarker = CandidateSamples;
+
+/// Warps the quad into `side` x `side` samples (CandidateSamples' grid).
+/// False when the quad is degenerate.
+bool warpToGrid(const ImageView &image, const std::array<Point2f, 4> &corners, int side, WarpedMarker &out);
 
 /// Warps the quad (clockwise, corners[0] mapped to the grid's top-left) into
 /// the sample grid of a marker with `bits` bits a side. False when the quad

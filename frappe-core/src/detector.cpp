@@ -120,6 +120,7 @@ struct Detector::Impl {
 	int maxHamming = 0;
 	FrontEndParams params;
 	std::unique_ptr<FrontEnd> frontEnd;
+	std::unique_ptr<CandidateWarper> warper; /* nullptr: warp on the CPU, one by one */
 	/* Read by the front end, written by the back end: in pipelined use
 	 * they run on different threads. */
 	std::mutex adaptiveLock;
@@ -137,10 +138,18 @@ struct Detector::Impl {
 	 * at once: the tracer by runTrace(), the warp buffer by runFinish(). */
 	detail::ContourTracer tracer;
 	detail::WarpedMarker warped;
+	/* With a batch warper: per candidate, the traced outline, whether it
+	 * refined, and its samples (runFinish() only). */
+	struct Batch {
+		std::vector<std::array<Point2f, 4>> outlines, quads;
+		std::vector<std::uint8_t> refined, warpedOk;
+		std::vector<CandidateSamples> samples;
+	} batch;
 
 	void checkImage(const ImageView &image) const;
 	void trace(Slot &slot);
 	void finish(const ImageView &image, Slot &slot);
+	void refineAndWarpAll(const ImageView &image, Slot &slot, float search, double &refineMs, double &warpMs);
 	Slot &slotAt(int slot)
 	{
 		return const_cast<Slot &>(static_cast<const Impl *>(this)->slotAt(slot));
@@ -188,6 +197,28 @@ void Detector::Impl::trace(Slot &slot)
 	slot.result.times[Stage::Trace] = msSince(t);
 }
 
+/* Batch mode: every candidate refined, then all warped in one call. */
+void Detector::Impl::refineAndWarpAll(const ImageView &image, Slot &slot, float search, double &refineMs,
+				      double &warpMs)
+{
+	const std::size_t n = slot.quads.size();
+	batch.outlines.resize(n);
+	batch.quads.resize(n);
+	batch.refined.resize(n);
+	batch.warpedOk.assign(n, 0);
+	batch.samples.resize(n);
+	auto t = Clock::now();
+	for (std::size_t k = 0; k < n; ++k) {
+		batch.outlines[k] = slot.quads[k].corners;
+		batch.refined[k] = detail::refineCorners(image, slot.quads[k].corners, search);
+		batch.quads[k] = slot.quads[k].corners;
+	}
+	refineMs += msSince(t);
+	t = Clock::now();
+	warper->warp(image, batch.quads, (dict->bits + 2) * detail::kSamplesPerCell, batch.samples, batch.warpedOk);
+	warpMs += msSince(t);
+}
+
 void Detector::Impl::finish(const ImageView &image, Slot &slot)
 {
 	Result &res = slot.result;
@@ -202,27 +233,40 @@ void Detector::Impl::finish(const ImageView &image, Slot &slot)
 	const int whiteFrame = 3 * bits + 3; /* three quarters of the 4(n+1) border cells */
 	double refineMs = 0, warpMs = 0, decodeMs = 0;
 	for (detail::Quad &q : slot.quads) {
-		t = Clock::now();
 		for (Point2f &p : q.corners) {
 			p.x = (p.x + 0.5f) / scale - 0.5f;
 			p.y = (p.y + 0.5f) / scale - 0.5f;
 		}
-		if (surroundsDecoded(q.corners, quadArea(q.corners), res.markers)) {
+	}
+	refineMs += msSince(t);
+	const bool batched = warper != nullptr;
+	if (batched)
+		refineAndWarpAll(image, slot, search, refineMs, warpMs);
+	for (std::size_t k = 0; k < slot.quads.size(); ++k) {
+		detail::Quad &q = slot.quads[k];
+		t = Clock::now();
+		const std::array<Point2f, 4> outline = batched ? batch.outlines[k] : q.corners;
+		if (surroundsDecoded(outline, quadArea(outline), res.markers)) {
 			refineMs += msSince(t);
 			continue;
 		}
-		std::array<Point2f, 4> outline = q.corners;
-		bool refined = detail::refineCorners(image, q.corners, search);
+		bool refined = batched ? batch.refined[k] != 0 : detail::refineCorners(image, q.corners, search);
 		refineMs += msSince(t);
 		detail::Binarised b;
 		if (refined && sidesAtLeast(q.corners, config.min_marker_side)) {
 			++res.candidates;
 			t = Clock::now();
-			refined = detail::warpMarker(image, q.corners, bits, warped);
+			const detail::WarpedMarker *samples = &warped;
+			if (batched) {
+				refined = batch.warpedOk[k] != 0;
+				samples = &batch.samples[k];
+			} else {
+				refined = detail::warpMarker(image, q.corners, bits, warped);
+			}
 			warpMs += msSince(t);
 			t = Clock::now();
 			if (refined)
-				b = detail::binarise(warped, bits);
+				b = detail::binarise(*samples, bits);
 			decodeMs += msSince(t);
 		}
 		if (!refined || b.border_errors >= whiteFrame) {
@@ -250,7 +294,7 @@ void Detector::Impl::finish(const ImageView &image, Slot &slot)
 			/* Refinement can pull a small, blurred marker's sides onto its
 			 * code's edges; the traced outline may still read. */
 			t = Clock::now();
-			std::array<Point2f, 4> traced = outline;
+			const std::array<Point2f, 4> traced = outline;
 			if (detail::warpMarker(image, traced, bits, warped)) {
 				const detail::Binarised bt = detail::binarise(warped, bits);
 				if (bt.contrast >= 10.0f && bt.border_errors <= borderAllowance) {
@@ -384,6 +428,8 @@ void Detector::setFrontEnd(std::unique_ptr<FrontEnd> frontEnd)
 }
 
 const FrontEnd &Detector::frontEnd() const { return *impl_->frontEnd; }
+void Detector::setWarper(std::unique_ptr<CandidateWarper> warper) { impl_->warper = std::move(warper); }
+const CandidateWarper *Detector::warper() const { return impl_->warper.get(); }
 const EdgeMap &Detector::edgeMap(int slot) const { return impl_->slotAt(slot).edges; }
 void Detector::reset()
 {

@@ -130,3 +130,39 @@ TEST(RenderedMarkers, CornersFollowSubPixelPhase)
 		}
 	}
 }
+
+/* A batch warper (here the CPU's own, through the interface a QPU warper
+ * implements) must give exactly the markers of the one-by-one path, on a
+ * frame with many candidates, nested outlines and clutter. */
+TEST(RenderedMarkers, BatchWarpGivesTheSameMarkers)
+{
+	const Dictionary &dict = *findDictionary("aruco_mip_36h12");
+	Image img(640, 480, 90);
+	std::mt19937 rng(3);
+	for (int id = 0; id < 18; ++id) {
+		const auto q = squarePose(60.0f + (id % 6) * 104.0f, 80.0f + (id / 6) * 150.0f, 24.0f + 4.0f * id,
+					 17.0f * id, static_cast<float>((id * 11) % 55));
+		RenderOptions opt;
+		opt.quiet_cells = 1 + id % 3;
+		renderMarker(img.mut(), dict, id, q, opt);
+	}
+	blur(img, 0.7f);
+	addNoise(img, 3.0f, rng);
+
+	Detector oneByOne(Config{});
+	Detector batched(Config{});
+	batched.setWarper(makeCpuWarper());
+	ASSERT_NE(batched.warper(), nullptr);
+	const Result a = oneByOne.detect(img.view());
+	const Result &b = batched.detect(img.view());
+	EXPECT_GE(a.markers.size(), 12u);
+	ASSERT_EQ(a.markers.size(), b.markers.size());
+	for (std::size_t i = 0; i < a.markers.size(); ++i) {
+		EXPECT_EQ(a.markers[i].id, b.markers[i].id);
+		EXPECT_EQ(a.markers[i].hamming, b.markers[i].hamming);
+		for (int k = 0; k < 4; ++k) {
+			EXPECT_EQ(a.markers[i].corners[k].x, b.markers[i].corners[k].x);
+			EXPECT_EQ(a.markers[i].corners[k].y, b.markers[i].corners[k].y);
+		}
+	}
+}

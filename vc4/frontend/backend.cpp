@@ -4,6 +4,7 @@
 #include <stdexcept>
 
 #include "frontend/vc4_front_end.hpp"
+#include "frontend/vc4_warper.hpp"
 
 namespace frappe::vc4 {
 
@@ -12,10 +13,10 @@ BackendChoice selectFrontEnd(std::string_view name, int threads)
 	BackendChoice choice;
 	if (name == "cpu") {
 		choice.frontEnd = makeCpuFrontEnd(threads);
-	} else if (name == "vc4") {
-		choice.frontEnd = makeFrontEnd(FrontEndOptions{ .emulate = false });
-	} else if (name == "vc4-emu") {
-		choice.frontEnd = makeFrontEnd(FrontEndOptions{ .emulate = true });
+	} else if (name == "vc4" || name == "vc4-emu") {
+		const FrontEndOptions options{ .emulate = name == "vc4-emu" };
+		choice.frontEnd = makeFrontEnd(options);
+		choice.warper = makeWarper(options);
 	} else if (name == "auto") {
 #if !defined(__arm__) && !defined(__aarch64__)
 		/* No VideoCore IV outside a Raspberry Pi: nothing to probe or say. */
@@ -28,7 +29,9 @@ BackendChoice selectFrontEnd(std::string_view name, int threads)
 		if (reason.empty()) {
 			try {
 				choice.frontEnd = makeFrontEnd(FrontEndOptions{ .emulate = false });
+				choice.warper = makeWarper(FrontEndOptions{ .emulate = false });
 			} catch (const std::exception &e) {
+				choice.frontEnd.reset();
 				choice.fallback = e.what();
 			}
 		} else {

@@ -8,12 +8,15 @@
 #include <string>
 #include <string_view>
 
+#include "frappe/candidate_warp.h"
 #include "frappe/edge_map.h"
 
 namespace frappe::vc4 {
 
 struct BackendChoice {
 	std::unique_ptr<frappe::FrontEnd> frontEnd;
+	/// The QPU warp of the candidates for vc4 and vc4-emu; nullptr for the CPU.
+	std::unique_ptr<frappe::CandidateWarper> warper;
 	/// Set when "auto" fell back to the CPU: why the QPUs were not used, in
 	/// one sentence, for a single warning.
 	std::string fallback;
@@ -23,7 +26,7 @@ struct BackendChoice {
 inline constexpr std::string_view kBackendNames = "auto, cpu, vc4, vc4-emu";
 
 /// "cpu": the reference CPU front end with `threads` bands. "vc4": the QPU
-/// kernels on the real GPU; throws std::runtime_error with the probe's reason
+/// kernels (front end and candidate warp) on the real GPU; throws std::runtime_error with the probe's reason
 /// when it cannot be used. "vc4-emu": the same kernels on the emulator, bit
 /// for bit what the GPU computes (slow: for tests and estimates). "auto": vc4
 /// when the probe succeeds, else the CPU with `fallback` set. Throws

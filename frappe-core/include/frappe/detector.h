@@ -7,6 +7,7 @@
 #include <string_view>
 #include <vector>
 
+#include "frappe/candidate_warp.h"
 #include "frappe/config.h"
 #include "frappe/dictionary.h"
 #include "frappe/edge_map.h"
@@ -93,6 +94,13 @@ public:
 	/// is the CPU front end.
 	void setFrontEnd(std::unique_ptr<FrontEnd> frontEnd);
 	const FrontEnd &frontEnd() const;
+
+	/// Hands the perspective warp to `warper` (for example the QPUs): the
+	/// frame's candidates are then refined first and warped in one batch.
+	/// nullptr (the default) warps each candidate on the CPU as it comes.
+	void setWarper(std::unique_ptr<CandidateWarper> warper);
+	/// The batch warper, or nullptr.
+	const CandidateWarper *warper() const;
 
 	/// The edge map of a slot's last frame, for visualisation and tests.
 	const EdgeMap &edgeMap(int slot = 0) const;

@@ -2,6 +2,7 @@
 // frappe/frappe.h: the whole public API of frappe-core.
 #pragma once
 
+#include "frappe/candidate_warp.h"
 #include "frappe/config.h"
 #include "frappe/detector.h"
 #include "frappe/dictionary.h"

@@ -1,0 +1,32 @@
+// SPDX-License-Identifier: MIT
+// frappe::CandidateWarper on the VideoCore IV QPUs: PERSPECTIVE_WARP of a frame's
+// candidates, up to 32 a launch (kernels/warp.hpp), on the real GPU or the emulator.
+//
+// The kernel is exact integer arithmetic (kernels/warp_reference.hpp), not frappe-core's
+// float warp: samples differ from the CPU's by at most 0.8 grey levels, so a cell whose
+// mean lies that close to the binarisation threshold can read differently. Candidates the
+// fixed point cannot hold (warpParams() refuses them) and codes wider than 6x6 (more than
+// 16 samples a side) are warped on the CPU.
+#pragma once
+
+#include <memory>
+
+#include "frappe/candidate_warp.h"
+#include "frontend/vc4_front_end.hpp"
+
+namespace frappe::vc4 {
+
+/// options.emulate selects the emulator; otherwise the real GPU, and then throws
+/// std::runtime_error with the probe's reason when it cannot be used.
+std::unique_ptr<frappe::CandidateWarper> makeWarper(const FrontEndOptions &options = {});
+
+/// Candidates of the last warp() call that ran on the QPUs, and the launches it took.
+struct WarpCounts {
+	unsigned on_qpus = 0;
+	unsigned on_cpu = 0;
+	unsigned launches = 0;
+};
+/// False when `warper` is not a VC4 warper.
+bool lastWarpCounts(const frappe::CandidateWarper &warper, WarpCounts &out);
+
+} // namespace frappe::vc4
