@@ -88,25 +88,13 @@ void ContourTracer::trace(const EdgeMap &edges, const TraceParams &params, std::
 	stride_ = w;
 	radius2_ = params.cluster_radius * params.cluster_radius;
 	labels_.resize(static_cast<std::size_t>(w) * h);
-	/* Label 1 for every edge pixel: a machine word of pixels at a time (the
-	 * compiler vectorises this where it can; without SIMD, as on ARMv6, it
-	 * still does 4 or 8 pixels per step instead of one). */
+	/* Label 1 for every edge pixel; a plain loop over local pointers that
+	 * the compiler vectorises. */
 	{
 		const std::uint8_t *src = edges.pixels.data();
 		std::uint8_t *dst = labels_.data();
 		const std::size_t n = labels_.size();
-		using Word = std::uintptr_t;
-		constexpr Word kEdges = static_cast<Word>(~Word{ 0 }) / 0xFF * EdgeMap::kEdge;
-		constexpr std::size_t kStep = sizeof(Word);
-		const std::size_t whole = n / kStep * kStep;
-		const std::uint8_t *s = src;
-		for (std::uint8_t *d = dst; s != src + whole; s += kStep, d += kStep) {
-			Word a;
-			std::memcpy(&a, s, sizeof a);
-			a &= kEdges;
-			std::memcpy(d, &a, sizeof a);
-		}
-		for (std::size_t i = whole; i < n; ++i)
+		for (std::size_t i = 0; i < n; ++i)
 			dst[i] = src[i] & EdgeMap::kEdge;
 	}
 

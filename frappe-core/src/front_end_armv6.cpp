@@ -165,54 +165,62 @@ void gradientRowV6(const std::uint8_t *a, const std::uint8_t *b, const std::uint
 	mag[w - 1] = 0;
 	int x = 1;
 	if (w >= 16) {
-		/* Pass 1, per word of four pixels: the column sums vs = a + 2b + c
-		 * and differences vd = c - a, even and odd lanes: VSE VSO VDE VDO. */
-		std::uint8_t *cols = reinterpret_cast<std::uint8_t *>(tmp); /* 2w int16 = w words */
+		/* Pass 1: the column sums vs = a + 2b + c and differences
+		 * vd = c - a, in natural order (int16). Four columns per step:
+		 * even and odd lanes, then packed back in order with PKHBT/PKHTB. */
+		std::uint8_t *vs = reinterpret_cast<std::uint8_t *>(tmp);
+		std::uint8_t *vd = vs + 2 * (w + (w & 1)); /* word-aligned (RowScratch: 2w + 2) */
 		const int words = w / 4;
 		for (int k = 0; k < words; ++k) {
 			const u32 wa = load32(a + 4 * k), wb = load32(b + 4 * k), wc = load32(c + 4 * k);
 			const u32 ea = evenBytes(wa), eb = evenBytes(wb), ec = evenBytes(wc);
 			const u32 oa = oddBytes(wa), ob = oddBytes(wb), oc = oddBytes(wc);
-			std::uint8_t *o = cols + 16 * k;
-			store32(o, ea + ec + (eb << 1));
-			store32(o + 4, oa + oc + (ob << 1));
-			store32(o + 8, ssub16(ec, ea));
-			store32(o + 12, ssub16(oc, oa));
+			const u32 se = ea + ec + (eb << 1), so = oa + oc + (ob << 1);
+			const u32 de = ssub16(ec, ea), dO = ssub16(oc, oa);
+			store32(vs + 8 * k, pkhbt16(se, so));
+			store32(vs + 8 * k + 4, pkhtb16(so, se));
+			store32(vd + 8 * k, pkhbt16(de, dO));
+			store32(vd + 8 * k + 4, pkhtb16(dO, de));
 		}
-		/* Pass 2: gx = vs[x+1] - vs[x-1], gy = vd[x-1] + 2 vd[x] + vd[x+1],
-		 * in signed lanes; word k needs word k+1's first column. Pixel 0
-		 * is computed from garbage and overwritten below. */
-		u32 prevS = 0, prevD = 0;
-		u32 se = load32(cols), so = load32(cols + 4), de = load32(cols + 8), dO = load32(cols + 12);
-		for (int k = 0; k + 1 < words; ++k) {
-			const std::uint8_t *n = cols + 16 * (k + 1);
-			const u32 nse = load32(n), nso = load32(n + 4), nde = load32(n + 8), ndo = load32(n + 12);
-			const u32 gxE = ssub16(so, prevS | (so << 16));
-			const u32 gyE = sadd16(sadd16(prevD | (dO << 16), dO), sadd16(de, de));
-			const u32 gxO = ssub16((se >> 16) | (nse << 16), se);
-			const u32 gyO = sadd16(sadd16(de, (de >> 16) | (nde << 16)), sadd16(dO, dO));
-			const u32 p0 = pkhbt16(gxE, gyE), p2 = pkhtb16(gyE, gxE);
-			const u32 p1 = pkhbt16(gxO, gyO), p3 = pkhtb16(gyO, gxO);
-			std::uint8_t *pp = pairs + 16 * k;
-			store32(pp, p0);
-			store32(pp + 4, p1);
-			store32(pp + 8, p2);
-			store32(pp + 12, p3);
-			std::int32_t *m = mag + 4 * k;
-			m[0] = smuad(p0);
-			m[1] = smuad(p1);
-			m[2] = smuad(p2);
-			m[3] = smuad(p3);
-			prevS = so >> 16;
-			prevD = dO >> 16;
-			se = nse;
-			so = nso;
-			de = nde;
-			dO = ndo;
+		for (int i = 4 * words; i < w; ++i) {
+			const std::int16_t s2 = static_cast<std::int16_t>(a[i] + 2 * b[i] + c[i]);
+			const std::int16_t d2 = static_cast<std::int16_t>(c[i] - a[i]);
+			std::memcpy(vs + 2 * i, &s2, 2);
+			std::memcpy(vd + 2 * i, &d2, 2);
 		}
-		storePair(0, 0);
-		mag[0] = 0;
-		x = std::max(1, 4 * (words - 1));
+		/* Pass 2, pixels x and x+1 (x odd, so the loads at x-1 and x+1
+		 * are word-aligned): gx = vs[x+1] - vs[x-1] is one SSUB16,
+		 * gy = vd[x-1] + 2 vd[x] + vd[x+1] three SADD16, then the (gx, gy)
+		 * pairs and gx^2 + gy^2 by SMUAD. */
+		std::uint8_t *pp = pairs + 4;
+		std::int32_t *m = mag + 1;
+		const std::uint8_t *s0 = vs;
+		const std::ptrdiff_t dOff = vd - vs;
+		auto two = [&](u32 sl, u32 sr, u32 dl, u32 dr, std::uint8_t *p, std::int32_t *mm) {
+			const u32 gxw = ssub16(sr, sl);
+			const u32 dm = (dl >> 16) | (dr << 16);
+			const u32 gyw = sadd16(sadd16(dl, dr), sadd16(dm, dm));
+			const u32 p0 = pkhbt16(gxw, gyw), p1 = pkhtb16(gyw, gxw);
+			store32(p, p0);
+			store32(p + 4, p1);
+			mm[0] = smuad(p0);
+			mm[1] = smuad(p1);
+		};
+		const int pairsN = (w - 2) / 2; /* x = 1, 3, ... while x + 1 <= w - 2 */
+		/* Four pixels per step; the words at x+1 are the next step's x-1. */
+		const std::uint8_t *const s4End = vs + 8 * (pairsN / 2);
+		u32 sl = load32(s0), dl = load32(s0 + dOff);
+		for (; s0 != s4End; s0 += 8, pp += 16, m += 4) {
+			const u32 sm = load32(s0 + 4), dm = load32(s0 + dOff + 4);
+			const u32 sr = load32(s0 + 8), dr = load32(s0 + dOff + 8);
+			two(sl, sm, dl, dm, pp, m);
+			two(sm, sr, dm, dr, pp + 8, m + 2);
+			sl = sr;
+			dl = dr;
+		}
+		if (pairsN & 1)
+			two(load32(s0), load32(s0 + 4), load32(s0 + dOff), load32(s0 + dOff + 4), pp, m);
+		x = 1 + 2 * pairsN;
 	}
 	for (; x < w - 1; ++x)
 		storePair(x, gradientPair(a, b, c, x, mag[x]));
