@@ -213,8 +213,7 @@ public:
 					const int bx = 4 * tx + b, by = 2 * ty + half;
 					if (bx >= out.tiles_x || by >= out.tiles_y)
 						continue;
-					const uint32_t *w4 = words + 16 * half + 4 * b;
-					if (w4[0] | w4[1] | w4[2] | w4[3])
+					if (words[16 * half + 4 * b + 3])
 						out.tiles[static_cast<size_t>(by) * out.tiles_x + bx] = 1;
 				}
 		}

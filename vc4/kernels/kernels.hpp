@@ -31,9 +31,9 @@
 // Edge output: one byte per pixel (EdgeMap::kEdge | kCorner), rows of paddedWidth bytes.
 // Pass 2 lanes hold pixels 4i + j (j = 0..3 in four sub-passes), so four bytes pack into the
 // lane's word and a 16-word VPM row is a 64-pixel image row.
-// Mask output: per tile two rows of 16 words (rows 0-15 and 16-31 of the tile); word i is
-// the OR of the edge words of lane i over those 16 rows, so 16x16 block t of the tile is
-// non-empty when words 4t .. 4t+3 are not all zero (maskBlocks() reduces them).
+// Mask output: per tile two rows of 16 words (rows 0-15 and 16-31 of the tile); word 4t+3
+// of a row is non-zero when the 16x16 block t of those rows holds an edge pixel (it is
+// the OR of the block's edge bytes; the other words are partial ORs, ignored).
 //
 // VPM: each QPU uses the 8 rows starting at 8 * qpu_num (96 of the 192 rows), so twelve
 // invocations run at once with no locking of VPM space; VDW setup and start are done under

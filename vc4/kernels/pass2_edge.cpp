@@ -14,7 +14,7 @@
 //   corner : c = (Sxx + Syy - 2T) >> 9, a = |Sxx - Syy| >> 9, b = |Sxy| >> 8,
 //            c > 0 and c*c > a*a + b*b (mul24 of values below 2^16)
 // Four rows leave by one VDW, double-buffered in the QPU's 8 VPM rows; after 16 rows the
-// OR of the edge words goes out as the tile's mask row.
+// OR of the edge words, reduced over each 16x16 block, goes out as the tile's mask row.
 #include "isa/setup_words.hpp"
 #include "kernels/builder.hpp"
 #include "kernels/kernels.hpp"
@@ -229,13 +229,18 @@ Built build()
 			b.op(bxor(VDWS, VDWS, VDWTOG));
 		}
 		b.loopEnd(group, GRPCNT);
-		// The mask row of these 16 rows, through the current (idle) VPM half.
-		b.op(mov(reg::vw_setup, VPMROW));
-		b.op(mov(reg::vpm_write, MASKACC));
-		b.op(sub(r0, VDWS, UNITDIFF));
+		// The mask row of these 16 rows, through the current (idle) VPM half: lane 4t+3
+		// gets the OR of lanes 4t .. 4t+3 (two vector rotations), i.e. of block t.
+		b.op(mov(r0, MASKACC));
+		b.op(mov(reg::vw_setup, VPMROW)); // (a rotation must not read r0 just written)
+		b.op(mmov(r1, r0).rot(1));
+		b.op(bor(r0, r0, r1));
+		b.op(sub(r2, VDWS, UNITDIFF));
+		b.op(mmov(r1, r0).rot(2));
+		b.op(bor(reg::vpm_write, r0, r1));
 		b.op(mov(reg::nop, reg::mutex_acq));
 		b.op(mov(reg::vw_setup, VDWSTRIDE));
-		b.op(mov(reg::vw_setup, r0));
+		b.op(mov(reg::vw_setup, r2));
 		b.op(mov(reg::vw_addr, MDST));
 		b.op(mov(reg::mutex_rel, imm(1)));
 		b.ldi(r0, 64);

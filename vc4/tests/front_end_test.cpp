@@ -239,6 +239,24 @@ TEST(Vc4FrontEnd, SizesAndScales)
 	}
 }
 
+// A flat frame with one marker: most 16x16 blocks empty, some not.
+TEST(Vc4FrontEnd, SparseTileMask)
+{
+	for (const int w : {200, 131}) {
+		Img img{w, 130, w, std::vector<uint8_t>(static_cast<size_t>(w) * 130, 128)};
+		MutableImageView m{img.pixels.data(), img.width, img.height, img.stride};
+		renderMarker(m, *findDictionary("aruco_mip_36h12"), 3, perspectiveSquare(w * 0.6f, 70, 40, 20, 10),
+		             {.quiet_cells = 1, .supersample = 2, .black = 25, .white = 225});
+		EdgeMap want, got;
+		makeCpuFrontEnd(1)->run(img.view(), 1.0f, params(), want);
+		vc4::makeFrontEnd({.seed = 9})->run(img.view(), 1.0f, params(), got);
+		expectSame(got, want, "sparse " + std::to_string(w));
+		const auto set = std::count(want.tiles.begin(), want.tiles.end(), 1);
+		EXPECT_GT(set, 0);
+		EXPECT_LT(set, static_cast<long>(want.tiles.size()) / 2);
+	}
+}
+
 TEST(Vc4FrontEnd, Thresholds)
 {
 	const Img img = scene(150, 90, 7, 2);
