@@ -10,6 +10,7 @@
 #include <random>
 
 #include "asm/text.hpp"
+#include "frappe/detector.h"
 #include "frappe/edge_map.h"
 #include "front_end_rows.h" // frappe-core's row kernels (internal header)
 #include "isa/disasm.hpp"
@@ -236,6 +237,37 @@ TEST(Vc4FrontEnd, SizesAndScales)
 		const std::string what = std::to_string(c.w) + "x" + std::to_string(c.h) + " scale " + std::to_string(c.scale);
 		compare(img, c.scale, params(), 0, what);
 		EXPECT_GT(last_edges, 0u) << what;
+	}
+}
+
+// The whole detector with its front end on the emulator ("vc4-emu"): the same markers,
+// corners and edge maps as with the CPU front end, in Normal and AScale modes.
+TEST(Vc4FrontEnd, WholeDetector)
+{
+	for (const Mode mode : {Mode::Normal, Mode::AScale}) {
+		Config config;
+		config.mode = mode;
+		Detector cpu(config), qpu(config);
+		qpu.setFrontEnd(vc4::makeFrontEnd({.seed = 4}));
+		ASSERT_STREQ(qpu.frontEnd().name(), "vc4-emu");
+		size_t found = 0;
+		for (int frame = 0; frame < 3; ++frame) {
+			const Img img = scene(320, 240, 40 + frame, 3);
+			const Result want = cpu.detect(img.view());
+			const Result got = qpu.detect(img.view());
+			expectSame(qpu.edgeMap(), cpu.edgeMap(), "detector frame " + std::to_string(frame));
+			EXPECT_EQ(got.scale, want.scale);
+			ASSERT_EQ(got.markers.size(), want.markers.size()) << "frame " << frame;
+			for (size_t i = 0; i < want.markers.size(); ++i) {
+				EXPECT_EQ(got.markers[i].id, want.markers[i].id);
+				for (int c = 0; c < 4; ++c) {
+					EXPECT_EQ(got.markers[i].corners[c].x, want.markers[i].corners[c].x);
+					EXPECT_EQ(got.markers[i].corners[c].y, want.markers[i].corners[c].y);
+				}
+			}
+			found += want.markers.size();
+		}
+		EXPECT_GT(found, 0u);
 	}
 }
 
