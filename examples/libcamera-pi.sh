@@ -8,6 +8,10 @@
 # read-only). Keep the width a multiple of 64: that libcamera attaches no
 # GstVideoMeta, so other widths would be read with the wrong stride.
 #
+# The default backend=auto runs the front end on the QPUs when the GPU can be
+# used (legacy firmware stack, no vc4-kms-v3d overlay: vc4/BRINGUP.md) and on the
+# CPU otherwise, with one warning saying why.
+#
 # Pose: set marker-size (metres) and your calibrated camera-matrix (the
 # numbers below are only a plausible guess for a v2 camera at 640x480).
 set -eu
