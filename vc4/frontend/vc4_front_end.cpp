@@ -2,6 +2,7 @@
 #include "frontend/vc4_front_end.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cstring>
 #include <stdexcept>
 #include <vector>
@@ -169,10 +170,9 @@ public:
 
 		const unsigned tiles = g.tiles();
 		const unsigned programs = std::min(kPrograms, tiles);
-		std::vector<uint32_t> p1, p2;
+		// Uniform streams straight into the device buffers (no allocation per frame).
 		for (unsigned p = 0; p < programs; ++p) {
-			p1.clear();
-			p2.clear();
+			uint8_t *p1 = buf_.unif[0][p].cpu.data(), *p2 = buf_.unif[1][p].cpu.data();
 			for (unsigned t = p; t < tiles; t += kPrograms) {
 				const uint32_t x0 = (t % g.tilesX()) * kTileW, y0 = (t / g.tilesX()) * kTileH;
 				const kernels::GradientUniforms u1{
@@ -185,18 +185,16 @@ public:
 					x0, y0, edgeThr, cornerC, buf_.edge.bus + y0 * pw + x0,
 					isa::VdwStride{.stride = static_cast<uint16_t>(pw - 64)}.word(), 4 * pw,
 					buf_.mask.bus + 128 * t};
-				append(p1, &u1, kernels::kGradientUniforms, t + kPrograms < tiles);
-				append(p2, &u2, kernels::kEdgeUniforms, t + kPrograms < tiles);
+				p1 = append(p1, &u1, sizeof(u1), t + kPrograms < tiles);
+				p2 = append(p2, &u2, sizeof(u2), t + kPrograms < tiles);
 			}
-			std::memcpy(buf_.unif[0][p].cpu.data(), p1.data(), 4 * p1.size());
-			std::memcpy(buf_.unif[1][p].cpu.data(), p2.data(), 4 * p2.size());
 		}
 		for (int pass = 0; pass < 2; ++pass) {
-			std::vector<JobType> jobs;
+			std::array<JobType, kPrograms> jobs;
 			for (unsigned p = 0; p < programs; ++p)
-				jobs.push_back({buf_.unif[pass][p].bus, buf_.code[pass].bus});
+				jobs[p] = {buf_.unif[pass][p].bus, buf_.code[pass].bus};
 			counts_.pass[pass].tiles = tiles;
-			backend_.run(jobs, counts_.pass[pass]);
+			backend_.run(std::span<const JobType>(jobs.data(), programs), counts_.pass[pass]);
 		}
 		counted_ = true;
 
@@ -246,11 +244,12 @@ private:
 #endif
 	                                   >;
 
-	static void append(std::vector<uint32_t> &v, const void *block, unsigned words, bool more)
+	static uint8_t *append(uint8_t *at, const void *block, size_t bytes, bool more)
 	{
-		const auto *w = static_cast<const uint32_t *>(block);
-		v.insert(v.end(), w, w + words);
-		v.push_back(more ? 1u : 0u);
+		const uint32_t m = more ? 1u : 0u;
+		std::memcpy(at, block, bytes);
+		std::memcpy(at + bytes, &m, 4);
+		return at + bytes + 4;
 	}
 
 	// Device buffers for this geometry; kept while the geometry does not change.

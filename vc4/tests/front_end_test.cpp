@@ -182,9 +182,15 @@ TEST(Vc4Kernels, GradientPassMatchesCoreRows)
 // reads), and their hazard lint is clean (finish() throws otherwise).
 TEST(Vc4Kernels, ListingsRoundTrip)
 {
+	// The uniform structs of kernels.hpp are the programs' streams, in order, then `more`.
+	EXPECT_EQ(vc4::kernels::gradientPass().program.uniforms.size(), vc4::kernels::kGradientUniforms + 1);
+	EXPECT_EQ(vc4::kernels::edgePass().program.uniforms.size(), vc4::kernels::kEdgeUniforms + 1);
+	EXPECT_EQ(vc4::kernels::gradientPass().program.uniformIndex("vdw_stride"), 12u);
+	EXPECT_EQ(vc4::kernels::edgePass().program.uniformIndex("mask_dst"), 12u);
 	for (const auto &built : {vc4::kernels::gradientPass(), vc4::kernels::edgePass()}) {
 		EXPECT_EQ(vc4::qasm::assembleText(vc4::isa::disassembleProgram(built.program.code)), built.program.code)
 			<< built.program.name;
+		EXPECT_EQ(built.program.uniforms.back().name, "more");
 		std::printf("%s: %zu instructions, %u nops the builder could not fill\n", built.program.name.c_str(),
 		            built.program.code.size(), built.nops);
 	}
