@@ -181,7 +181,7 @@ void ContourTracer::follow(int x0, int y0, int fromDir, const EdgeMap &edges)
 	auto at = [&](int x, int y) -> std::uint8_t & { return L[static_cast<std::size_t>(y) * w + x]; };
 
 	points_.clear();
-	auto visit = [&](int x, int y) {
+	auto visit = [&](int x, int y) __attribute__((always_inline)) {
 		++steps_;
 		points_.push_back({ x, y });
 		if (!(E[static_cast<std::size_t>(y) * w + x] & EdgeMap::kCorner) || tooManyClusters_)
