@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <random>
 
@@ -13,7 +14,9 @@
 #include "frappe/detector.h"
 #include "frappe/edge_map.h"
 #include "front_end_rows.h" // frappe-core's row kernels (internal header)
+#include "emu/device.hpp"
 #include "isa/disasm.hpp"
+#include "isa/setup_words.hpp"
 #include "kernels/kernels.hpp"
 #include "frappe/dictionary.h"
 #include "frappe/render.h"
@@ -176,6 +179,78 @@ TEST(Vc4Kernels, GradientPassMatchesCoreRows)
 	comparePass1(scene(130, 70, 4, 2, 3), 1.0f, 2, "130x70 stride 133");
 	comparePass1(scene(200, 150, 5, 2), 0.5f, 3, "200x150 scale 0.5");
 	comparePass1(scene(161, 97, 6, 2), 0.7f, 4, "161x97 scale 0.7");
+}
+
+// Pass 2 alone, on the emulator without the front end: fed referencePlanes() (frappe-core's
+// gradients), its edge bytes and tile mask against the CPU front end's EdgeMap.
+void comparePass2(const Img &img, const FrontEndParams &p, unsigned seed, const std::string &what)
+{
+	namespace k = vc4::kernels;
+	const Planes ref = referencePlanes(img, 1.0f);
+	const int w = ref.w, h = ref.h;
+	const uint32_t pw = (w + 63) / 64 * 64, ph = (h + 31) / 32 * 32, pitch = 16 * pw, margin = pitch + 64;
+	const unsigned tx = pw / 64, tiles = tx * (ph / 32), programs = std::min(12u, tiles);
+	vc4::emu::Config config;
+	config.strict = true;
+	config.tmu_fifo_limit = 4;
+	vc4::emu::Device dev(config, 16u << 20);
+	auto grad = dev.alloc(pitch * ph + 2 * margin), edge = dev.alloc(pw * ph), mask = dev.alloc(128 * tiles);
+	std::fill(edge.cpu.begin(), edge.cpu.end(), uint8_t{0xEE});
+	for (int y = 0; y < h; ++y)
+		for (int x = 0; x < w; ++x) {
+			const size_t i = static_cast<size_t>(y) * w + x;
+			const uint32_t v[4] = {ref.b[i], ref.xx[i], ref.yy[i], ref.xy[i]};
+			for (int q = 0; q < 4; ++q)
+				std::memcpy(grad.cpu.data() + margin + y * pitch + q * pitch / 4 + 4 * x, &v[q], 4);
+		}
+	const auto code = dev.upload(k::edgePass().program.code);
+	const int64_t thr = std::clamp<int64_t>(p.edge_threshold_sq, -1, int64_t{1} << 22);
+	std::vector<vc4::emu::Job> jobs;
+	for (unsigned prog = 0; prog < programs; ++prog) {
+		std::vector<uint32_t> u;
+		for (unsigned t = prog; t < tiles; t += 12) {
+			const uint32_t x0 = t % tx * 64, y0 = t / tx * 32;
+			const k::EdgeUniforms e{grad.bus + margin, pitch, pitch / 4, uint32_t(w - 2), uint32_t(h - 2), x0, y0,
+			                        static_cast<uint32_t>(thr) << 2 | 3u,
+			                        2u * static_cast<uint32_t>(static_cast<int32_t>(p.corner_threshold)),
+			                        edge.bus + y0 * pw + x0, vc4::isa::VdwStride{.stride = uint16_t(pw - 64)}.word(),
+			                        4 * pw, mask.bus + 128 * t};
+			const auto *words = reinterpret_cast<const uint32_t *>(&e);
+			u.insert(u.end(), words, words + k::kEdgeUniforms);
+			u.push_back(t + 12 < tiles ? 1 : 0);
+		}
+		jobs.push_back({dev.upload(u).bus, code.bus});
+	}
+	vc4::emu::LaunchOptions lo;
+	if (seed) {
+		lo.schedule = vc4::emu::Schedule::Random;
+		lo.seed = seed;
+	}
+	const auto stats = dev.wait(dev.launch(jobs, lo));
+	EXPECT_EQ(stats.host_interrupts, jobs.size());
+	EdgeMap want;
+	makeCpuFrontEnd(1)->run(img.view(), 1.0f, p, want);
+	size_t bad = 0;
+	for (int y = 0; y < h; ++y)
+		for (int x = 0; x < w; ++x)
+			bad += edge.cpu[static_cast<size_t>(y) * pw + x] != want.at(x, y);
+	EXPECT_EQ(bad, 0u) << what << ": edge bytes";
+	for (int by = 0; by < want.tiles_y; ++by)
+		for (int bx = 0; bx < want.tiles_x; ++bx) {
+			const unsigned t = (by / 2) * tx + bx / 4;
+			uint32_t word;
+			std::memcpy(&word, mask.cpu.data() + 128 * t + 64 * (by % 2) + 4 * (4 * (bx % 4) + 3), 4);
+			EXPECT_EQ(word != 0, !want.tileEmpty(bx, by)) << what << ": block " << bx << ", " << by;
+		}
+}
+
+TEST(Vc4Kernels, EdgePassMatchesCoreOnCoreGradients)
+{
+	comparePass2(scene(67, 33, 1, 1), params(), 0, "67x33");
+	comparePass2(scene(3, 3, 2, 0), params(0, 0), 0, "3x3");
+	comparePass2(scene(7, 5, 3, 0), params(0, 0), 1, "7x5");
+	comparePass2(scene(200, 150, 5, 3), params(), 2, "200x150");
+	comparePass2(scene(131, 97, 6, 2), params(100, 500), 3, "131x97 low thresholds");
 }
 
 // The kernels survive a round trip through their vc4asm-syntax listings (what vc4asm
