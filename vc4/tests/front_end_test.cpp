@@ -352,6 +352,22 @@ TEST(Vc4FrontEnd, WholeDetector)
 	}
 }
 
+// Off a Pi (or with the QPUs unusable) the real-GPU front end refuses with the probe's reason.
+TEST(Vc4FrontEnd, RealGpuProbe)
+{
+	const std::string reason = vc4::probeGpu();
+	if (reason.empty()) {
+		EXPECT_STREQ(vc4::makeFrontEnd({.emulate = false})->name(), "vc4");
+		return;
+	}
+	try {
+		vc4::makeFrontEnd({.emulate = false});
+		ADD_FAILURE() << "makeFrontEnd succeeded although the probe said: " << reason;
+	} catch (const std::runtime_error &e) {
+		EXPECT_EQ(std::string(e.what()), reason);
+	}
+}
+
 // A flat frame with one marker: most 16x16 blocks empty, some not.
 TEST(Vc4FrontEnd, SparseTileMask)
 {
