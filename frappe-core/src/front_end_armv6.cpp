@@ -136,7 +136,57 @@ void smoothRowV6(const std::uint8_t *a, const std::uint8_t *b, const std::uint8_
 	u32 prevHi = static_cast<u32>(t(0)) + 2; /* t[-1] = t[0] */
 	/* Word k needs word k+1's first pixel: whole words up to w-1. */
 	const int words = (w - 4) / 4;
-	for (int k = 0; k < words; ++k) {
+	int k = 0;
+	if (words >= 2) {
+		/* Two words a step, written out (GCC spills and reloads its
+		 * constants): 24 instructions per four pixels. The results are
+		 * bits 4..11 of the lanes: bytes 0 and 2 of sE >> 4 (even pixels)
+		 * and bytes 1 and 3 of sO << 4 (odd pixels), which SEL merges
+		 * once the GE flags are 0101 (USUB8 of 1,0,1,0 and 0,1,0,1). */
+		const std::uint8_t *pa = a, *pb = b, *pc = c;
+		std::uint8_t *po = out;
+		const std::uint8_t *const oEnd = out + 8 * (words / 2);
+		u32 En, On, t0, t1;
+		__asm__ volatile(
+			"mov     %[t1], %[one], lsl #8\n\t"
+			"usub8   %[t0], %[one], %[t1]\n\t"
+			"1:\n\t"
+#define FRAPPE_SMOOTH_WORD(E, O, EN, ON)                                                          \
+			"ldr     %[t0], [%[pa], #4]!\n\t"                                         \
+			"ldr     %[t1], [%[pc], #4]!\n\t"                                         \
+			"uxtb16  %[" EN "], %[t0]\n\t"                                            \
+			"uxtab16 %[" EN "], %[" EN "], %[t1]\n\t"                                 \
+			"uxtb16  %[" ON "], %[t0], ror #8\n\t"                                    \
+			"uxtab16 %[" ON "], %[" ON "], %[t1], ror #8\n\t"                         \
+			"ldr     %[t0], [%[pb], #4]!\n\t"                                         \
+			"uxtab16 %[t1], %[one], %[t0]\n\t"                                        \
+			"add     %[" EN "], %[" EN "], %[t1], lsl #1\n\t"                         \
+			"uxtab16 %[t1], %[one], %[t0], ror #8\n\t"                                \
+			"add     %[" ON "], %[" ON "], %[t1], lsl #1\n\t"                         \
+			"orr     %[t0], %[P], %[" O "], lsl #16\n\t"                              \
+			"add     %[t0], %[t0], %[" O "]\n\t"                                      \
+			"add     %[t0], %[t0], %[" E "], lsl #1\n\t"    /* sE */                  \
+			"mov     %[t1], %[" E "], lsr #16\n\t"                                    \
+			"orr     %[t1], %[t1], %[" EN "], lsl #16\n\t"                            \
+			"add     %[t1], %[t1], %[" E "]\n\t"                                      \
+			"add     %[t1], %[t1], %[" O "], lsl #1\n\t"    /* sO */                  \
+			"mov     %[t0], %[t0], lsr #4\n\t"                                        \
+			"mov     %[t1], %[t1], lsl #4\n\t"                                        \
+			"sel     %[t0], %[t0], %[t1]\n\t"                                         \
+			"str     %[t0], [%[po]], #4\n\t"                                          \
+			"mov     %[P], %[" O "], lsr #16\n\t"
+			FRAPPE_SMOOTH_WORD("E", "O", "En", "On")
+			FRAPPE_SMOOTH_WORD("En", "On", "E", "O")
+#undef FRAPPE_SMOOTH_WORD
+			"cmp     %[po], %[end]\n\t"
+			"bne     1b"
+			: [pa] "+r"(pa), [pb] "+r"(pb), [pc] "+r"(pc), [po] "+r"(po), [E] "+r"(E), [O] "+r"(O),
+			  [P] "+r"(prevHi), [En] "=&r"(En), [On] "=&r"(On), [t0] "=&r"(t0), [t1] "=&r"(t1)
+			: [one] "r"(kOne), [end] "r"(oEnd)
+			: "cc", "memory");
+		k = 2 * (words / 2);
+	}
+	for (; k < words; ++k) {
 		const int xn = 4 * k + 4;
 		const u32 wa = load32(a + xn), wb = load32(b + xn), wc = load32(c + xn);
 		const u32 En = even(wa, wb, wc), On = odd(wa, wb, wc);
@@ -166,61 +216,109 @@ void gradientRowV6(const std::uint8_t *a, const std::uint8_t *b, const std::uint
 	int x = 1;
 	if (w >= 16) {
 		/* Pass 1: the column sums vs = a + 2b + c and differences
-		 * vd = c - a, in natural order (int16). Four columns per step:
-		 * even and odd lanes, then packed back in order with PKHBT/PKHTB. */
-		std::uint8_t *vs = reinterpret_cast<std::uint8_t *>(tmp);
-		std::uint8_t *vd = vs + 2 * (w + (w & 1)); /* word-aligned (RowScratch: 2w + 2) */
+		 * vd = c - a, four columns a step in even and odd lanes (UXTB16),
+		 * stored as they come: the even columns' vs in one int16 array,
+		 * the odd columns' in another, and so for vd. */
+		const int half = ((w + 1) / 2 + 3) & ~1; /* values per array, word-aligned */
+		std::int16_t *const sE = tmp, *const sO = tmp + half, *const dE = tmp + 2 * half,
+				   *const dO = tmp + 3 * half; /* RowScratch: 2w + 16 values */
 		const int words = w / 4;
-		for (int k = 0; k < words; ++k) {
-			const u32 wa = load32(a + 4 * k), wb = load32(b + 4 * k), wc = load32(c + 4 * k);
-			const u32 ea = evenBytes(wa), eb = evenBytes(wb), ec = evenBytes(wc);
-			const u32 oa = oddBytes(wa), ob = oddBytes(wb), oc = oddBytes(wc);
-			const u32 se = ea + ec + (eb << 1), so = oa + oc + (ob << 1);
-			const u32 de = ssub16(ec, ea), dO = ssub16(oc, oa);
-			store32(vs + 8 * k, pkhbt16(se, so));
-			store32(vs + 8 * k + 4, pkhtb16(so, se));
-			store32(vd + 8 * k, pkhbt16(de, dO));
-			store32(vd + 8 * k + 4, pkhtb16(dO, de));
+		{
+			/* 21 instructions per four columns (GCC: 25 and more). */
+			const std::uint8_t *pa = a, *pb = b, *pc = c;
+			const std::uint8_t *const aEnd = a + 4 * words;
+			std::int16_t *pse = sE, *pso = sO, *pde = dE, *pdo = dO;
+			u32 t0, t1, t2, t3, t4;
+			__asm__ volatile(
+				"1:\n\t"
+				"ldr     %[t0], [%[pa]], #4\n\t"
+				"ldr     %[t1], [%[pc]], #4\n\t"
+				"uxtb16  %[t3], %[t0]\n\t"               /* ea */
+				"uxtb16  %[t0], %[t0], ror #8\n\t"       /* oa */
+				"uxtb16  %[t4], %[t1]\n\t"               /* ec */
+				"uxtb16  %[t1], %[t1], ror #8\n\t"       /* oc */
+				"ssub16  %[t2], %[t4], %[t3]\n\t"
+				"str     %[t2], [%[pde]], #4\n\t"        /* vd even */
+				"ssub16  %[t2], %[t1], %[t0]\n\t"
+				"str     %[t2], [%[pdo]], #4\n\t"        /* vd odd */
+				"add     %[t3], %[t3], %[t4]\n\t"
+				"add     %[t0], %[t0], %[t1]\n\t"
+				"ldr     %[t2], [%[pb]], #4\n\t"
+				"uxtab16 %[t3], %[t3], %[t2]\n\t"
+				"uxtab16 %[t3], %[t3], %[t2]\n\t"
+				"uxtab16 %[t0], %[t0], %[t2], ror #8\n\t"
+				"uxtab16 %[t0], %[t0], %[t2], ror #8\n\t"
+				"str     %[t3], [%[pse]], #4\n\t"        /* vs even */
+				"str     %[t0], [%[pso]], #4\n\t"        /* vs odd */
+				"cmp     %[pa], %[end]\n\t"
+				"bne     1b"
+				: [pa] "+r"(pa), [pb] "+r"(pb), [pc] "+r"(pc), [pse] "+r"(pse), [pso] "+r"(pso),
+				  [pde] "+r"(pde), [pdo] "+r"(pdo), [t0] "=&r"(t0), [t1] "=&r"(t1), [t2] "=&r"(t2),
+				  [t3] "=&r"(t3), [t4] "=&r"(t4)
+				: [end] "r"(aEnd)
+				: "cc", "memory");
 		}
 		for (int i = 4 * words; i < w; ++i) {
-			const std::int16_t s2 = static_cast<std::int16_t>(a[i] + 2 * b[i] + c[i]);
-			const std::int16_t d2 = static_cast<std::int16_t>(c[i] - a[i]);
-			std::memcpy(vs + 2 * i, &s2, 2);
-			std::memcpy(vd + 2 * i, &d2, 2);
+			std::int16_t *vs = (i & 1) ? sO : sE, *vd = (i & 1) ? dO : dE;
+			vs[i / 2] = static_cast<std::int16_t>(a[i] + 2 * b[i] + c[i]);
+			vd[i / 2] = static_cast<std::int16_t>(c[i] - a[i]);
 		}
-		/* Pass 2, pixels x and x+1 (x odd, so the loads at x-1 and x+1
-		 * are word-aligned): gx = vs[x+1] - vs[x-1] is one SSUB16,
-		 * gy = vd[x-1] + 2 vd[x] + vd[x+1] three SADD16, then the (gx, gy)
-		 * pairs and gx^2 + gy^2 by SMUAD. */
+		/* Pass 2, pixels 2j+1 .. 2j+4: a word loaded at index j of an
+		 * array holds columns (2j, 2j+2) or (2j+1, 2j+3), so
+		 *   gx(2j+1, 2j+3) = sE[j+1..] - sE[j..]        (one SSUB16)
+		 *   gy(2j+1, 2j+3) = dE[j..] + dE[j+1..] + 2 dO[j..]
+		 * and the even pixels 2j+2, 2j+4 likewise with E and O swapped;
+		 * the loads at j+1 are unaligned (allowed on ARMv6). */
+		/* Written out: GCC keeps a counter and spills; this is 34
+		 * instructions per four pixels. */
+		const int steps = (w - 2) / 4;
 		std::uint8_t *pp = pairs + 4;
-		std::int32_t *m = mag + 1;
-		const std::uint8_t *s0 = vs;
-		const std::ptrdiff_t dOff = vd - vs;
-		auto two = [&](u32 sl, u32 sr, u32 dl, u32 dr, std::uint8_t *p, std::int32_t *mm) {
-			const u32 gxw = ssub16(sr, sl);
-			const u32 dm = (dl >> 16) | (dr << 16);
-			const u32 gyw = sadd16(sadd16(dl, dr), sadd16(dm, dm));
-			const u32 p0 = pkhbt16(gxw, gyw), p1 = pkhtb16(gyw, gxw);
-			store32(p, p0);
-			store32(p + 4, p1);
-			mm[0] = smuad(p0);
-			mm[1] = smuad(p1);
-		};
-		const int pairsN = (w - 2) / 2; /* x = 1, 3, ... while x + 1 <= w - 2 */
-		/* Four pixels per step; the words at x+1 are the next step's x-1. */
-		const std::uint8_t *const s4End = vs + 8 * (pairsN / 2);
-		u32 sl = load32(s0), dl = load32(s0 + dOff);
-		for (; s0 != s4End; s0 += 8, pp += 16, m += 4) {
-			const u32 sm = load32(s0 + 4), dm = load32(s0 + dOff + 4);
-			const u32 sr = load32(s0 + 8), dr = load32(s0 + dOff + 8);
-			two(sl, sm, dl, dm, pp, m);
-			two(sm, sr, dm, dr, pp + 8, m + 2);
-			sl = sr;
-			dl = dr;
-		}
-		if (pairsN & 1)
-			two(load32(s0), load32(s0 + 4), load32(s0 + dOff), load32(s0 + dOff + 4), pp, m);
-		x = 1 + 2 * pairsN;
+		std::uint8_t *m = reinterpret_cast<std::uint8_t *>(mag + 1);
+		const std::uint8_t *const ppEnd = pp + 16 * steps;
+		const std::int16_t *pse = sE, *pso = sO, *pde = dE, *pdo = dO;
+		u32 t0, t1, t2, t3, t4, t5;
+		__asm__ volatile(
+			"1:\n\t"
+			"ldr    %[t4], [%[pdo], #2]\n\t"        /* do1 */
+			"ldr    %[t3], [%[pdo]], #4\n\t"        /* do0 */
+			"ldr    %[t2], [%[pde], #2]\n\t"        /* de1 */
+			"ldr    %[t1], [%[pde]], #4\n\t"        /* de0 */
+			"sadd16 %[t1], %[t1], %[t2]\n\t"
+			"sadd16 %[t5], %[t3], %[t3]\n\t"
+			"sadd16 %[t1], %[t1], %[t5]\n\t"        /* gy odd */
+			"sadd16 %[t3], %[t3], %[t4]\n\t"
+			"sadd16 %[t2], %[t2], %[t2]\n\t"
+			"sadd16 %[t3], %[t3], %[t2]\n\t"        /* gy even */
+			"ldr    %[t0], [%[pse], #2]\n\t"
+			"ldr    %[t2], [%[pse]], #4\n\t"
+			"ssub16 %[t0], %[t0], %[t2]\n\t"        /* gx odd */
+			"ldr    %[t4], [%[pso], #2]\n\t"
+			"ldr    %[t2], [%[pso]], #4\n\t"
+			"ssub16 %[t4], %[t4], %[t2]\n\t"        /* gx even */
+			"pkhbt  %[t2], %[t0], %[t1], lsl #16\n\t" /* pixel 2j+1 */
+			"pkhtb  %[t1], %[t1], %[t0], asr #16\n\t" /* pixel 2j+3 */
+			"pkhbt  %[t0], %[t4], %[t3], lsl #16\n\t" /* pixel 2j+2 */
+			"pkhtb  %[t3], %[t3], %[t4], asr #16\n\t" /* pixel 2j+4 */
+			"str    %[t2], [%[pp]], #16\n\t"
+			"str    %[t0], [%[pp], #-12]\n\t"
+			"str    %[t1], [%[pp], #-8]\n\t"
+			"str    %[t3], [%[pp], #-4]\n\t"
+			"smuad  %[t2], %[t2], %[t2]\n\t"
+			"smuad  %[t0], %[t0], %[t0]\n\t"
+			"smuad  %[t1], %[t1], %[t1]\n\t"
+			"smuad  %[t3], %[t3], %[t3]\n\t"
+			"str    %[t2], [%[m]], #16\n\t"
+			"str    %[t0], [%[m], #-12]\n\t"
+			"str    %[t1], [%[m], #-8]\n\t"
+			"str    %[t3], [%[m], #-4]\n\t"
+			"cmp    %[pp], %[end]\n\t"
+			"bne    1b"
+			: [pse] "+r"(pse), [pso] "+r"(pso), [pde] "+r"(pde), [pdo] "+r"(pdo), [pp] "+r"(pp),
+			  [m] "+r"(m), [t0] "=&r"(t0), [t1] "=&r"(t1), [t2] "=&r"(t2), [t3] "=&r"(t3),
+			  [t4] "=&r"(t4), [t5] "=&r"(t5)
+			: [end] "r"(ppEnd)
+			: "cc", "memory");
+		x = 1 + 4 * steps;
 	}
 	for (; x < w - 1; ++x)
 		storePair(x, gradientPair(a, b, c, x, mag[x]));

@@ -31,7 +31,7 @@ struct GradRows {
 struct RowScratch {
 	std::vector<std::uint8_t> smooth[4];
 	std::vector<std::uint16_t> columns;    ///< smoothRow's vertical pass
-	std::vector<std::int16_t> separable;   ///< gradientRow's two column passes (2w + 2)
+	std::vector<std::int16_t> separable;   ///< gradientRow's two column passes (2w + 16)
 	/// gx holds 2w values: the ARMv6 kernels store (gx, gy) pairs in it.
 	std::vector<std::int16_t> gx[3], gy[3];
 	std::vector<std::int32_t> mag[3];
@@ -43,7 +43,7 @@ struct RowScratch {
 		for (int i = 0; i < 4; ++i)
 			smooth[i].resize(w);
 		columns.resize(w);
-		separable.resize(2 * static_cast<std::size_t>(w) + 2);
+		separable.resize(2 * static_cast<std::size_t>(w) + 16);
 		products.resize(3 * static_cast<std::size_t>(w));
 		for (int i = 0; i < 3; ++i) {
 			gx[i].resize(2 * static_cast<std::size_t>(w));

@@ -85,7 +85,7 @@ void checkRows(const RowKernels &ref, const RowKernels &k, int w, int kind, int 
 	if (w < 3)
 		return;
 
-	std::vector<std::int16_t> gx(2 * w + 8, 0x5555), gy(2 * w + 8, 0x5555), rgx(w), rgy(w), sep(2 * w + 2);
+	std::vector<std::int16_t> gx(2 * w + 8, 0x5555), gy(2 * w + 8, 0x5555), rgx(w), rgy(w), sep(2 * w + 16);
 	std::vector<std::int32_t> mag(w + 4, 0x55555555), rmag(w);
 	std::vector<std::int32_t> t0(w), t1(w), t2(w), prod(3 * w);
 	const TensorRow tensor{ t0.data(), t1.data(), t2.data(), prod.data() };
