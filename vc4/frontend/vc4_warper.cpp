@@ -120,14 +120,17 @@ public:
 		}
 		for (std::size_t first = 0; first < params_.size(); first += kernels::kWarpMaxCandidates) {
 			const std::size_t count = std::min<std::size_t>(kernels::kWarpMaxCandidates, params_.size() - first);
-			const auto streams = kernels::warpUniforms(
-				qpuImage, std::span<const kernels::WarpParams>(params_).subspan(first, count), out_.bus, kPrograms);
+			/* Uniforms straight into the device buffers: a launch allocates nothing. */
+			uint32_t *streams[kPrograms];
+			for (unsigned p = 0; p < kPrograms; ++p)
+				streams[p] = reinterpret_cast<uint32_t *>(unif_[p].cpu.data());
+			const unsigned programs = kernels::writeWarpUniforms(
+				qpuImage, std::span<const kernels::WarpParams>(params_).subspan(first, count), out_.bus, kPrograms,
+				streams);
 			Job jobs[kPrograms];
-			for (std::size_t p = 0; p < streams.size(); ++p) {
-				std::memcpy(unif_[p].cpu.data(), streams[p].data(), 4 * streams[p].size());
+			for (unsigned p = 0; p < programs; ++p)
 				jobs[p] = { unif_[p].bus, code_.bus };
-			}
-			target_.run(std::span<const Job>(jobs, streams.size()));
+			target_.run(std::span<const Job>(jobs, programs));
 			++counts_.launches;
 			for (std::size_t c = 0; c < count; ++c) {
 				const std::size_t k = onQpu_[first + c];

@@ -38,6 +38,7 @@
 // division each, which is exactly what 12 x 16 lanes are for.
 #include "kernels/warp.hpp"
 
+#include <algorithm>
 #include <stdexcept>
 
 #include "asm/assembler.hpp"
@@ -236,33 +237,52 @@ qasm::Program warpKernel()
 	return a.finish();
 }
 
-std::vector<std::vector<uint32_t>> warpUniforms(const WarpImage &image, std::span<const WarpParams> candidates,
-                                                uint32_t out_bus, unsigned programs)
+unsigned writeWarpUniforms(const WarpImage &image, std::span<const WarpParams> candidates, uint32_t out_bus,
+                           unsigned programs, std::span<uint32_t *const> streams)
 {
 	if (candidates.size() > static_cast<size_t>(kWarpMaxCandidates))
 		throw std::invalid_argument("warpUniforms: at most 32 candidates a launch");
 	if (image.width < 2 || image.height < 2 || programs == 0 || programs > 12)
 		throw std::invalid_argument("warpUniforms: image of at least 2 x 2, 1 to 12 programs");
 	const size_t n = std::min<size_t>(programs, candidates.size());
-	std::vector<std::vector<uint32_t>> streams(n);
+	if (streams.size() < n)
+		throw std::invalid_argument("warpUniforms: fewer streams than programs");
 	for (size_t p = 0; p < n; ++p) {
 		const auto count = static_cast<uint32_t>((candidates.size() - p + n - 1) / n);
-		streams[p] = {image.bus,
-		              image.stride,
-		              static_cast<uint32_t>(image.width - 1) << kWarpFracBits,
-		              static_cast<uint32_t>(image.height - 1) << kWarpFracBits,
-		              static_cast<uint32_t>(image.width - 2),
-		              static_cast<uint32_t>(image.height - 2),
-		              count};
+		const uint32_t head[kWarpProgramUniforms] = {image.bus,
+		                                             image.stride,
+		                                             static_cast<uint32_t>(image.width - 1) << kWarpFracBits,
+		                                             static_cast<uint32_t>(image.height - 1) << kWarpFracBits,
+		                                             static_cast<uint32_t>(image.width - 2),
+		                                             static_cast<uint32_t>(image.height - 2),
+		                                             count};
+		std::copy(std::begin(head), std::end(head), streams[p]);
 	}
 	for (size_t k = 0; k < candidates.size(); ++k) {
 		const WarpParams &c = candidates[k];
-		auto &s = streams[k % n];
+		uint32_t *s = streams[k % n] + kWarpProgramUniforms + kWarpCandidateUniforms * (k / n);
 		const auto u = [](int32_t v) { return static_cast<uint32_t>(v); };
-		s.insert(s.end(), {out_bus + static_cast<uint32_t>(kWarpOutputBytes * k), u(c.ox) << kWarpFracBits,
-		                   u(c.oy) << kWarpFracBits, u(c.x.at00), u(c.x.di), u(c.x.dj), u(c.y.at00), u(c.y.di),
-		                   u(c.y.dj), u(c.d.at00), u(c.d.di), u(c.d.dj)});
+		const uint32_t words[kWarpCandidateUniforms] = {
+			out_bus + static_cast<uint32_t>(kWarpOutputBytes * k), u(c.ox) << kWarpFracBits,
+			u(c.oy) << kWarpFracBits, u(c.x.at00), u(c.x.di), u(c.x.dj), u(c.y.at00), u(c.y.di),
+			u(c.y.dj), u(c.d.at00), u(c.d.di), u(c.d.dj)};
+		std::copy(std::begin(words), std::end(words), s);
 	}
+	return static_cast<unsigned>(n);
+}
+
+std::vector<std::vector<uint32_t>> warpUniforms(const WarpImage &image, std::span<const WarpParams> candidates,
+                                                uint32_t out_bus, unsigned programs)
+{
+	const size_t n = std::min<size_t>(std::clamp(programs, 1u, 12u), candidates.size());
+	std::vector<std::vector<uint32_t>> streams(n);
+	uint32_t *heads[12] = {};
+	for (size_t p = 0; p < n; ++p) {
+		const size_t count = (candidates.size() - p + n - 1) / n;
+		streams[p].resize(kWarpProgramUniforms + kWarpCandidateUniforms * count);
+		heads[p] = streams[p].data();
+	}
+	writeWarpUniforms(image, candidates, out_bus, programs, std::span<uint32_t *const>(heads, n));
 	return streams;
 }
 

@@ -32,6 +32,11 @@ struct WarpImage {
 // Uniform streams for a launch: candidate k goes to program k % programs and writes its
 // 256 samples to out_bus + 256 k. Returns min(programs, candidates) streams (run one QPU
 // each); candidates.size() <= kWarpMaxCandidates.
+// The same written into caller-owned streams (one per program, each room for
+// kWarpProgramUniforms + kWarpCandidateUniforms * ceil(candidates / programs) words), so a
+// launch allocates nothing. Returns the number of streams used.
+unsigned writeWarpUniforms(const WarpImage &image, std::span<const WarpParams> candidates, uint32_t out_bus,
+                           unsigned programs, std::span<uint32_t *const> streams);
 std::vector<std::vector<uint32_t>> warpUniforms(const WarpImage &image, std::span<const WarpParams> candidates,
                                                 uint32_t out_bus, unsigned programs = 12);
 
