@@ -140,7 +140,7 @@ if [ ! -f "$PLUGIN" ] || [ "$HERE/frappecount.c" -nt "$PLUGIN" ]; then
 		"$HERE/frappecount.c" -o "$PLUGIN"
 fi
 
-# ---- cross build of frappe-core (static, scalar front end) --------------------
+# ---- cross build of frappe-core (static, no Highway: the ARMv6 row kernels) ---
 mkdir -p "$CACHE"
 XF=$CACHE/sysroot-armel.ini
 printf "[constants]\nsysroot = '%s'\n" "$SYSROOT" > "$XF.tmp"

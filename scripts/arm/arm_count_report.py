@@ -236,7 +236,7 @@ def main():
     out = []
     P = out.append
     P(f"{n} frames, {sizes[0][0]}x{sizes[0][1]} (first), instructions counted under qemu-arm -cpu arm1176\n")
-    P("### frappe-core, ARMv6KZ + VFPv2 (-O3, scalar front end)\n")
+    P("### frappe-core, ARMv6KZ + VFPv2 (-O3, -Dsimd=disabled: the ARMv6 SIMD32 row kernels)\n")
     P("| stage | median insns/frame | p90 insns/frame | median insns/px | p90 insns/px | share |")
     P("|---|---:|---:|---:|---:|---:|")
     grand = sum(whole)
