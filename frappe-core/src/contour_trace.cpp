@@ -48,6 +48,41 @@ struct NextStepTable {
 };
 constexpr NextStepTable kNextStep;
 
+/* The same table indexed by the neighbourhood read a row at a time: bits
+ * 0..2 the row above (x-1, x, x+1), 3..5 this row (the centre, bit 4, is
+ * ignored), 6..8 the row below. */
+struct RowStepTable {
+	std::uint8_t entry[8][512];
+	constexpr RowStepTable() : entry{}
+	{
+		/* Index bit of each direction, in kDx/kDy order. */
+		constexpr int kBit[8] = { 5, 2, 1, 0, 3, 6, 7, 8 };
+		for (int back = 0; back < 8; ++back)
+			for (int idx = 0; idx < 512; ++idx) {
+				int mask = 0;
+				for (int d = 0; d < 8; ++d)
+					mask |= ((idx >> kBit[d]) & 1) << d;
+				entry[back][idx] = kNextStep.entry[back][mask];
+			}
+	}
+};
+constexpr RowStepTable kRowStep;
+
+/* Bits 0..2: which of the three labels at p[0], p[1], p[2] are non-zero
+ * (labels are 0..3). Reads p[3] too: the label image has padding. */
+inline unsigned rowBits(const std::uint8_t *p)
+{
+	if constexpr (std::endian::native == std::endian::little) {
+		std::uint32_t v;
+		std::memcpy(&v, p, 4);
+		v = (v | (v >> 1)) & 0x00010101u;
+		return (v | (v >> 7) | (v >> 14)) & 7u;
+	} else {
+		return static_cast<unsigned>(p[0] != 0) | static_cast<unsigned>(p[1] != 0) << 1 |
+		       static_cast<unsigned>(p[2] != 0) << 2;
+	}
+}
+
 float cross(Point2f o, Point2f a, Point2f b)
 {
 	return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x);
@@ -87,13 +122,14 @@ void ContourTracer::trace(const EdgeMap &edges, const TraceParams &params, std::
 		return;
 	stride_ = w;
 	radius2_ = params.cluster_radius * params.cluster_radius;
-	labels_.resize(static_cast<std::size_t>(w) * h);
+	/* Four bytes of padding: follow reads neighbours a word at a time. */
+	labels_.resize(static_cast<std::size_t>(w) * h + 4);
 	/* Label 1 for every edge pixel; a plain loop over local pointers that
 	 * the compiler vectorises. */
 	{
 		const std::uint8_t *src = edges.pixels.data();
 		std::uint8_t *dst = labels_.data();
-		const std::size_t n = labels_.size();
+		const std::size_t n = static_cast<std::size_t>(w) * h;
 		for (std::size_t i = 0; i < n; ++i)
 			dst[i] = src[i] & EdgeMap::kEdge;
 	}
@@ -230,7 +266,8 @@ void ContourTracer::follow(int x0, int y0, int fromDir, const EdgeMap &edges)
 	const std::size_t maxSteps = 4 * labels_.size();
 	for (;;) {
 		/* 3.3: counter-clockwise from the pixel after `back`. */
-		const std::uint8_t step = kNextStep.entry[back][neighbourMask(p3)];
+		const unsigned idx = rowBits(p3 - w - 1) | rowBits(p3 - 1) << 3 | rowBits(p3 + w - 1) << 6;
+		const std::uint8_t step = kRowStep.entry[back][idx];
 		const int d4 = step & 7;
 		/* 3.4: mark the current pixel. */
 		if (step & 8)
