@@ -158,8 +158,16 @@ void ContourTracer::trace(const EdgeMap &edges, const TraceParams &params, std::
 						x += 7;
 						continue;
 					}
-					if constexpr (std::endian::native == std::endian::little)
-						x += std::countr_zero(word) >> 3;
+					if constexpr (std::endian::native == std::endian::little) {
+						/* On 32-bit targets a 64-bit count is a libgcc call. */
+						if constexpr (sizeof(void *) >= 8) {
+							x += std::countr_zero(word) >> 3;
+						} else {
+							const auto lo = static_cast<std::uint32_t>(word);
+							x += lo ? std::countr_zero(lo) >> 3
+								: 4 + (std::countr_zero(static_cast<std::uint32_t>(word >> 32)) >> 3);
+						}
+					}
 				}
 				const std::uint8_t f = row[x];
 				if (f == 0)
