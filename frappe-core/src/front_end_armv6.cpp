@@ -96,13 +96,30 @@ inline std::int32_t smuad(u32 a)
 	return __smuad(static_cast<int16x2_t>(a), static_cast<int16x2_t>(a));
 }
 
-/* The (gx, gy) pair of pixel x of the middle of rows a, b, c, for the first
- * and last few pixels (x in 1 .. w-2). */
+/* The smoothed rows of these kernels are stored lane-split, as the SIMD32
+ * code makes them: per four pixels 4k .. 4k+3 two words, (p0, p2) and
+ * (p1, p3), each value in a 16-bit lane (2w + 8 bytes a row, see
+ * RowScratch). The gradient pass loads them without unpacking. */
+inline void putSmoothed(std::uint8_t *row, int x, std::uint8_t v)
+{
+	const std::uint16_t v16 = v;
+	std::memcpy(row + armv6SmoothedOffset(x), &v16, 2);
+}
+
+inline int getSmoothed(const std::uint8_t *row, int x)
+{
+	std::uint16_t v16;
+	std::memcpy(&v16, row + armv6SmoothedOffset(x), 2);
+	return v16;
+}
+
+/* The (gx, gy) pair of pixel x of the middle of smoothed rows a, b, c, for
+ * the first and last few pixels (x in 1 .. w-2). */
 inline u32 gradientPair(const std::uint8_t *a, const std::uint8_t *b, const std::uint8_t *c, int x,
 			std::int32_t &mag)
 {
-	auto vs = [&](int i) { return a[i] + 2 * b[i] + c[i]; };
-	auto vd = [&](int i) { return c[i] - a[i]; };
+	auto vs = [&](int i) { return getSmoothed(a, i) + 2 * getSmoothed(b, i) + getSmoothed(c, i); };
+	auto vd = [&](int i) { return getSmoothed(c, i) - getSmoothed(a, i); };
 	const std::int32_t sx = vs(x + 1) - vs(x - 1);
 	const std::int32_t sy = vd(x - 1) + 2 * vd(x) + vd(x + 1);
 	mag = sx * sx + sy * sy;
@@ -113,7 +130,10 @@ void smoothRowV6(const std::uint8_t *a, const std::uint8_t *b, const std::uint8_
 		 std::uint8_t *out, std::uint16_t *tmp)
 {
 	if (w < 16) {
-		smoothRow(a, b, c, w, out, tmp);
+		std::uint8_t bytes[16];
+		smoothRow(a, b, c, w, bytes, tmp);
+		for (int x = 0; x < w; ++x)
+			putSmoothed(out, x, bytes[x]);
 		return;
 	}
 	auto t = [&](int x) {
@@ -140,16 +160,13 @@ void smoothRowV6(const std::uint8_t *a, const std::uint8_t *b, const std::uint8_
 	if (words >= 2) {
 		/* Two words a step, written out (GCC spills and reloads its
 		 * constants): 24 instructions per four pixels. The results are
-		 * bits 4..11 of the lanes: bytes 0 and 2 of sE >> 4 (even pixels)
-		 * and bytes 1 and 3 of sO << 4 (odd pixels), which SEL merges
-		 * once the GE flags are 0101 (USUB8 of 1,0,1,0 and 0,1,0,1). */
+		 * bits 4..11 of the lanes of sE (even pixels) and sO (odd ones),
+		 * stored as they are (see putSmoothed). */
 		const std::uint8_t *pa = a, *pb = b, *pc = c;
 		std::uint8_t *po = out;
-		const std::uint8_t *const oEnd = out + 8 * (words / 2);
+		const std::uint8_t *const oEnd = out + 16 * (words / 2);
 		u32 En, On, t0, t1;
 		__asm__ volatile(
-			"mov     %[t1], %[one], lsl #8\n\t"
-			"usub8   %[t0], %[one], %[t1]\n\t"
 			"1:\n\t"
 #define FRAPPE_SMOOTH_WORD(E, O, EN, ON)                                                          \
 			"ldr     %[t0], [%[pa], #4]!\n\t"                                         \
@@ -170,10 +187,10 @@ void smoothRowV6(const std::uint8_t *a, const std::uint8_t *b, const std::uint8_
 			"orr     %[t1], %[t1], %[" EN "], lsl #16\n\t"                            \
 			"add     %[t1], %[t1], %[" E "]\n\t"                                      \
 			"add     %[t1], %[t1], %[" O "], lsl #1\n\t"    /* sO */                  \
-			"mov     %[t0], %[t0], lsr #4\n\t"                                        \
-			"mov     %[t1], %[t1], lsl #4\n\t"                                        \
-			"sel     %[t0], %[t0], %[t1]\n\t"                                         \
-			"str     %[t0], [%[po]], #4\n\t"                                          \
+			"and     %[t0], %[mask], %[t0], lsr #4\n\t"                              \
+			"and     %[t1], %[mask], %[t1], lsr #4\n\t"                              \
+			"str     %[t0], [%[po]], #8\n\t"                                          \
+			"str     %[t1], [%[po], #-4]\n\t"                                         \
 			"mov     %[P], %[" O "], lsr #16\n\t"
 			FRAPPE_SMOOTH_WORD("E", "O", "En", "On")
 			FRAPPE_SMOOTH_WORD("En", "On", "E", "O")
@@ -182,7 +199,7 @@ void smoothRowV6(const std::uint8_t *a, const std::uint8_t *b, const std::uint8_
 			"bne     1b"
 			: [pa] "+r"(pa), [pb] "+r"(pb), [pc] "+r"(pc), [po] "+r"(po), [E] "+r"(E), [O] "+r"(O),
 			  [P] "+r"(prevHi), [En] "=&r"(En), [On] "=&r"(On), [t0] "=&r"(t0), [t1] "=&r"(t1)
-			: [one] "r"(kOne), [end] "r"(oEnd)
+			: [one] "r"(kOne), [mask] "r"(kMask), [end] "r"(oEnd)
 			: "cc", "memory");
 		k = 2 * (words / 2);
 	}
@@ -194,13 +211,14 @@ void smoothRowV6(const std::uint8_t *a, const std::uint8_t *b, const std::uint8_
 		 * left E, right (t2, t4). The sums stay below 4096. */
 		const u32 sE = (prevHi | (O << 16)) + O + (E << 1);
 		const u32 sO = ((E >> 16) | (En << 16)) + E + (O << 1);
-		store32(out + 4 * k, ((sE >> 4) & kMask) | (((sO >> 4) & kMask) << 8));
+		store32(out + 8 * k, (sE >> 4) & kMask);
+		store32(out + 8 * k + 4, (sO >> 4) & kMask);
 		prevHi = O >> 16;
 		E = En;
 		O = On;
 	}
 	for (int x = 4 * words; x < w; ++x)
-		out[x] = static_cast<std::uint8_t>((t(x - 1) + 2 * t(x) + t(x + 1) + 8) >> 4);
+		putSmoothed(out, x, static_cast<std::uint8_t>((t(x - 1) + 2 * t(x) + t(x + 1) + 8) >> 4));
 }
 
 void gradientRowV6(const std::uint8_t *a, const std::uint8_t *b, const std::uint8_t *c, int w,
@@ -224,32 +242,30 @@ void gradientRowV6(const std::uint8_t *a, const std::uint8_t *b, const std::uint
 				   *const dO = tmp + 3 * half; /* RowScratch: 2w + 16 values */
 		const int words = w / 4;
 		{
-			/* 21 instructions per four columns (GCC: 25 and more). */
+			/* 18 instructions per four columns: the smoothed rows are
+			 * already in lanes. */
 			const std::uint8_t *pa = a, *pb = b, *pc = c;
-			const std::uint8_t *const aEnd = a + 4 * words;
+			const std::uint8_t *const aEnd = a + 8 * words;
 			std::int16_t *pse = sE, *pso = sO, *pde = dE, *pdo = dO;
 			u32 t0, t1, t2, t3, t4;
 			__asm__ volatile(
 				"1:\n\t"
-				"ldr     %[t0], [%[pa]], #4\n\t"
-				"ldr     %[t1], [%[pc]], #4\n\t"
-				"uxtb16  %[t3], %[t0]\n\t"               /* ea */
-				"uxtb16  %[t0], %[t0], ror #8\n\t"       /* oa */
-				"uxtb16  %[t4], %[t1]\n\t"               /* ec */
-				"uxtb16  %[t1], %[t1], ror #8\n\t"       /* oc */
-				"ssub16  %[t2], %[t4], %[t3]\n\t"
-				"str     %[t2], [%[pde]], #4\n\t"        /* vd even */
-				"ssub16  %[t2], %[t1], %[t0]\n\t"
-				"str     %[t2], [%[pdo]], #4\n\t"        /* vd odd */
-				"add     %[t3], %[t3], %[t4]\n\t"
-				"add     %[t0], %[t0], %[t1]\n\t"
-				"ldr     %[t2], [%[pb]], #4\n\t"
-				"uxtab16 %[t3], %[t3], %[t2]\n\t"
-				"uxtab16 %[t3], %[t3], %[t2]\n\t"
-				"uxtab16 %[t0], %[t0], %[t2], ror #8\n\t"
-				"uxtab16 %[t0], %[t0], %[t2], ror #8\n\t"
-				"str     %[t3], [%[pse]], #4\n\t"        /* vs even */
-				"str     %[t0], [%[pso]], #4\n\t"        /* vs odd */
+				"ldr     %[t1], [%[pa], #4]\n\t"         /* oa */
+				"ldr     %[t0], [%[pa]], #8\n\t"         /* ea */
+				"ldr     %[t3], [%[pc], #4]\n\t"         /* oc */
+				"ldr     %[t2], [%[pc]], #8\n\t"         /* ec */
+				"ssub16  %[t4], %[t2], %[t0]\n\t"
+				"str     %[t4], [%[pde]], #4\n\t"        /* vd even */
+				"ssub16  %[t4], %[t3], %[t1]\n\t"
+				"str     %[t4], [%[pdo]], #4\n\t"        /* vd odd */
+				"add     %[t0], %[t0], %[t2]\n\t"
+				"add     %[t1], %[t1], %[t3]\n\t"
+				"ldr     %[t3], [%[pb], #4]\n\t"         /* ob */
+				"ldr     %[t2], [%[pb]], #8\n\t"         /* eb */
+				"add     %[t0], %[t0], %[t2], lsl #1\n\t"
+				"add     %[t1], %[t1], %[t3], lsl #1\n\t"
+				"str     %[t0], [%[pse]], #4\n\t"        /* vs even */
+				"str     %[t1], [%[pso]], #4\n\t"        /* vs odd */
 				"cmp     %[pa], %[end]\n\t"
 				"bne     1b"
 				: [pa] "+r"(pa), [pb] "+r"(pb), [pc] "+r"(pc), [pse] "+r"(pse), [pso] "+r"(pso),
@@ -260,8 +276,9 @@ void gradientRowV6(const std::uint8_t *a, const std::uint8_t *b, const std::uint
 		}
 		for (int i = 4 * words; i < w; ++i) {
 			std::int16_t *vs = (i & 1) ? sO : sE, *vd = (i & 1) ? dO : dE;
-			vs[i / 2] = static_cast<std::int16_t>(a[i] + 2 * b[i] + c[i]);
-			vd[i / 2] = static_cast<std::int16_t>(c[i] - a[i]);
+			const int pa = getSmoothed(a, i), pb = getSmoothed(b, i), pc = getSmoothed(c, i);
+			vs[i / 2] = static_cast<std::int16_t>(pa + 2 * pb + pc);
+			vd[i / 2] = static_cast<std::int16_t>(pc - pa);
 		}
 		/* Pass 2, pixels 2j+1 .. 2j+4: a word loaded at index j of an
 		 * array holds columns (2j, 2j+2) or (2j+1, 2j+3), so

@@ -29,7 +29,7 @@ struct GradRows {
 
 /// Per-thread scratch: rings of smoothed rows and of gradient rows.
 struct RowScratch {
-	std::vector<std::uint8_t> smooth[4];
+	std::vector<std::uint8_t> smooth[4];   ///< 2w + 8 bytes: the ARMv6 layout needs 2w
 	std::vector<std::uint16_t> columns;    ///< smoothRow's vertical pass
 	std::vector<std::int16_t> separable;   ///< gradientRow's two column passes (2w + 16)
 	/// gx holds 2w values: the ARMv6 kernels store (gx, gy) pairs in it.
@@ -41,7 +41,7 @@ struct RowScratch {
 	void resize(int w)
 	{
 		for (int i = 0; i < 4; ++i)
-			smooth[i].resize(w);
+			smooth[i].resize(2 * static_cast<std::size_t>(w) + 8);
 		columns.resize(w);
 		separable.resize(2 * static_cast<std::size_t>(w) + 16);
 		products.resize(3 * static_cast<std::size_t>(w));
@@ -105,9 +105,16 @@ const RowKernels &bestRowKernels();
 
 #if defined(__ARM_FEATURE_SIMD32) && defined(__ARM_FEATURE_DSP)
 #define FRAPPE_HAVE_ARMV6_KERNELS 1
-/// ARMv6 SIMD32 kernels (front_end_armv6.cpp): the scalar kernels' bytes,
-/// but the gradient row stores (gx, gy) int16 pairs in `gx` and leaves `gy`.
+/// ARMv6 SIMD32 kernels (front_end_armv6.cpp): the scalar kernels' EdgeMap,
+/// but their own row layouts: the smoothed rows lane-split (below), and the
+/// gradient row's (gx, gy) as int16 pairs in `gx` (`gy` unused).
 const RowKernels &armv6RowKernels();
+/// Where the ARMv6 smoothing stores pixel x of a row: as a uint16, per four
+/// pixels 4k .. 4k+3 the words (p0, p2), (p1, p3).
+inline std::size_t armv6SmoothedOffset(int x)
+{
+	return 8 * static_cast<std::size_t>(x >> 2) + 4 * (x & 1) + 2 * ((x >> 1) & 1);
+}
 #endif
 
 /// A CPU front end with the given kernels (tests compare them).

@@ -77,20 +77,35 @@ void checkRows(const RowKernels &ref, const RowKernels &k, int w, int kind, int 
 	fillRow(b, w, kind);
 	fillRow(c, w, kind);
 	std::vector<std::uint16_t> tmp(w);
-	std::vector<std::uint8_t> o1(w + 4, 0xAB), o2(w + 4, 0xAB);
+	/* The ARMv6 smoothing stores its row lane-split (armv6SmoothedOffset). */
+	const std::size_t s16 = 2 * static_cast<std::size_t>(w) + 8;
+	std::vector<std::uint8_t> o1(w, 0xAB), o2(s16 + 8, 0xAB);
 	ref.smooth(a, b, c, w, o1.data(), tmp.data());
 	k.smooth(a, b, c, w, o2.data(), tmp.data());
-	for (int x = 0; x < w + 4; ++x)
-		CHECK(o1[x] == o2[x], "smoothRow w=%d kind=%d x=%d: %d vs %d", w, kind, x, o1[x], o2[x]);
+	for (int x = 0; x < w; ++x) {
+		std::uint16_t v;
+		std::memcpy(&v, o2.data() + armv6SmoothedOffset(x), 2);
+		CHECK(o1[x] == v, "smoothRow w=%d kind=%d x=%d: %d vs %d", w, kind, x, o1[x], v);
+	}
+	for (std::size_t i = s16; i < s16 + 8; ++i)
+		CHECK(o2[i] == 0xAB, "smoothRow w=%d wrote past its row", w);
 	if (w < 3)
 		return;
+	/* The gradient kernels take the rows in their smoothing's layout. */
+	std::vector<std::uint8_t> la(s16, 0), lb(s16, 0), lc(s16, 0);
+	for (int x = 0; x < w; ++x) {
+		const std::uint16_t va = a[x], vb = b[x], vc = c[x];
+		std::memcpy(la.data() + armv6SmoothedOffset(x), &va, 2);
+		std::memcpy(lb.data() + armv6SmoothedOffset(x), &vb, 2);
+		std::memcpy(lc.data() + armv6SmoothedOffset(x), &vc, 2);
+	}
 
 	std::vector<std::int16_t> gx(2 * w + 8, 0x5555), gy(2 * w + 8, 0x5555), rgx(w), rgy(w), sep(2 * w + 16);
 	std::vector<std::int32_t> mag(w + 4, 0x55555555), rmag(w);
 	std::vector<std::int32_t> t0(w), t1(w), t2(w), prod(3 * w);
 	const TensorRow tensor{ t0.data(), t1.data(), t2.data(), prod.data() };
 	ref.gradient(a, b, c, w, rgx.data(), rgy.data(), rmag.data(), sep.data(), tensor);
-	k.gradient(a, b, c, w, gx.data(), gy.data(), mag.data(), sep.data(), tensor);
+	k.gradient(la.data(), lb.data(), lc.data(), w, gx.data(), gy.data(), mag.data(), sep.data(), tensor);
 	for (int x = 0; x < w; ++x) {
 		/* The ARMv6 kernel stores (gx, gy) pairs in the gx buffer. */
 		CHECK(gx[2 * x] == rgx[x] && gx[2 * x + 1] == rgy[x] && mag[x] == rmag[x],
