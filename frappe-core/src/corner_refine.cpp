@@ -20,6 +20,19 @@ constexpr int kCoarseSamples = 16; /* edge points per side, first pass */
 constexpr int kMaxProfile = 64;  /* samples along one normal */
 constexpr float kProfileStep = 0.5f;
 
+/* sampleBilinear for 0 <= x <= width - 2, 0 <= y <= height - 2, where its
+ * clamps do nothing: the same arithmetic, without them. */
+inline float sampleInside(const ImageView &img, float x, float y)
+{
+	const int x0 = static_cast<int>(x), y0 = static_cast<int>(y);
+	const float fx = x - static_cast<float>(x0), fy = y - static_cast<float>(y0);
+	const std::uint8_t *r0 = img.row(y0);
+	const std::uint8_t *r1 = img.row(y0 + 1);
+	const float top = static_cast<float>(r0[x0]) + fx * static_cast<float>(r0[x0 + 1] - r0[x0]);
+	const float bot = static_cast<float>(r1[x0]) + fx * static_cast<float>(r1[x0 + 1] - r1[x0]);
+	return top + fy * (bot - top);
+}
+
 /* Measures one side from a to b (clockwise quad, so the marker interior is
  * on the right of a->b on screen). */
 bool fitSide(const ImageView &img, Point2f a, Point2f b, float search, int maxSamples, Line &line)
@@ -43,6 +56,10 @@ bool fitSide(const ImageView &img, Point2f a, Point2f b, float search, int maxSa
 	stepsUp += static_cast<float>(stepsUp) < steps;
 	const int half = std::min(kMaxProfile / 2 - 1, stepsUp + 1);
 
+	/* Where sampleInside may be used (-1: nowhere). */
+	const float xMax = img.width >= 2 && img.height >= 2 ? static_cast<float>(img.width - 2) : -1.0f;
+	const float yMax = img.width >= 2 && img.height >= 2 ? static_cast<float>(img.height - 2) : -1.0f;
+
 	double sw = 0, sx = 0, sy = 0, sxx = 0, syy = 0, sxy = 0;
 	int used = 0;
 	float profile[kMaxProfile];
@@ -50,9 +67,23 @@ bool fitSide(const ImageView &img, Point2f a, Point2f b, float search, int maxSa
 		const float t = margin + usable * (static_cast<float>(i) + 0.5f) / static_cast<float>(nSamples);
 		const float px = a.x + ux * t, py = a.y + uy * t;
 		const int n = 2 * half + 1;
-		for (int k = 0; k < n; ++k) {
-			const float s = static_cast<float>(k - half) * kProfileStep;
-			profile[k] = sampleBilinear(img, px + nx * s, py + ny * s);
+		/* The samples lie on a segment, in order (float rounding is
+		 * monotonic), so when both ends are at least a pixel inside the
+		 * image all are, and sampleBilinear's clamps change nothing. */
+		const float sA = static_cast<float>(0 - half) * kProfileStep;
+		const float sB = static_cast<float>(n - 1 - half) * kProfileStep;
+		const float xA = px + nx * sA, xB = px + nx * sB, yA = py + ny * sA, yB = py + ny * sB;
+		if (xA >= 0.0f && xB >= 0.0f && xA <= xMax && xB <= xMax && yA >= 0.0f && yB >= 0.0f &&
+		    yA <= yMax && yB <= yMax) {
+			for (int k = 0; k < n; ++k) {
+				const float s = static_cast<float>(k - half) * kProfileStep;
+				profile[k] = sampleInside(img, px + nx * s, py + ny * s);
+			}
+		} else {
+			for (int k = 0; k < n; ++k) {
+				const float s = static_cast<float>(k - half) * kProfileStep;
+				profile[k] = sampleBilinear(img, px + nx * s, py + ny * s);
+			}
 		}
 		/* Strongest drop in intensity going inwards (white border outside,
 		 * black frame inside); steps of the other sign belong to other edges. */
