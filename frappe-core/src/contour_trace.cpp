@@ -49,14 +49,14 @@ struct NextStepTable {
 constexpr NextStepTable kNextStep;
 
 /* The same table indexed by the neighbourhood read a row at a time: bits
- * 0..2 the row above (x-1, x, x+1), 3..5 this row (the centre, bit 4, is
- * ignored), 6..8 the row below. */
+ * 0..2 column x-1 (rows above, this, below), 3..5 column x (the centre, bit
+ * 4, is ignored), 6..8 column x+1. */
 struct RowStepTable {
 	std::uint8_t entry[8][512];
 	constexpr RowStepTable() : entry{}
 	{
 		/* Index bit of each direction, in kDx/kDy order. */
-		constexpr int kBit[8] = { 5, 2, 1, 0, 3, 6, 7, 8 };
+		constexpr int kBit[8] = { 7, 6, 3, 0, 1, 2, 5, 8 };
 		for (int back = 0; back < 8; ++back)
 			for (int idx = 0; idx < 512; ++idx) {
 				int mask = 0;
@@ -68,18 +68,28 @@ struct RowStepTable {
 };
 constexpr RowStepTable kRowStep;
 
-/* Bits 0..2: which of the three labels at p[0], p[1], p[2] are non-zero
- * (labels are 0..3). Reads p[3] too: the label image has padding. */
-inline unsigned rowBits(const std::uint8_t *p)
+/* Bit 0 of byte i: whether label p[i] is non-zero (labels are 0..3), for
+ * i = 0, 1, 2. Reads p[3] too: the label image has padding. */
+inline std::uint32_t rowNonZero(const std::uint8_t *p)
+{
+	std::uint32_t v;
+	std::memcpy(&v, p, 4);
+	return (v | (v >> 1)) & 0x00010101u;
+}
+
+/* The RowStepTable index of the 3x3 neighbourhood around p. */
+inline unsigned neighbourIndex(const std::uint8_t *p, int w)
 {
 	if constexpr (std::endian::native == std::endian::little) {
-		std::uint32_t v;
-		std::memcpy(&v, p, 4);
-		v = (v | (v >> 1)) & 0x00010101u;
-		return (v | (v >> 7) | (v >> 14)) & 7u;
+		const std::uint32_t raw =
+			rowNonZero(p - w - 1) | rowNonZero(p - 1) << 1 | rowNonZero(p + w - 1) << 2;
+		return (raw & 7u) | ((raw >> 5) & 0x38u) | ((raw >> 10) & 0x1C0u);
 	} else {
-		return static_cast<unsigned>(p[0] != 0) | static_cast<unsigned>(p[1] != 0) << 1 |
-		       static_cast<unsigned>(p[2] != 0) << 2;
+		unsigned idx = 0;
+		for (int dx = -1; dx <= 1; ++dx)
+			for (int dy = -1; dy <= 1; ++dy)
+				idx |= static_cast<unsigned>(p[dy * w + dx] != 0) << (3 * (dx + 1) + dy + 1);
+		return idx;
 	}
 }
 
@@ -218,16 +228,32 @@ void ContourTracer::follow(int x0, int y0, int fromDir, const EdgeMap &edges)
 {
 	clusters_.clear();
 	tooManyClusters_ = false;
-	steps_ = 0;
 	std::uint8_t *L = labels_.data();
 	const std::uint8_t *E = edges.pixels.data();
 	const int w = stride_;
 	auto at = [&](int x, int y) -> std::uint8_t & { return L[static_cast<std::size_t>(y) * w + x]; };
 
 	points_.clear();
+	/* The points go through a small local buffer and the step count is a
+	 * local: the label stores (bytes, which may alias anything) would make
+	 * the compiler reload the members on every step. */
+	constexpr int kChunk = 128;
+	Pixel chunk[kChunk];
+	int inChunk = 0;
+	int steps = 0;
+	auto flush = [&] {
+		points_.insert(points_.end(), chunk, chunk + inChunk);
+		inChunk = 0;
+	};
+	auto finish = [&] {
+		flush();
+		steps_ = steps;
+	};
 	auto visit = [&](int x, int y) __attribute__((always_inline)) {
-		++steps_;
-		points_.push_back({ x, y });
+		++steps;
+		chunk[inChunk++] = { x, y };
+		if (inChunk == kChunk)
+			flush();
 		if (!(E[static_cast<std::size_t>(y) * w + x] & EdgeMap::kCorner) || tooManyClusters_)
 			return;
 		const float fx = static_cast<float>(x), fy = static_cast<float>(y);
@@ -262,6 +288,7 @@ void ContourTracer::follow(int x0, int y0, int fromDir, const EdgeMap &edges)
 	if (mask0 == 0) {
 		*p0 = 3; /* isolated pixel */
 		visit(x0, y0);
+		finish();
 		return;
 	}
 	int d1 = fromDir;
@@ -274,8 +301,7 @@ void ContourTracer::follow(int x0, int y0, int fromDir, const EdgeMap &edges)
 	const std::size_t maxSteps = 4 * labels_.size();
 	for (;;) {
 		/* 3.3: counter-clockwise from the pixel after `back`. */
-		const unsigned idx = rowBits(p3 - w - 1) | rowBits(p3 - 1) << 3 | rowBits(p3 + w - 1) << 6;
-		const std::uint8_t step = kRowStep.entry[back][idx];
+		const std::uint8_t step = kRowStep.entry[back][neighbourIndex(p3, w)];
 		const int d4 = step & 7;
 		/* 3.4: mark the current pixel. */
 		if (step & 8)
@@ -285,14 +311,18 @@ void ContourTracer::follow(int x0, int y0, int fromDir, const EdgeMap &edges)
 		visit(x3, y3);
 		std::uint8_t *p4 = p3 + off[d4];
 		/* 3.5: back at the start, about to repeat the first move. */
-		if (p4 == p0 && p3 == p1)
+		if (p4 == p0 && p3 == p1) {
+			finish();
 			return;
+		}
 		back = (d4 + 4) & 7;
 		p3 = p4;
 		x3 += kDx[d4];
 		y3 += kDy[d4];
-		if (static_cast<std::size_t>(steps_) > maxSteps) /* only on a corrupt label image */
+		if (static_cast<std::size_t>(steps) > maxSteps) { /* only on a corrupt label image */
+			finish();
 			return;
+		}
 	}
 }
 
