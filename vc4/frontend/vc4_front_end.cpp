@@ -176,8 +176,7 @@ public:
 			for (unsigned t = p; t < tiles; t += kPrograms) {
 				const uint32_t x0 = (t % g.tilesX()) * kTileW, y0 = (t / g.tilesX()) * kTileH;
 				const kernels::GradientUniforms u1{
-					buf_.src.bus, stride, static_cast<uint32_t>(g.src_w - 1), static_cast<uint32_t>(g.src_h - 1),
-					stepX, stepY, static_cast<uint32_t>(g.w - 1), static_cast<uint32_t>(g.h - 1), x0, y0,
+					static_cast<uint32_t>(g.src_w - 1), stepX, static_cast<uint32_t>(g.w - 1), x0,
 					grad + y0 * pitch + 4 * x0, pitch,
 					isa::VdwStride{.stride = static_cast<uint16_t>(pitch / 4 - 64)}.word()};
 				const kernels::EdgeUniforms u2{
@@ -185,7 +184,17 @@ public:
 					x0, y0, edgeThr, cornerC, buf_.edge.bus + y0 * pw + x0,
 					isa::VdwStride{.stride = static_cast<uint16_t>(pw - 64)}.word(), 4 * pw,
 					buf_.mask.bus + 128 * t};
-				p1 = append(p1, &u1, sizeof(u1), t + kPrograms < tiles);
+				std::memcpy(p1, &u1, sizeof(u1));
+				p1 += sizeof(u1);
+				for (int strip = 0; strip < 4; ++strip) {
+					uint32_t rows[kernels::kGradientRowUniforms];
+					kernels::gradientRowUniforms(rows, buf_.src.bus, stride, g.src_h, stepY, g.h, static_cast<int>(y0));
+					std::memcpy(p1, rows, sizeof(rows));
+					p1 += sizeof(rows);
+				}
+				const uint32_t more = t + kPrograms < tiles ? 1u : 0u;
+				std::memcpy(p1, &more, 4);
+				p1 += 4;
 				p2 = append(p2, &u2, sizeof(u2), t + kPrograms < tiles);
 			}
 		}
@@ -257,7 +266,7 @@ private:
 	{
 		if (device_ && g == geometry_)
 			return;
-		const uint32_t u1 = 4 * g.uniformWords(kernels::kGradientUniforms);
+		const uint32_t u1 = 4 * g.uniformWords(kernels::kGradientUniforms + 4 * kernels::kGradientRowUniforms);
 		const uint32_t u2 = 4 * g.uniformWords(kernels::kEdgeUniforms);
 		const uint32_t total = g.srcBytes() + g.gradBytes() + 2 * g.gradMargin() + g.edgeBytes() + g.maskBytes() +
 		                       kPrograms * (u1 + u2 + 2 * 4096) + 6 * 4096 + 2 * kCodeSlack;

@@ -51,23 +51,41 @@ inline constexpr int kTileW = 64;
 inline constexpr int kTileH = 32;
 inline constexpr int kMaxWidth = 2048;
 
-/// Pass 1 uniforms of one tile, in stream order (then `more`).
+/// Pass 1 uniforms of one tile, in stream order; then for each of the four 16-pixel
+/// strips the kGradientRowUniforms words of gradientRowUniforms(); then `more`.
 struct GradientUniforms {
-	uint32_t src;        ///< bus address of the full-resolution 8-bit image (4-aligned)
-	uint32_t src_stride; ///< bytes, a multiple of 4
 	uint32_t src_wmax;   ///< full width - 1
-	uint32_t src_hmax;   ///< full height - 1
 	uint32_t step_x;     ///< round(65536 * full width / scaled width), as scaleNearest
-	uint32_t step_y;
 	uint32_t wmax;       ///< scaled width - 1
-	uint32_t hmax;       ///< scaled height - 1
 	uint32_t x0;         ///< tile origin in the scaled frame
-	uint32_t y0;
 	uint32_t dst;        ///< bus address of plane 0 at (x0, y0) in the gradient buffer
 	uint32_t dst_pitch;  ///< gradPitch
 	uint32_t vdw_stride; ///< VdwStride word: gradPitch / 4 - 64
 };
 inline constexpr unsigned kGradientUniforms = sizeof(GradientUniforms) / 4;
+/// Per strip: the source-row address of input row y0-3, then for i = 0 .. 37 the address
+/// of input row y0-2+i and the interior mask of gradient row y0-5+i (-1 for rows 1 .. h-2,
+/// else 0). A row address is src + stride * min(H-1, ((2 clamp(r, 0, h-1) + 1) step_y) >> 17)
+/// (scaleNearest's row, edge replicated); src and stride must be multiples of 4.
+inline constexpr unsigned kGradientRowUniforms = 1 + 2 * 38;
+
+/// Writes one strip's kGradientRowUniforms words for the tile at y0.
+inline uint32_t *gradientRowUniforms(uint32_t *out, uint32_t src, uint32_t stride, int src_h, uint32_t step_y,
+                                     int h, int y0)
+{
+	auto row = [&](int r) {
+		const int y = r < 0 ? 0 : r > h - 1 ? h - 1 : r;
+		const uint64_t sy = ((2 * static_cast<uint64_t>(y) + 1) * step_y) >> 17;
+		return src + stride * static_cast<uint32_t>(sy < static_cast<uint64_t>(src_h - 1) ? sy : src_h - 1);
+	};
+	*out++ = row(y0 - 3);
+	for (int i = 0; i < 38; ++i) {
+		const int g = y0 - 5 + i;
+		*out++ = row(y0 - 2 + i);
+		*out++ = g >= 1 && g <= h - 2 ? 0xffffffffu : 0u;
+	}
+	return out;
+}
 
 /// Pass 2 uniforms of one tile, in stream order (then `more`).
 struct EdgeUniforms {

@@ -6,7 +6,9 @@
 // swept top to bottom with a sliding window. For input row R of a strip every lane
 // gathers the five source pixels at scaled columns x-2 .. x+2 through the TMUs (one
 // request per column, 16 per-lane addresses: this is where nearest scaling and edge
-// replication happen, so both are free), and the window turns them into:
+// replication happen, so both are free; the source row's address and the row's interior
+// mask come from the uniform stream, kGradientRowUniforms a strip), and the window turns
+// them into:
 //   t_k(R-1) = I_k(R-2) + 2 I_k(R-1) + I_k(R)            vertical binomial, k = -2..2
 //   p_j(R-1) = (t_{j-1} + 2 t_j + t_{j+1} + 8) >> 4        smoothed, j = -1..1
 //   hs = p_-1 + 2 p_0 + p_1,  hd = p_1 - p_-1              horizontal Sobel parts
@@ -29,12 +31,10 @@ namespace {
 
 // Registers. Port rule: one read of file A and one of file B per instruction (a small
 // immediate takes B's), and ADD and MUL results of one instruction go to different files.
-constexpr Reg SRC = A(0), SWMAX = A(1), STEPX = A(2), WMAX = A(3), RN = A(4), ROWADDR = A(5),
-	      DSTS = A(6), VPMW = A(7), C106 = A(8), HS = A(22), FP = A(23), G = A(24),
-	      COLTERM = A(25), PXX = A(26), SYY = A(27), PXY = A(28), CNT = A(29),
-	      STRIPCNT = A(30), VDWTOG = A(31);
-constexpr Reg SSTRIDE = B(0), SHMAX = B(1), STEPY = B(2), HMAX = B(3), DPITCH = B(4),
-	      HM2 = B(5), Y0M3 = B(6), DSTBASE = B(7), HD = B(20), GP = B(21), SXX = B(22),
+constexpr Reg SWMAX = A(1), STEPX = A(2), WMAX = A(3), ROWADDR = A(5), DSTS = A(6),
+	      VPMW = A(7), C106 = A(8), HS = A(22), FP = A(23), COLMASK = A(25), PXX = A(26),
+	      SYY = A(27), PXY = A(28), CNT = A(29), STRIPCNT = A(30), VDWTOG = A(31);
+constexpr Reg DPITCH = B(4), DSTBASE = B(7), HD = B(20), GP = B(21), SXX = B(22),
 	      PYY = B(23), SXY = B(24), BPREV = B(25), VDWSTRIDE = B(26), VDWS = B(27),
 	      TMPB = B(29), XS = B(30);
 constexpr Reg COLOFF[5] = {B(8), B(9), B(10), B(11), B(12)};
@@ -45,30 +45,16 @@ constexpr Reg I[5] = {A(19), B(18), A(20), B(19), A(21)};
 
 Dst tmuS(int k) { return (k & 1) ? reg::tmu1_s : reg::tmu0_s; }
 
-// ROWADDR = src + stride * min(H-1, ((2 clamp(RN, 0, h-1) + 1) * step_y) >> 17); RN += 1.
-void rowAddress(Builder &b)
-{
-	b.op(max(r0, RN, imm(0)));
-	b.op(min(r0, r0, HMAX));
-	b.op(shl(r0, r0, imm(1)));
-	b.op(add(r0, r0, imm(1)));
-	b.op(mul24(r1, r0, STEPY));
-	b.op(shr(r1, r1, imm(-15))); // 17: shift counts use the low 5 bits
-	b.op(min(r1, r1, SHMAX));
-	b.op(mul24(r1, r1, SSTRIDE));
-	b.op(add(RN, RN, imm(1)));
-	b.op(add(ROWADDR, r1, SRC));
-}
-
+// Rows come from the uniform stream: the host maps each row like scaleNearest (clamped to
+// the frame), so the scaled fetch costs one uniform read a row.
 // One input row: pop the five gathers of row R, issue row R+1's, and compute the
 // vertical sums t_k into T[k]; then smoothing and the horizontal Sobel parts, leaving
 // gx in r2 and gy in r3 (garbage until the window is full).
 void rowBody(Builder &b)
 {
-	rowAddress(b);
 	for (int k = 0; k < 5; ++k) {
 		if (k == 0)
-			b.ldtmu(0);
+			b.ldtmu(0, mov(ROWADDR, reg::unif)); // the next row's address
 		b.op(shr(r2, r4, COLSH[k]));
 		b.op(add(tmuS(k), ROWADDR, COLOFF[k]), v8min(r2, r2, r5)); // r5 = 0xff: byte mask
 		b.op(add(r3, I[k], r2), mmov(I[k], r2));                  // q = I(R-1) + I(R)
@@ -101,20 +87,15 @@ void rowBody(Builder &b)
 	b.op(add(r2, r1, GP), mmov(GP, r1));
 }
 
-// gx in r2, gy in r3 of gradient row G: zero them off the interior; B(G) and the tensor
-// products P(G); write row G-1 (B, Vxx, Vyy, Vxy) to the VPM; G += 1.
+// gx in r2, gy in r3 of gradient row g: zero them off the interior; B(g) and the tensor
+// products P(g); write row g-1 (B, Vxx, Vyy, Vxy) to the VPM.
 void rowOutput(Builder &b)
 {
-	// Interior: G - 1 >= 0, h - 2 - G >= 0, and the column's term (same sign test).
-	b.op(sub(r0, G, imm(1)));
-	b.op(sub(r1, HM2, G));
-	b.op(bor(r0, r0, r1));
-	b.op(bor(r0, r0, COLTERM));
-	b.op(asr(r0, r0, imm(-1)));                     // -1 off the interior
-	b.op(bnot(r0, r0));
+	// Interior: the row's mask (uniform stream: -1 for rows 1 .. h-2, else 0) and the
+	// column's.
+	b.op(band(r0, COLMASK, reg::unif));
 	b.op(band(r2, r2, r0));
 	b.op(band(r3, r3, r0));
-	b.op(add(G, G, imm(1)));
 	b.op(sub(r0, imm(0), r2));
 	b.op(max(r0, r2, r0));                          // |gx|
 	b.op(sub(r1, imm(0), r3));
@@ -179,19 +160,10 @@ Built build()
 	b.op(add(VDWS, r2, r1));
 
 	Label tile = b.label();
-	b.op(mov(SRC, b.uniform("src", UniformKind::Address)));
-	b.op(mov(SSTRIDE, b.uniform("src_stride")));
 	b.op(mov(SWMAX, b.uniform("src_wmax")));
-	b.op(mov(SHMAX, b.uniform("src_hmax")));
 	b.op(mov(STEPX, b.uniform("step_x")));
-	b.op(mov(STEPY, b.uniform("step_y")));
 	b.op(mov(WMAX, b.uniform("wmax")));
-	b.op(mov(r0, b.uniform("hmax")));
-	b.op(mov(HMAX, r0));
-	b.op(sub(HM2, r0, imm(1)));
 	b.op(mov(XS, b.uniform("x0")));
-	b.op(mov(r0, b.uniform("y0")));
-	b.op(sub(Y0M3, r0, imm(3)));
 	b.op(mov(DSTBASE, b.uniform("dst", UniformKind::Address)));
 	b.op(mov(DPITCH, b.uniform("dst_pitch")));
 	b.op(mov(VDWSTRIDE, b.uniform("vdw_stride")));
@@ -218,12 +190,12 @@ Built build()
 		b.op(sub(r1, r0, imm(1)));
 		b.op(sub(r2, WMAX, r0));
 		b.op(sub(r2, r2, imm(1)));
-		b.op(bor(COLTERM, r1, r2));
-		b.op(mov(RN, Y0M3));
+		b.op(bor(r1, r1, r2));
+		b.op(asr(r1, r1, imm(-1)));   // -1 off the interior columns
+		b.op(bnot(COLMASK, r1));
 		b.op(mov(DSTS, DSTBASE));
-		b.op(sub(G, RN, imm(2)));
 		// Prefetch row y0-3.
-		rowAddress(b);
+		b.op(mov(ROWADDR, reg::unif));
 		for (int k = 0; k < 5; ++k)
 			b.op(add(tmuS(k), ROWADDR, COLOFF[k]));
 		// Prologue: rows y0-3 .. y0+2 fill the window (gradient rows y0-1 and y0 are the

@@ -260,7 +260,7 @@ TEST(Vc4Kernels, ListingsRoundTrip)
 	// The uniform structs of kernels.hpp are the programs' streams, in order, then `more`.
 	EXPECT_EQ(vc4::kernels::gradientPass().program.uniforms.size(), vc4::kernels::kGradientUniforms + 1);
 	EXPECT_EQ(vc4::kernels::edgePass().program.uniforms.size(), vc4::kernels::kEdgeUniforms + 1);
-	EXPECT_EQ(vc4::kernels::gradientPass().program.uniformIndex("vdw_stride"), 12u);
+	EXPECT_EQ(vc4::kernels::gradientPass().program.uniformIndex("vdw_stride"), 6u);
 	EXPECT_EQ(vc4::kernels::edgePass().program.uniformIndex("mask_dst"), 12u);
 	for (const auto &built : {vc4::kernels::gradientPass(), vc4::kernels::edgePass()}) {
 		EXPECT_EQ(vc4::qasm::assembleText(vc4::isa::disassembleProgram(built.program.code)), built.program.code)
