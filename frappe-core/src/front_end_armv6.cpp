@@ -18,7 +18,7 @@
 // SMLATB on the same words; the `gy` buffer is not used.
 #include "front_end_rows.h"
 
-#if defined(__ARM_FEATURE_SIMD32) && defined(__ARM_FEATURE_DSP)
+#if defined(__ARM_FEATURE_SIMD32) && defined(__ARM_FEATURE_DSP) && defined(__ARMEL__)
 
 #include <arm_acle.h>
 

@@ -103,7 +103,7 @@ const RowKernels &scalarRowKernels();
 /// ARMv6 SIMD32 ones, or the scalar ones.
 const RowKernels &bestRowKernels();
 
-#if defined(__ARM_FEATURE_SIMD32) && defined(__ARM_FEATURE_DSP)
+#if defined(__ARM_FEATURE_SIMD32) && defined(__ARM_FEATURE_DSP) && defined(__ARMEL__)
 #define FRAPPE_HAVE_ARMV6_KERNELS 1
 /// ARMv6 SIMD32 kernels (front_end_armv6.cpp): the scalar kernels' EdgeMap,
 /// but their own row layouts: the smoothed rows lane-split (below), and the
