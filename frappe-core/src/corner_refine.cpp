@@ -56,6 +56,11 @@ bool fitSide(const ImageView &img, Point2f a, Point2f b, float search, int maxSa
 	stepsUp += static_cast<float>(stepsUp) < steps;
 	const int half = std::min(kMaxProfile / 2 - 1, stepsUp + 1);
 
+	/* The offsets along the normal, once. */
+	float offsets[kMaxProfile];
+	for (int k = 0; k < 2 * half + 1; ++k)
+		offsets[k] = static_cast<float>(k - half) * kProfileStep;
+
 	/* Where sampleInside may be used (-1: nowhere). */
 	const float xMax = img.width >= 2 && img.height >= 2 ? static_cast<float>(img.width - 2) : -1.0f;
 	const float yMax = img.width >= 2 && img.height >= 2 ? static_cast<float>(img.height - 2) : -1.0f;
@@ -70,20 +75,15 @@ bool fitSide(const ImageView &img, Point2f a, Point2f b, float search, int maxSa
 		/* The samples lie on a segment, in order (float rounding is
 		 * monotonic), so when both ends are at least a pixel inside the
 		 * image all are, and sampleBilinear's clamps change nothing. */
-		const float sA = static_cast<float>(0 - half) * kProfileStep;
-		const float sB = static_cast<float>(n - 1 - half) * kProfileStep;
+		const float sA = offsets[0], sB = offsets[n - 1];
 		const float xA = px + nx * sA, xB = px + nx * sB, yA = py + ny * sA, yB = py + ny * sB;
 		if (xA >= 0.0f && xB >= 0.0f && xA <= xMax && xB <= xMax && yA >= 0.0f && yB >= 0.0f &&
 		    yA <= yMax && yB <= yMax) {
-			for (int k = 0; k < n; ++k) {
-				const float s = static_cast<float>(k - half) * kProfileStep;
-				profile[k] = sampleInside(img, px + nx * s, py + ny * s);
-			}
+			for (int k = 0; k < n; ++k)
+				profile[k] = sampleInside(img, px + nx * offsets[k], py + ny * offsets[k]);
 		} else {
-			for (int k = 0; k < n; ++k) {
-				const float s = static_cast<float>(k - half) * kProfileStep;
-				profile[k] = sampleBilinear(img, px + nx * s, py + ny * s);
-			}
+			for (int k = 0; k < n; ++k)
+				profile[k] = sampleBilinear(img, px + nx * offsets[k], py + ny * offsets[k]);
 		}
 		/* Strongest drop in intensity going inwards (white border outside,
 		 * black frame inside); steps of the other sign belong to other edges. */
