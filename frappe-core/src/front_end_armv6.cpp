@@ -466,6 +466,19 @@ inline u32 nmsGroup(const EdgeRowCtx &e, int x, std::int32_t thr)
 	return mask;
 }
 
+/* The four result bytes of the pixels x .. x+3; out of line, so that the
+ * scan over the (mostly empty) row keeps its registers. */
+__attribute__((noinline)) u32 edgeGroup(const EdgeRowCtx &e, int x, std::int32_t thr)
+{
+	u32 v = 0;
+	for (u32 edges = nmsGroup(e, x, thr); edges; edges &= edges - 1) {
+		const int i = __builtin_ctz(edges);
+		v |= (isCornerV6(e.pairs, x + i, e.twoT) ? EdgeMap::kEdge | EdgeMap::kCorner : EdgeMap::kEdge)
+		     << (8 * i);
+	}
+	return v;
+}
+
 bool edgeRowV6(const GradRows &rows, int w, const FrontEndParams &params, std::uint8_t *out)
 {
 	out[0] = 0;
@@ -485,12 +498,7 @@ bool edgeRowV6(const GradRows &rows, int w, const FrontEndParams &params, std::u
 		const std::int32_t m0 = mid[x], m1 = mid[x + 1], m2 = mid[x + 2], m3 = mid[x + 3];
 		u32 v = 0;
 		if ((m0 | m1 | m2 | m3) > thr) {
-			for (u32 edges = nmsGroup(e, x, thr); edges; edges &= edges - 1) {
-				const int i = __builtin_ctz(edges);
-				v |= (isCornerV6(e.pairs, x + i, e.twoT) ? EdgeMap::kEdge | EdgeMap::kCorner
-									   : EdgeMap::kEdge)
-				     << (8 * i);
-			}
+			v = edgeGroup(e, x, thr);
 			any |= v;
 		}
 		store32(out + x, v);
