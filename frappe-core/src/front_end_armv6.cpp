@@ -348,7 +348,7 @@ inline u32 pairAt(const std::int16_t *row, int x)
 
 /* isCorner on the pair rows: Sxx + Syy by SMLAD, Sxx - Syy by SMLSD, Sxy
  * by SMLATB; then the scalar kernel's int32 test. */
-__attribute__((noinline)) bool isCornerV6(const std::int16_t *const pairRows[3], int x, std::int32_t twoT)
+inline bool isCornerV6(const std::int16_t *const pairRows[3], int x, std::int32_t twoT)
 {
 	std::int32_t s = 0, d = 0, xy = 0;
 	for (int r = 0; r < 3; ++r) {
