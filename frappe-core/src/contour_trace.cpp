@@ -93,6 +93,37 @@ inline unsigned neighbourIndex(const std::uint8_t *p, int w)
 	}
 }
 
+/* Labels of eight pixels at p (and their neighbours at p - 1 .. p + 8, which
+ * must be readable): bit 0 of byte i set where pixel i may start a border,
+ * i.e. an unfollowed edge pixel (label 1) with background on its left (an
+ * outer border), or label 1 or 2 with background on its right (a hole). */
+std::uint64_t borderStarts(const std::uint8_t *p)
+{
+	constexpr std::uint64_t kOnes = 0x0101010101010101ull;
+	std::uint64_t here, left, right;
+	std::memcpy(&here, p, 8);
+	if (here == 0)
+		return 0;
+	std::memcpy(&left, p - 1, 8);
+	std::memcpy(&right, p + 1, 8);
+	const std::uint64_t b0 = here & kOnes, b1 = (here >> 1) & kOnes; /* labels are 0..3 */
+	const std::uint64_t leftZero = ~(left | (left >> 1)) & kOnes;
+	const std::uint64_t rightZero = ~(right | (right >> 1)) & kOnes;
+	return ((b0 & ~b1) & leftZero) | ((b0 ^ b1) & rightZero);
+}
+
+/* Index of the lowest non-zero byte of a non-zero word. */
+int firstByte(std::uint64_t v)
+{
+	/* On 32-bit targets a 64-bit count is a libgcc call. */
+	if constexpr (sizeof(void *) >= 8) {
+		return std::countr_zero(v) >> 3;
+	} else {
+		const auto lo = static_cast<std::uint32_t>(v);
+		return lo ? std::countr_zero(lo) >> 3 : 4 + (std::countr_zero(static_cast<std::uint32_t>(v >> 32)) >> 3);
+	}
+}
+
 float cross(Point2f o, Point2f a, Point2f b)
 {
 	return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x);
@@ -158,25 +189,18 @@ void ContourTracer::trace(const EdgeMap &edges, const TraceParams &params, std::
 			const int x0 = std::max(1, tx * T), x1 = std::min(w - 1, tEnd * T);
 			tx = tEnd;
 			for (int x = x0; x < x1; ++x) {
-				/* Most pixels are background: find the next non-zero label
-				 * eight at a time (little-endian: the lowest set byte is
-				 * the leftmost pixel). */
-				if (x + 8 <= x1) {
-					std::uint64_t word;
-					std::memcpy(&word, row + x, 8);
-					if (word == 0) {
-						x += 7;
-						continue;
-					}
-					if constexpr (std::endian::native == std::endian::little) {
-						/* On 32-bit targets a 64-bit count is a libgcc call. */
-						if constexpr (sizeof(void *) >= 8) {
-							x += std::countr_zero(word) >> 3;
-						} else {
-							const auto lo = static_cast<std::uint32_t>(word);
-							x += lo ? std::countr_zero(lo) >> 3
-								: 4 + (std::countr_zero(static_cast<std::uint32_t>(word >> 32)) >> 3);
+				/* Most pixels are background or lie on a border already
+				 * followed: find the next pixel where a border can start,
+				 * eight at a time (little-endian: the lowest byte is the
+				 * leftmost pixel). */
+				if constexpr (std::endian::native == std::endian::little) {
+					if (x + 8 <= x1) {
+						const std::uint64_t starts = borderStarts(row + x);
+						if (starts == 0) {
+							x += 7;
+							continue;
 						}
+						x += firstByte(starts);
 					}
 				}
 				const std::uint8_t f = row[x];
