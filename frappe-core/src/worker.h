@@ -3,6 +3,7 @@
 // mode: started once per detector, handed work without allocating.
 #pragma once
 
+#include <atomic>
 #include <condition_variable>
 #include <memory>
 #include <mutex>
@@ -51,6 +52,14 @@ private:
 	TaskRef task_;
 	bool busy_ = false;
 	bool quit_ = false;
+	/* Who sleeps on a condition variable, so that the other side only
+	 * notifies when someone is there to wake. */
+	bool workerAsleep_ = false;
+	bool waiterAsleep_ = false;
+	/* busy_, readable without the lock: both sides poll it briefly before
+	 * sleeping, because a wake-up through the kernel costs tens of
+	 * microseconds on virtual machines, a noticeable share of a 1 ms frame. */
+	std::atomic<bool> busyFlag_{ false };
 	std::thread thread_;
 };
 
