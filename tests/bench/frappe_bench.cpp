@@ -33,6 +33,7 @@
 
 #include "frappe/frappe.h"
 #include "frappe/render.h"
+#include "opencv_dictionary.h"
 
 #ifdef FRAPPE_BENCH_APRILTAG
 #include <apriltag/apriltag.h>
@@ -61,22 +62,6 @@ double percentile(std::vector<double> v, double p)
 	return v[lo] + (idx - static_cast<double>(lo)) * (v[hi] - v[lo]);
 }
 
-cv::Ptr<cv::aruco::Dictionary> opencvDictionary(const frappe::Dictionary &d, int maxCorrection)
-{
-	auto dict = cv::makePtr<cv::aruco::Dictionary>();
-	dict->markerSize = d.bits;
-	dict->maxCorrectionBits = maxCorrection;
-	const int n = d.bits;
-	for (int id = 0; id < d.size(); ++id) {
-		cv::Mat bits(n, n, CV_8UC1);
-		for (int r = 0; r < n; ++r)
-			for (int c = 0; c < n; ++c)
-				bits.at<std::uint8_t>(r, c) =
-					static_cast<std::uint8_t>((d.codes[id] >> (n * n - 1 - (r * n + c))) & 1u);
-		dict->bytesList.push_back(cv::aruco::Dictionary::getByteListFromBits(bits));
-	}
-	return dict;
-}
 
 void writeLine(std::ofstream &out, const std::string &image, const std::vector<int> &ids,
 	       const std::vector<std::array<frappe::Point2f, 4>> &corners, double t)

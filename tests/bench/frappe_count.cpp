@@ -34,12 +34,13 @@
 #include <jpeglib.h>
 #include <png.h>
 
-#ifdef FRAPPE_COUNT_OPENCV
-#include <opencv2/aruco.hpp>
-#include <opencv2/core/utility.hpp>
-#endif
-
 #include "frappe/frappe.h"
+
+#ifdef FRAPPE_COUNT_OPENCV
+#include <opencv2/core/utility.hpp>
+
+#include "opencv_dictionary.h"
+#endif
 
 /* The marker functions: the plugin recognises them by name. They must stay
  * real calls (noinline) and differ in body so the linker does not fold them. */
@@ -152,25 +153,6 @@ void writeLine(std::ofstream &out, const std::string &image, const std::vector<i
 	}
 	out << "], \"time_ms\": 0}\n";
 }
-
-#ifdef FRAPPE_COUNT_OPENCV
-cv::Ptr<cv::aruco::Dictionary> opencvDictionary(const frappe::Dictionary &d, int maxCorrection)
-{
-	auto dict = cv::makePtr<cv::aruco::Dictionary>();
-	dict->markerSize = d.bits;
-	dict->maxCorrectionBits = maxCorrection;
-	const int n = d.bits;
-	for (int id = 0; id < d.size(); ++id) {
-		cv::Mat bits(n, n, CV_8UC1);
-		for (int r = 0; r < n; ++r)
-			for (int c = 0; c < n; ++c)
-				bits.at<std::uint8_t>(r, c) =
-					static_cast<std::uint8_t>((d.codes[id] >> (n * n - 1 - (r * n + c))) & 1u);
-		dict->bytesList.push_back(cv::aruco::Dictionary::getByteListFromBits(bits));
-	}
-	return dict;
-}
-#endif
 
 } // namespace
 
