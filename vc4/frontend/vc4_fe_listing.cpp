@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
-// vc4-fe-listing LISTING: writes the front end's two QPU programs (kernels/kernels.hpp) as
-// one vc4asm-syntax listing, with their uniform streams, for review and for re-assembly by
+// vc4-fe-listing LISTING: writes the QPU programs of the vc4 backends, the front end's two
+// passes (kernels/kernels.hpp) and the candidate warp (kernels/warp.hpp), as one
+// vc4asm-syntax listing, with their uniform streams, for review and for re-assembly by
 // vc4asm. Run by meson at build time (vc4_frontend.dis in the build directory).
 #include <cstdio>
 #include <exception>
@@ -8,6 +9,7 @@
 
 #include "isa/disasm.hpp"
 #include "kernels/kernels.hpp"
+#include "kernels/warp.hpp"
 
 int main(int argc, char **argv)
 {
@@ -24,6 +26,11 @@ int main(int argc, char **argv)
 				listing << " " << u.name;
 			listing << "\n" << isa::disassembleProgram(b.program.code, true) << "\n";
 		}
+		const qasm::Program warp = kernels::warpKernel();
+		listing << "# " << warp.name << ": " << warp.code.size() << " instructions; uniforms: "
+			<< kernels::kWarpProgramUniforms << " a program, then " << kernels::kWarpCandidateUniforms
+			<< " a candidate (kernels/warp.hpp)\n"
+			<< isa::disassembleProgram(warp.code, true) << "\n";
 		return listing ? 0 : 1;
 	} catch (const std::exception &e) {
 		std::fprintf(stderr, "vc4-fe-listing: %s\n", e.what());
