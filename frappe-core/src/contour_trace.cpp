@@ -223,11 +223,14 @@ void ContourTracer::trace(const EdgeMap &edges, const TraceParams &params, std::
 				if (!spansAtLeast(0.7f * params.min_side))
 					continue;
 				/* The paper's rule first: the corner clusters; failing that,
-				 * the outline's extreme points. */
+				 * the outline's extreme points, for a border with at least
+				 * two corner clusters (a marker whose faint corners did not
+				 * all register still has two; clutter with none is most of
+				 * what reaches here). */
 				Quad quad;
 				if ((!tooManyClusters_ && clusters_.size() >= 4 && quadFromClusters(quad) &&
 				     acceptQuad(params, w, h, quad)) ||
-				    (quadFromOutline(quad) && acceptQuad(params, w, h, quad)))
+				    (clusters_.size() >= 2 && quadFromOutline(quad) && acceptQuad(params, w, h, quad)))
 					out.push_back(quad);
 			}
 		}
