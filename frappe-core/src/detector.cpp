@@ -7,6 +7,7 @@
 #include <cmath>
 #include <mutex>
 #include <stdexcept>
+#include <span>
 #include <string>
 
 #include "adaptive_scale.h"
@@ -138,11 +139,13 @@ struct Detector::Impl {
 	 * at once: the tracer by runTrace(), the warp buffer by runFinish(). */
 	detail::ContourTracer tracer;
 	detail::WarpedMarker warped;
-	/* With a batch warper: per candidate, the traced outline, whether it
-	 * refined, and its samples (runFinish() only). */
+	/* With a batch warper (runFinish() only): per candidate its traced
+	 * outline, whether it refined, and its place in the warped batch (-1
+	 * when not warped); per warped candidate its corners and samples. */
 	struct Batch {
 		std::vector<std::array<Point2f, 4>> outlines, quads;
 		std::vector<std::uint8_t> refined, warpedOk;
+		std::vector<int> place;
 		std::vector<CandidateSamples> samples;
 	} batch;
 
@@ -203,19 +206,27 @@ void Detector::Impl::refineAndWarpAll(const ImageView &image, Slot &slot, float 
 {
 	const std::size_t n = slot.quads.size();
 	batch.outlines.resize(n);
-	batch.quads.resize(n);
 	batch.refined.resize(n);
-	batch.warpedOk.assign(n, 0);
-	batch.samples.resize(n);
+	batch.place.resize(n);
+	batch.quads.clear();
 	auto t = Clock::now();
 	for (std::size_t k = 0; k < n; ++k) {
-		batch.outlines[k] = slot.quads[k].corners;
-		batch.refined[k] = detail::refineCorners(image, slot.quads[k].corners, search);
-		batch.quads[k] = slot.quads[k].corners;
+		std::array<Point2f, 4> &corners = slot.quads[k].corners;
+		batch.outlines[k] = corners;
+		batch.refined[k] = detail::refineCorners(image, corners, search);
+		batch.place[k] = -1;
+		if (batch.refined[k] && sidesAtLeast(corners, config.min_marker_side)) {
+			batch.place[k] = static_cast<int>(batch.quads.size());
+			batch.quads.push_back(corners);
+		}
 	}
 	refineMs += msSince(t);
 	t = Clock::now();
-	warper->warp(image, batch.quads, (dict->bits + 2) * detail::kSamplesPerCell, batch.samples, batch.warpedOk);
+	const std::size_t m = batch.quads.size();
+	batch.warpedOk.assign(m, 0);
+	batch.samples.resize(std::max(batch.samples.size(), m));
+	warper->warp(image, batch.quads, (dict->bits + 2) * detail::kSamplesPerCell,
+		     std::span(batch.samples).first(m), batch.warpedOk);
 	warpMs += msSince(t);
 }
 
@@ -258,8 +269,9 @@ void Detector::Impl::finish(const ImageView &image, Slot &slot)
 			t = Clock::now();
 			const detail::WarpedMarker *samples = &warped;
 			if (batched) {
-				refined = batch.warpedOk[k] != 0;
-				samples = &batch.samples[k];
+				const int j = batch.place[k];
+				refined = batch.warpedOk[static_cast<std::size_t>(j)] != 0;
+				samples = &batch.samples[static_cast<std::size_t>(j)];
 			} else {
 				refined = detail::warpMarker(image, q.corners, bits, warped);
 			}
@@ -294,13 +306,12 @@ void Detector::Impl::finish(const ImageView &image, Slot &slot)
 			/* Refinement can pull a small, blurred marker's sides onto its
 			 * code's edges; the traced outline may still read. */
 			t = Clock::now();
-			const std::array<Point2f, 4> traced = outline;
-			if (detail::warpMarker(image, traced, bits, warped)) {
+			if (detail::warpMarker(image, outline, bits, warped)) {
 				const detail::Binarised bt = detail::binarise(warped, bits);
 				if (bt.contrast >= 10.0f && bt.border_errors <= borderAllowance) {
 					d = detail::decode(*dict, bt.code, maxHamming);
 					if (d.id >= 0)
-						q.corners = traced;
+						q.corners = outline;
 				}
 			}
 			decodeMs += msSince(t);
