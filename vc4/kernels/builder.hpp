@@ -70,6 +70,18 @@ public:
 		nop();
 		nop();
 	}
+	/// The end of a tile's body: another tile follows when the uniform `more` is
+	/// non-zero (the host closes each tile's uniform block with it); then wait for the
+	/// last VDW store.
+	void nextTileOrEnd(Label tile)
+	{
+		op(mov(r0, uniform("more")).setFlags());
+		a_.branch(tile, isa::BranchCond::AnyZClear);
+		nop();
+		nop();
+		nop();
+		op(mov(reg::nop, reg::vw_wait));
+	}
 	Label label()
 	{
 		// The other way in is a loop's last delay slot, a nop: the fall-through

@@ -225,13 +225,7 @@ Built build()
 		b.op(add(XS, XS, r1));
 	}
 	b.loopEnd(strip, STRIPCNT);
-	// Another tile follows when `more` is non-zero.
-	b.op(mov(r0, b.uniform("more")).setFlags());
-	b.assembler().branch(tile, isa::BranchCond::AnyZClear);
-	b.nop();
-	b.nop();
-	b.nop();
-	b.op(mov(reg::nop, reg::vw_wait));
+	b.nextTileOrEnd(tile);
 	Built out;
 	out.nops = b.nops();
 	out.program = b.finish();

@@ -248,12 +248,7 @@ Built build()
 		b.op(mov(reg::nop, reg::vw_wait));
 	}
 	b.loopEnd(half, HALFCNT);
-	b.op(mov(r0, b.uniform("more")).setFlags());
-	b.assembler().branch(tile, isa::BranchCond::AnyZClear);
-	b.nop();
-	b.nop();
-	b.nop();
-	b.op(mov(reg::nop, reg::vw_wait));
+	b.nextTileOrEnd(tile);
 	Built out;
 	out.nops = b.nops();
 	out.program = b.finish();
