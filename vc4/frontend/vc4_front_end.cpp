@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "emu/device.hpp"
+#include "frontend/emulator.hpp"
 #include "isa/setup_words.hpp"
 #include "kernels/kernels.hpp"
 
@@ -69,22 +70,12 @@ struct EmuBackend {
 	static const char *name() { return "vc4-emu"; }
 	Device &open(uint32_t bytes, Buffers<Device> &)
 	{
-		emu::Config config;
-		config.strict = options.strict;
-		config.tmu_fifo_limit = 4; // what the hardware does reliably (vc4asm addendum)
-		device = std::make_unique<emu::Device>(config, roundUp(bytes + (1u << 20), 1u << 20));
+		device = openEmulator(options, bytes);
 		return *device;
 	}
 	void run(std::span<const emu::Job> jobs, PassCounts &c)
 	{
-		emu::LaunchOptions lo;
-		if (options.seed) {
-			lo.schedule = emu::Schedule::Random;
-			lo.seed = options.seed;
-		}
-		const emu::LaunchStats s = device->wait(device->launch(jobs, lo));
-		if (s.host_interrupts != jobs.size())
-			throw std::runtime_error("vc4-emu: a QPU program ended without raising the host interrupt");
+		const emu::LaunchStats s = runOnEmulator(*device, jobs, options);
 		c.instructions = s.instructions;
 		c.slowest_cycles = s.cycles;
 		c.programs = static_cast<unsigned>(jobs.size());

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "emu/device.hpp"
+#include "frontend/emulator.hpp"
 #include "kernels/warp.hpp"
 #include "kernels/warp_reference.hpp"
 #if FRAPPE_VC4_HAVE_RUNTIME
@@ -34,23 +35,10 @@ struct EmuTarget {
 	static const char *name() { return "vc4-emu"; }
 	Device &open(uint32_t bytes)
 	{
-		emu::Config config;
-		config.strict = options.strict;
-		config.tmu_fifo_limit = 4; // what the hardware does reliably (vc4asm addendum)
-		device = std::make_unique<emu::Device>(config, roundUp(bytes + (1u << 20), 1u << 20));
+		device = openEmulator(options, bytes);
 		return *device;
 	}
-	void run(std::span<const Job> jobs)
-	{
-		emu::LaunchOptions lo;
-		if (options.seed) {
-			lo.schedule = emu::Schedule::Random;
-			lo.seed = options.seed;
-		}
-		const emu::LaunchStats s = device->wait(device->launch(jobs, lo));
-		if (s.host_interrupts != jobs.size())
-			throw std::runtime_error("vc4-emu: a warp program ended without raising the host interrupt");
-	}
+	void run(std::span<const Job> jobs) { runOnEmulator(*device, jobs, options); }
 };
 
 #if FRAPPE_VC4_HAVE_RUNTIME
