@@ -154,7 +154,8 @@ float dist2(Point2f a, Point2f b)
 
 } // namespace
 
-void ContourTracer::trace(const EdgeMap &edges, const TraceParams &params, std::vector<Quad> &out)
+void ContourTracer::trace(const EdgeMap &edges, const TraceParams &params, std::vector<Quad> &out,
+			  MarkerProbe *probe)
 {
 	out.clear();
 	borders_ = 0;
@@ -230,10 +231,99 @@ void ContourTracer::trace(const EdgeMap &edges, const TraceParams &params, std::
 				Quad quad;
 				if ((!tooManyClusters_ && clusters_.size() >= 4 && quadFromClusters(quad) &&
 				     acceptQuad(params, w, h, quad)) ||
-				    (clusters_.size() >= 2 && quadFromOutline(quad) && acceptQuad(params, w, h, quad)))
+				    (clusters_.size() >= 2 && quadFromOutline(quad) && acceptQuad(params, w, h, quad))) {
 					out.push_back(quad);
+					if (probe && probe->isMarker(quad))
+						sealInside(quad, w, h);
+				}
 			}
 		}
+	}
+}
+
+namespace {
+
+/* Where the line `along` = v (y = v when byRows, else x = v) crosses the
+ * convex quad: false when it misses it. */
+bool quadSpan(const std::array<Point2f, 4> &q, float v, bool byRows, float &lo, float &hi)
+{
+	lo = 1e30f;
+	hi = -1e30f;
+	for (int i = 0; i < 4; ++i) {
+		const float au = byRows ? q[i].x : q[i].y, av = byRows ? q[i].y : q[i].x;
+		const Point2f &n = q[(i + 1) & 3];
+		const float bu = byRows ? n.x : n.y, bv = byRows ? n.y : n.x;
+		if ((v < av && v < bv) || (v > av && v > bv))
+			continue;
+		if (av == bv) {
+			lo = std::min(lo, std::min(au, bu));
+			hi = std::max(hi, std::max(au, bu));
+		} else {
+			const float u = au + (bu - au) * (v - av) / (bv - av);
+			lo = std::min(lo, u);
+			hi = std::max(hi, u);
+		}
+	}
+	return lo <= hi;
+}
+
+} // namespace
+
+/* Labels the marker's inside 3: followed, with nothing to start (outer
+ * borders start at a 1, hole borders before a 0), so neither the code's
+ * cells nor the hole border of the outline are followed. The quad's sides
+ * run within a pixel of the outline, inside or outside it: rows (then
+ * columns) are filled across the quad and on through the background left
+ * between the quad and the outline, as far as the outline, but never more
+ * than kReach pixels beyond the quad, so that a side not closed by an
+ * outline pixel cannot leak the fill outside. Zero pixels left enclosed
+ * would each start a small hole border. */
+void ContourTracer::sealInside(const Quad &quad, int w, int h)
+{
+	constexpr int kReach = 3;
+	const auto &q = quad.corners;
+	std::uint8_t *L = labels_.data();
+	const int stride = stride_;
+	float minX = q[0].x, maxX = q[0].x, minY = q[0].y, maxY = q[0].y;
+	for (const Point2f &p : q) {
+		minX = std::min(minX, p.x);
+		maxX = std::max(maxX, p.x);
+		minY = std::min(minY, p.y);
+		maxY = std::max(maxY, p.y);
+	}
+	/* Extends a run of filled pixels from `from` in steps of `step` over
+	 * background until the outline; returns the new end. */
+	auto reach = [&](std::ptrdiff_t from, std::ptrdiff_t step, int room) {
+		for (int k = 1; k <= std::min(kReach, room); ++k) {
+			if (L[from + k * step] != 0) {
+				for (int j = 1; j < k; ++j)
+					L[from + j * step] = 3;
+				break;
+			}
+		}
+	};
+	float lo, hi;
+	for (int y = std::max(1, static_cast<int>(std::ceil(minY))); y <= std::min(h - 2, static_cast<int>(maxY)); ++y) {
+		if (!quadSpan(q, static_cast<float>(y), true, lo, hi))
+			continue;
+		const int x0 = std::max(1, static_cast<int>(std::ceil(lo)));
+		const int x1 = std::min(w - 2, static_cast<int>(std::floor(hi)));
+		if (x0 > x1)
+			continue;
+		const std::ptrdiff_t row = static_cast<std::ptrdiff_t>(y) * stride;
+		std::memset(L + row + x0, 3, static_cast<std::size_t>(x1 - x0 + 1));
+		reach(row + x0, -1, x0 - 1);
+		reach(row + x1, 1, w - 2 - x1);
+	}
+	for (int x = std::max(1, static_cast<int>(std::ceil(minX))); x <= std::min(w - 2, static_cast<int>(maxX)); ++x) {
+		if (!quadSpan(q, static_cast<float>(x), false, lo, hi))
+			continue;
+		const int y0 = std::max(1, static_cast<int>(std::ceil(lo)));
+		const int y1 = std::min(h - 2, static_cast<int>(std::floor(hi)));
+		if (y0 > y1)
+			continue;
+		reach(static_cast<std::ptrdiff_t>(y0) * stride + x, -stride, y0 - 1);
+		reach(static_cast<std::ptrdiff_t>(y1) * stride + x, stride, h - 2 - y1);
 	}
 }
 

@@ -24,14 +24,28 @@ struct TraceParams {
 	float border_margin = 1.0f;  ///< corners must lie this far inside the frame
 };
 
+/// Asked during the scan whether an accepted quad is a marker. Nothing else
+/// can lie inside a marker, so the tracer seals its inside before the scan
+/// gets there: its code's cells are never followed (on a frame full of
+/// markers they are most of the edge pixels), nor is the hole border of its
+/// outline, which would be a second candidate for the same marker.
+class MarkerProbe
+{
+public:
+	virtual ~MarkerProbe() = default;
+	virtual bool isMarker(const Quad &quad) = 0;
+};
+
 /// Follows every border of the edge image once, keeps the closed ones with
 /// exactly four corner clusters that make a plausible marker outline, and
 /// drops the duplicate that the inner and outer borders of one ring give.
 class ContourTracer
 {
 public:
-	/// Appends the accepted quads to `out` (cleared first).
-	void trace(const EdgeMap &edges, const TraceParams &params, std::vector<Quad> &out);
+	/// Appends the accepted quads to `out` (cleared first). With a probe,
+	/// the inside of each quad it calls a marker is skipped.
+	void trace(const EdgeMap &edges, const TraceParams &params, std::vector<Quad> &out,
+		   MarkerProbe *probe = nullptr);
 
 	/// Borders followed in the last call, for statistics.
 	int bordersFollowed() const { return borders_; }
@@ -50,6 +64,7 @@ private:
 	bool quadFromClusters(Quad &quad) const;
 	bool quadFromOutline(Quad &quad) const;
 	bool acceptQuad(const TraceParams &params, int w, int h, Quad &quad) const;
+	void sealInside(const Quad &quad, int w, int h);
 
 	std::vector<std::uint8_t> labels_;
 	std::vector<Cluster> clusters_;

@@ -17,18 +17,48 @@ bool warpMarker(const ImageView &image, const std::array<Point2f, 4> &corners, i
 	return warpToGrid(image, corners, (bits + 2) * kSamplesPerCell, out);
 }
 
+/* bilinear sampling where sampleBilinear's clamps do nothing */
+inline float sampleInside(const ImageView &img, float x, float y)
+{
+	const int x0 = static_cast<int>(x), y0 = static_cast<int>(y);
+	const float fx = x - static_cast<float>(x0), fy = y - static_cast<float>(y0);
+	const std::uint8_t *r0 = img.row(y0) + x0;
+	const std::uint8_t *r1 = img.row(y0 + 1) + x0;
+	const float top = static_cast<float>(r0[0]) + fx * static_cast<float>(r0[1] - r0[0]);
+	const float bot = static_cast<float>(r1[0]) + fx * static_cast<float>(r1[1] - r1[0]);
+	return top + fy * (bot - top);
+}
+
 bool warpToGrid(const ImageView &image, const std::array<Point2f, 4> &corners, int side, WarpedMarker &out)
 {
 	const auto H = Homography::fromUnitSquare(corners);
 	if (!H)
 		return false;
 	out.side = side;
+	/* The samples lie inside the quad (a projective map keeps the unit
+	 * square's inside inside): when its corners are at least a pixel
+	 * inside the image, no sample needs clamping. */
+	bool inside = image.width >= 2 && image.height >= 2;
+	for (const Point2f &c : corners)
+		inside = inside && c.x >= 0.0f && c.y >= 0.0f && c.x <= static_cast<float>(image.width - 2) &&
+			 c.y <= static_cast<float>(image.height - 2);
+	/* Along a row of the grid the homography's numerators and denominator
+	 * are linear in the column: three additions and a division a sample. */
+	const auto &h = H->h;
 	const double step = 1.0 / side;
 	for (int j = 0; j < side; ++j) {
-		const double v = (j + 0.5) * step;
+		const double v = (j + 0.5) * step, u0 = 0.5 * step;
+		double nx = h[0] * u0 + h[1] * v + h[2], ny = h[3] * u0 + h[4] * v + h[5];
+		double d = h[6] * u0 + h[7] * v + h[8];
+		const double dnx = h[0] * step, dny = h[3] * step, dd = h[6] * step;
+		float *row = out.samples.data() + static_cast<std::size_t>(j) * side;
 		for (int i = 0; i < side; ++i) {
-			const Point2f p = H->map((i + 0.5) * step, v);
-			out.samples[static_cast<std::size_t>(j) * side + i] = sampleBilinear(image, p.x, p.y);
+			const double r = 1.0 / d;
+			const float x = static_cast<float>(nx * r), y = static_cast<float>(ny * r);
+			row[i] = inside ? sampleInside(image, x, y) : sampleBilinear(image, x, y);
+			nx += dnx;
+			ny += dny;
+			d += dd;
 		}
 	}
 	return true;

@@ -95,6 +95,39 @@ bool surroundsDecoded(const std::array<Point2f, 4> &q, float area, const std::ve
 	return false;
 }
 
+/* Reads a traced quad as a marker, as finish() would without refining it,
+ * so that the tracer can skip the marker's inside. A miss costs nothing but
+ * the skip: the quad stays a candidate either way. */
+class TracedMarkerProbe final : public detail::MarkerProbe
+{
+public:
+	TracedMarkerProbe(const ImageView &image, float scale, const Dictionary &dict, int maxHamming,
+			  detail::WarpedMarker &warped)
+		: image_(image), scale_(scale), dict_(dict), maxHamming_(maxHamming), warped_(warped)
+	{
+	}
+	bool isMarker(const detail::Quad &quad) override
+	{
+		std::array<Point2f, 4> corners = quad.corners;
+		for (Point2f &p : corners) {
+			p.x = (p.x + 0.5f) / scale_ - 0.5f;
+			p.y = (p.y + 0.5f) / scale_ - 0.5f;
+		}
+		if (!detail::warpMarker(image_, corners, dict_.bits, warped_))
+			return false;
+		const detail::Binarised b = detail::binarise(warped_, dict_.bits);
+		return b.contrast >= 10.0f && b.border_errors <= allowedBorderErrors(dict_.bits) &&
+		       detail::decode(dict_, b.code, maxHamming_).id >= 0;
+	}
+
+private:
+	const ImageView &image_;
+	float scale_;
+	const Dictionary &dict_;
+	int maxHamming_;
+	detail::WarpedMarker &warped_;
+};
+
 /* Largest image side accepted: contour coordinates are ints and buffers are
  * sized from width * height. */
 constexpr int kMaxSide = 1 << 15;
@@ -129,6 +162,7 @@ struct Detector::Impl {
 
 	/* One frame in flight: its edges, its candidates, its result. */
 	struct Slot {
+		ImageView image; /* the frame, valid until its back end returns */
 		EdgeMap edges;
 		std::vector<detail::Quad> quads;
 		Result result;
@@ -138,6 +172,7 @@ struct Detector::Impl {
 	/* Used by one stage each, so that stages of different slots can run
 	 * at once: the tracer by runTrace(), the warp buffer by runFinish(). */
 	detail::ContourTracer tracer;
+	detail::WarpedMarker traceWarped;
 	detail::WarpedMarker warped;
 	/* With a batch warper (runFinish() only): per candidate its traced
 	 * outline, whether it refined, and its place in the warped batch (-1
@@ -190,7 +225,8 @@ void Detector::Impl::trace(Slot &slot)
 	tp.cluster_radius = config.corner_cluster_radius;
 	tp.min_side = std::max(4.0f, config.min_marker_side * scale);
 	tp.border_margin = 1.0f;
-	tracer.trace(edges, tp, quads);
+	TracedMarkerProbe probe(slot.image, scale, *dict, maxHamming, traceWarped);
+	tracer.trace(edges, tp, quads, &probe);
 	detail::removeDuplicateQuads(quads, 2.5f);
 	/* Smallest first: a marker's own outline decodes before the outline of
 	 * its quiet zone, which can then be skipped. */
@@ -390,6 +426,7 @@ void Detector::runFrontEnd(const ImageView &image, int slot)
 	/* Never scale a frame so small that a marker could not survive it. */
 	if (scaledLength(image.width, scale) < 32 || scaledLength(image.height, scale) < 32)
 		scale = 1.0f;
+	s.image = image;
 	s.result.times = {};
 	s.result.times[Stage::AdaptiveScale] = msSince(t0);
 	const auto t1 = Clock::now();

@@ -147,3 +147,81 @@ TEST(ContourTrace, EmptyTilesAreSkippedWithoutLosingContours)
 	EXPECT_TRUE(quads.empty());
 	EXPECT_EQ(tracer.bordersFollowed(), 0);
 }
+
+namespace {
+
+/* Calls the quads it is shown markers when their top-left corner is in a
+ * given box, and counts the calls. */
+struct BoxProbe final : MarkerProbe {
+	float x0, y0, x1, y1;
+	int calls = 0;
+	BoxProbe(float ax, float ay, float bx, float by) : x0(ax), y0(ay), x1(bx), y1(by) {}
+	bool isMarker(const Quad &quad) override
+	{
+		++calls;
+		float minX = 1e9f, minY = 1e9f;
+		for (const Point2f &c : quad.corners) {
+			minX = std::min(minX, c.x);
+			minY = std::min(minY, c.y);
+		}
+		return minX >= x0 && minX <= x1 && minY >= y0 && minY <= y1;
+	}
+};
+
+/* A marker-like edge map: an outline ring holding a second ring (the inner
+ * edge of its black frame) and two code cells. */
+void markerLike(EdgeMap &em, int x0, int y0, int side)
+{
+	ring(em, x0, y0, x0 + side, y0 + side);
+	const int c = side / 8;
+	ring(em, x0 + c, y0 + c, x0 + side - c, y0 + side - c);
+	ring(em, x0 + 2 * c, y0 + 2 * c, x0 + 4 * c, y0 + 4 * c);
+	ring(em, x0 + 4 * c + 2, y0 + 4 * c + 2, x0 + 6 * c, y0 + 6 * c);
+}
+
+} // namespace
+
+/* The inside of a quad the probe calls a marker is never followed: not the
+ * hole border of its outline, not its code's cells. */
+TEST(ContourTrace, InsideOfAProbedMarkerIsSkipped)
+{
+	EdgeMap em = emptyMap(160, 120);
+	markerLike(em, 20, 20, 80);
+	ContourTracer tracer;
+	std::vector<Quad> quads;
+	tracer.trace(em, TraceParams{}, quads);
+	/* Each of the four rings gives an outer and a hole border. */
+	EXPECT_EQ(tracer.bordersFollowed(), 8);
+	EXPECT_EQ(quads.size(), 8u);
+
+	BoxProbe yes(18, 18, 22, 22);
+	tracer.trace(em, TraceParams{}, quads, &yes);
+	EXPECT_EQ(tracer.bordersFollowed(), 1);
+	ASSERT_EQ(quads.size(), 1u);
+	EXPECT_EQ(yes.calls, 1);
+
+	/* A probe that says no changes nothing. */
+	BoxProbe no(-10, -10, -5, -5);
+	tracer.trace(em, TraceParams{}, quads, &no);
+	EXPECT_EQ(tracer.bordersFollowed(), 8);
+	EXPECT_EQ(quads.size(), 8u);
+	EXPECT_EQ(no.calls, 8);
+}
+
+/* The seal stays inside the probed outline: a ring two pixels beside it,
+ * and one just below it, are still found whole. */
+TEST(ContourTrace, SealDoesNotReachNeighbours)
+{
+	EdgeMap em = emptyMap(200, 160);
+	markerLike(em, 20, 20, 64);
+	ring(em, 87, 20, 140, 84);  /* two background pixels right of x = 84 */
+	ring(em, 20, 87, 84, 140);  /* and below y = 84 */
+	BoxProbe probe(18, 18, 22, 22);
+	ContourTracer tracer;
+	std::vector<Quad> quads;
+	tracer.trace(em, TraceParams{}, quads, &probe);
+	/* The marker's outline, then both borders of each neighbour. */
+	EXPECT_EQ(tracer.bordersFollowed(), 5);
+	removeDuplicateQuads(quads, 2.5f);
+	EXPECT_EQ(quads.size(), 3u);
+}

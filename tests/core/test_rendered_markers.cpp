@@ -166,3 +166,36 @@ TEST(RenderedMarkers, BatchWarpGivesTheSameMarkers)
 		}
 	}
 }
+
+/* A board: markers one cell apart, as on a calibration target. Each one's
+ * inside is skipped once it decodes; its neighbours, a cell away, must not
+ * be. */
+TEST(RenderedMarkers, BoardWithOneCellGaps)
+{
+	const Dictionary &dict = *findDictionary("aruco_mip_36h12");
+	Detector det(Config{});
+	Image img(640, 480, 255);
+	constexpr float kSide = 40.0f, kPitch = kSide * 9.0f / 8.0f; /* one cell of 5 px between */
+	std::vector<std::pair<int, std::array<Point2f, 4>>> truth;
+	for (int r = 0; r < 6; ++r) {
+		for (int c = 0; c < 8; ++c) {
+			const int id = 100 + r * 8 + c;
+			const float x = 130.0f + c * kPitch, y = 100.0f + r * kPitch;
+			const std::array<Point2f, 4> q = { Point2f{ x, y }, Point2f{ x + kSide, y },
+							   Point2f{ x + kSide, y + kSide }, Point2f{ x, y + kSide } };
+			/* The page is white: a drawn quiet zone would overlap the
+			 * neighbour's border pixels. */
+			RenderOptions opt;
+			opt.quiet_cells = 0;
+			renderMarker(img.mut(), dict, id, q, opt);
+			truth.emplace_back(id, q);
+		}
+	}
+	const Result &res = det.detect(img.view());
+	EXPECT_EQ(res.markers.size(), truth.size());
+	for (const auto &[id, q] : truth) {
+		const Marker *m = findMarker(res.markers, id);
+		ASSERT_NE(m, nullptr) << "id " << id;
+		EXPECT_LT(meanCornerError(m->corners, q), 0.1f) << "id " << id;
+	}
+}
