@@ -6,13 +6,17 @@
 // replication does not vectorise, are left to scalar code.
 //
 // Lane types: smoothing and Sobel in int16 (|gx|, |gy| <= 1020), the squared
-// magnitude and the non-maximum suppression in int32 (m <= 2 * 1020^2).
+// magnitude and the non-maximum suppression in int32 (m <= 2 * 1020^2); the
+// gradient row holds (gx, gy) int16 pairs (see UsePairs), and the corner
+// test's sums are computed from them only where a vector holds an edge.
 
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "front_end_simd.cpp"
 #include <hwy/foreach_target.h> // IWYU pragma: keep
 
 #include <hwy/highway.h>
+
+#include <algorithm>
 
 #include "front_end_rows.h"
 
@@ -59,158 +63,181 @@ void SmoothRow(const std::uint8_t *a, const std::uint8_t *b, const std::uint8_t 
 	out[w - 1] = static_cast<std::uint8_t>((tmp[w - 2] + 3 * tmp[w - 1] + 8) >> 4);
 }
 
+#if HWY_TARGET != HWY_SCALAR
+
+/* The gradient row layout of these kernels (like the ARMv6 ones): per pixel
+ * one int32 "pair" P = gx | gy << 16 in the gx buffer (2w int16 values), gy
+ * unused. On pairs one int16 pair-multiply-add gives gx^2 + gy^2, gx^2 or
+ * 2 gx gy per pixel, so the corner test needs no tensor rows and no 32-bit
+ * multiplies. Rows narrower than a vector take the scalar kernels and their
+ * layout; GradientRow and EdgeRow make the same choice from w. */
+template <class D16>
+bool UsePairs(D16 d16, int w)
+{
+	return w >= static_cast<int>(hn::Lanes(d16)) + 2;
+}
+
+/* a0*b0 + a1*b1 for the int16 pair of each int32 lane (madd on x86). */
+template <class D32, class V16>
+hn::Vec<D32> PairDot(D32 d32, V16 a, V16 b)
+{
+	auto odd = hn::Zero(d32);
+	return hn::RearrangeToOddPlusEven(hn::ReorderWidenMulAccumulate(d32, a, b, hn::Zero(d32), odd), odd);
+}
+
 void GradientRow(const std::uint8_t *a, const std::uint8_t *b, const std::uint8_t *c, int w,
 		 std::int16_t *gx, std::int16_t *gy, std::int32_t *mag, std::int16_t *tmp,
 		 TensorRow tensor)
 {
 	const hn::ScalableTag<std::int16_t> d16;
 	const hn::Rebind<std::uint8_t, decltype(d16)> d8;
-	const hn::ScalableTag<std::int32_t> d32;
-	const hn::Rebind<std::int16_t, decltype(d32)> d16h;
+	const hn::Half<decltype(d16)> d16h;
+	const hn::Repartition<std::int32_t, decltype(d16)> d32;
+	const hn::Repartition<std::uint32_t, decltype(d16)> du32;
+	const hn::Rebind<std::uint16_t, decltype(d32)> du16h;
 	const int N = static_cast<int>(hn::Lanes(d16));
-	const int N32 = static_cast<int>(hn::Lanes(d32));
-	std::int16_t *vs = tmp, *vd = tmp + w;
-
-	int x = 0;
-	for (; x + N <= w; x += N) {
-		const auto va = hn::PromoteTo(d16, hn::LoadU(d8, a + x));
-		const auto vb = hn::PromoteTo(d16, hn::LoadU(d8, b + x));
-		const auto vc = hn::PromoteTo(d16, hn::LoadU(d8, c + x));
-		hn::StoreU(hn::Add(hn::Add(va, vc), hn::Add(vb, vb)), d16, vs + x);
-		hn::StoreU(hn::Sub(vc, va), d16, vd + x);
+	if (!UsePairs(d16, w)) {
+		gradientRow(a, b, c, w, gx, gy, mag, tmp, tensor);
+		return;
 	}
-	for (; x < w; ++x) {
-		vs[x] = static_cast<std::int16_t>(a[x] + 2 * b[x] + c[x]);
-		vd[x] = static_cast<std::int16_t>(c[x] - a[x]);
+	auto *pairs = reinterpret_cast<std::int32_t *>(gx);
+	auto load = [&](const std::uint8_t *p) { return hn::PromoteTo(d16, hn::LoadU(d8, p)); };
+	/* One pass, no column buffers: the 3x3 Sobel straight from the rows.
+	 * The last vector overlaps the previous one instead of a scalar tail. */
+	for (int x = 1;; x += N) {
+		x = std::min(x, w - 1 - N);
+		const auto al = load(a + x - 1), am = load(a + x), ar = load(a + x + 1);
+		const auto cl = load(c + x - 1), cm = load(c + x), cr = load(c + x + 1);
+		const auto bl = load(b + x - 1), br = load(b + x + 1);
+		const auto sx = hn::Sub(hn::Add(hn::Add(ar, cr), hn::Add(br, br)),
+					hn::Add(hn::Add(al, cl), hn::Add(bl, bl)));
+		const auto dm = hn::Sub(cm, am);
+		const auto sy = hn::Add(hn::Add(hn::Sub(cl, al), hn::Sub(cr, ar)), hn::Add(dm, dm));
+		/* Widen each half into pairs: gx zero-extended, gy in the top. */
+		auto store = [&](int x0, hn::Vec<decltype(d16h)> vx, hn::Vec<decltype(d16h)> vy) {
+			const auto p = hn::BitCast(d32, hn::Or(hn::PromoteTo(du32, hn::BitCast(du16h, vx)),
+							       hn::ShiftLeft<16>(hn::PromoteTo(du32, hn::BitCast(du16h, vy)))));
+			hn::StoreU(p, d32, pairs + x0);
+			hn::StoreU(PairDot(d32, hn::BitCast(d16, p), hn::BitCast(d16, p)), d32, mag + x0);
+		};
+		store(x, hn::LowerHalf(d16h, sx), hn::LowerHalf(d16h, sy));
+		store(x + N / 2, hn::UpperHalf(d16h, sx), hn::UpperHalf(d16h, sy));
+		if (x == w - 1 - N)
+			break;
 	}
-
-	gx[0] = gy[0] = 0;
-	gx[w - 1] = gy[w - 1] = 0;
-	x = 1;
-	for (; x + N <= w - 1; x += N) {
-		const auto sx = hn::Sub(hn::LoadU(d16, vs + x + 1), hn::LoadU(d16, vs + x - 1));
-		const auto m = hn::LoadU(d16, vd + x);
-		const auto sy = hn::Add(hn::Add(hn::LoadU(d16, vd + x - 1), hn::LoadU(d16, vd + x + 1)),
-					hn::Add(m, m));
-		hn::StoreU(sx, d16, gx + x);
-		hn::StoreU(sy, d16, gy + x);
-	}
-	for (; x < w - 1; ++x) {
-		gx[x] = static_cast<std::int16_t>(vs[x + 1] - vs[x - 1]);
-		gy[x] = static_cast<std::int16_t>(vd[x - 1] + 2 * vd[x] + vd[x + 1]);
-	}
-
-	/* The squared magnitude, and the tensor products summed over x-1..x+1
-	 * for the corner test: each product once, then the sums. gx and gy are
-	 * 0 in the end columns. */
-	std::int32_t *pxx = tensor.scratch, *pyy = pxx + w, *pxy = pyy + w;
-	x = 0;
-	for (; x + N32 <= w; x += N32) {
-		const auto vx = hn::PromoteTo(d32, hn::LoadU(d16h, gx + x));
-		const auto vy = hn::PromoteTo(d32, hn::LoadU(d16h, gy + x));
-		const auto xx = hn::Mul(vx, vx), yy = hn::Mul(vy, vy);
-		hn::StoreU(hn::Add(xx, yy), d32, mag + x);
-		hn::StoreU(xx, d32, pxx + x);
-		hn::StoreU(yy, d32, pyy + x);
-		hn::StoreU(hn::Mul(vx, vy), d32, pxy + x);
-	}
-	for (; x < w; ++x) {
-		pxx[x] = gx[x] * gx[x];
-		pyy[x] = gy[x] * gy[x];
-		pxy[x] = gx[x] * gy[x];
-		mag[x] = pxx[x] + pyy[x];
-	}
-	std::int32_t *txx = tensor.xx, *tyy = tensor.yy, *txy = tensor.xy;
-	txx[0] = tyy[0] = txy[0] = 0;
-	txx[w - 1] = tyy[w - 1] = txy[w - 1] = 0;
-	auto sum3 = [&](const std::int32_t *p) {
-		return hn::Add(hn::Add(hn::LoadU(d32, p - 1), hn::LoadU(d32, p)), hn::LoadU(d32, p + 1));
-	};
-	x = 1;
-	for (; x + N32 <= w - 1; x += N32) {
-		hn::StoreU(sum3(pxx + x), d32, txx + x);
-		hn::StoreU(sum3(pyy + x), d32, tyy + x);
-		hn::StoreU(sum3(pxy + x), d32, txy + x);
-	}
-	for (; x < w - 1; ++x) {
-		txx[x] = pxx[x - 1] + pxx[x] + pxx[x + 1];
-		tyy[x] = pyy[x - 1] + pyy[x] + pyy[x + 1];
-		txy[x] = pxy[x - 1] + pxy[x] + pxy[x + 1];
-	}
+	pairs[0] = pairs[w - 1] = 0;
+	mag[0] = mag[w - 1] = 0;
 }
 
 bool EdgeRow(const GradRows &rows, int w, const FrontEndParams &params, std::uint8_t *out)
 {
-	const hn::ScalableTag<std::int32_t> d32;
-	const hn::Rebind<std::int16_t, decltype(d32)> d16h;
+	const hn::ScalableTag<std::int16_t> d16;
+	const hn::Repartition<std::int32_t, decltype(d16)> d32;
+	const hn::Repartition<std::uint32_t, decltype(d16)> du32;
 	const hn::Rebind<std::uint8_t, decltype(d32)> d8;
 	const int N = static_cast<int>(hn::Lanes(d32));
+	if (!UsePairs(d16, w))
+		return edgeRow(rows, w, params, out);
 	const std::int32_t *up = rows.mag[0];
 	const std::int32_t *mid = rows.mag[1];
 	const std::int32_t *down = rows.mag[2];
-	const std::int16_t *gxr = rows.gx[1];
-	const std::int16_t *gyr = rows.gy[1];
+	const std::int16_t *pr[3] = { rows.gx[0], rows.gx[1], rows.gx[2] };
+	auto pairs = [&](int r, int x) { return hn::LoadU(d16, pr[r] + 2 * x); };
 	/* Thresholds beyond the largest magnitude can never pass. */
 	const auto thr = hn::Set(d32, static_cast<std::int32_t>(
 					      std::min<std::int64_t>(params.edge_threshold_sq, 1 << 30)));
-	const auto k256 = hn::Set(d32, 256);
-	const auto k106 = hn::Set(d32, 106);
+	/* As pairs: 106|gx| - 256|gy| >= 0 is horizontal, 106|gy| - 256|gx|
+	 * >= 0 vertical (the scalar rule's 256|gy| <= 106|gx| and so on). */
+	auto pair = [&](std::int16_t lo, std::int16_t hi) {
+		return hn::BitCast(d16, hn::Set(du32, static_cast<std::uint16_t>(lo) |
+							      static_cast<std::uint32_t>(static_cast<std::uint16_t>(hi)) << 16));
+	};
+	const auto kHorizontal = pair(106, -256);
+	const auto kVertical = pair(-256, 106);
+	const auto lowHalf = hn::BitCast(d16, hn::Set(d32, 0xFFFF));
 	const auto zero = hn::Zero(d32);
-	const auto one = hn::Set(d32, EdgeMap::kEdge);
-	const auto two = hn::Set(d32, EdgeMap::kCorner);
+	const auto gyPositive = hn::Set(d32, 0xFFFF); /* P > 0xFFFF exactly when gy > 0 */
+	const auto edgeOnly = hn::Set(d32, EdgeMap::kEdge);
+	const auto edgeCorner = hn::Set(d32, EdgeMap::kEdge | EdgeMap::kCorner);
 	const auto twoT = hn::Set(d32, 2 * static_cast<std::int32_t>(params.corner_threshold));
 
 	bool any = false;
 	out[0] = 0;
 	out[w - 1] = 0;
-	int x = 1;
-	for (; x + N <= w - 1; x += N) {
+	/* The last vector overlaps the previous one instead of a scalar tail. */
+	for (int x = 1;; x += N) {
+		x = std::min(x, w - 1 - N);
 		const auto m = hn::LoadU(d32, mid + x);
 		const auto strong = hn::Lt(thr, m);
-		if (hn::AllFalse(d32, strong)) {
-			hn::StoreU(hn::DemoteTo(d8, zero), d8, out + x);
-			continue;
+		auto v = zero;
+		if (!hn::AllFalse(d32, strong)) {
+			const auto p = pairs(1, x);
+			const auto absP = hn::Abs(p);
+			const auto horizontal = PairDot(d32, absP, kHorizontal);
+			const auto vertical = PairDot(d32, absP, kVertical);
+			const auto p32 = hn::BitCast(d32, p);
+			const auto diagFlip = hn::Xor(hn::Lt(zero, hn::ShiftLeft<16>(p32)), hn::Lt(gyPositive, p32));
+			const auto ul = hn::LoadU(d32, up + x - 1), um = hn::LoadU(d32, up + x),
+				   ur = hn::LoadU(d32, up + x + 1);
+			const auto dl = hn::LoadU(d32, down + x - 1), dm = hn::LoadU(d32, down + x),
+				   dr = hn::LoadU(d32, down + x + 1);
+			const auto ml = hn::LoadU(d32, mid + x - 1), mr = hn::LoadU(d32, mid + x + 1);
+			/* Same precedence as the scalar if/else chain: horizontal first. */
+			auto prev = hn::IfThenElse(diagFlip, ur, ul);
+			auto next = hn::IfThenElse(diagFlip, dl, dr);
+			/* Not IfNegativeThenElse: Highway 1.0's SSSE3 one is wrong. */
+			const auto notVertical = hn::Lt(vertical, zero), notHorizontal = hn::Lt(horizontal, zero);
+			prev = hn::IfThenElse(notVertical, prev, um);
+			next = hn::IfThenElse(notVertical, next, dm);
+			prev = hn::IfThenElse(notHorizontal, prev, ml);
+			next = hn::IfThenElse(notHorizontal, next, mr);
+			const auto edge = hn::And(hn::And(strong, hn::Lt(prev, m)), hn::Not(hn::Lt(m, next)));
+			if (!hn::AllFalse(d32, edge)) {
+				any = true;
+				/* Shi-Tomasi in isCorner's int32 form, summed here from
+				 * the pairs: only vectors holding an edge need it.
+				 * Sxx + Syy is the sum of the nine magnitudes. */
+				const auto s = hn::Add(hn::Add(hn::Add(hn::Add(ul, um), hn::Add(ur, dl)),
+							       hn::Add(hn::Add(dm, dr), hn::Add(ml, mr))), m);
+				auto sxx = zero, sxy2 = zero;
+				for (int r = 0; r < 3; ++r)
+					for (int dx = -1; dx <= 1; ++dx) {
+						const auto t = pairs(r, x + dx);
+						const auto swapped = hn::BitCast(d16, hn::RotateRight<16>(hn::BitCast(du32, t)));
+						sxx = hn::Add(sxx, PairDot(d32, t, hn::And(t, lowHalf)));
+						sxy2 = hn::Add(sxy2, PairDot(d32, t, swapped));
+					}
+				/* Sxx - Syy = 2 Sxx - S; |Sxy| >> 8 = |2 Sxy| >> 9. */
+				const auto c = hn::ShiftRight<9>(hn::Sub(s, twoT));
+				const auto ad = hn::ShiftRight<9>(hn::Abs(hn::Sub(hn::Add(sxx, sxx), s)));
+				const auto bd = hn::ShiftRight<9>(hn::Abs(sxy2));
+				const auto corner = hn::And(hn::Lt(zero, c),
+							    hn::Lt(hn::Add(hn::Mul(ad, ad), hn::Mul(bd, bd)), hn::Mul(c, c)));
+				v = hn::IfThenElseZero(edge, hn::IfThenElse(corner, edgeCorner, edgeOnly));
+			}
 		}
-		const auto gx = hn::PromoteTo(d32, hn::LoadU(d16h, gxr + x));
-		const auto gy = hn::PromoteTo(d32, hn::LoadU(d16h, gyr + x));
-		const auto ax = hn::Abs(gx), ay = hn::Abs(gy);
-		/* Same precedence as the scalar if/else chain: horizontal first. */
-		const auto horizontal = hn::Not(hn::Lt(hn::Mul(k106, ax), hn::Mul(k256, ay)));
-		const auto vertical = hn::Not(hn::Lt(hn::Mul(k106, ay), hn::Mul(k256, ax)));
-		const auto diagSame = hn::Eq(hn::VecFromMask(d32, hn::Lt(zero, gx)),
-					     hn::VecFromMask(d32, hn::Lt(zero, gy)));
-		auto prev = hn::IfThenElse(diagSame, hn::LoadU(d32, up + x - 1), hn::LoadU(d32, up + x + 1));
-		auto next = hn::IfThenElse(diagSame, hn::LoadU(d32, down + x + 1), hn::LoadU(d32, down + x - 1));
-		prev = hn::IfThenElse(vertical, hn::LoadU(d32, up + x), prev);
-		next = hn::IfThenElse(vertical, hn::LoadU(d32, down + x), next);
-		prev = hn::IfThenElse(horizontal, hn::LoadU(d32, mid + x - 1), prev);
-		next = hn::IfThenElse(horizontal, hn::LoadU(d32, mid + x + 1), next);
-		const auto edge = hn::And(hn::And(strong, hn::Lt(prev, m)), hn::Not(hn::Lt(m, next)));
-		if (hn::AllFalse(d32, edge)) {
-			hn::StoreU(hn::DemoteTo(d8, zero), d8, out + x);
-			continue;
-		}
-		any = true;
-		/* Shi-Tomasi in the scalar kernel's int32 form (see isCorner). */
-		const auto sxx = hn::Add(hn::Add(hn::LoadU(d32, rows.txx[0] + x), hn::LoadU(d32, rows.txx[1] + x)),
-					 hn::LoadU(d32, rows.txx[2] + x));
-		const auto syy = hn::Add(hn::Add(hn::LoadU(d32, rows.tyy[0] + x), hn::LoadU(d32, rows.tyy[1] + x)),
-					 hn::LoadU(d32, rows.tyy[2] + x));
-		const auto sxy = hn::Add(hn::Add(hn::LoadU(d32, rows.txy[0] + x), hn::LoadU(d32, rows.txy[1] + x)),
-					 hn::LoadU(d32, rows.txy[2] + x));
-		const auto c = hn::ShiftRight<9>(hn::Sub(hn::Add(sxx, syy), twoT));
-		const auto ad = hn::ShiftRight<9>(hn::Abs(hn::Sub(sxx, syy)));
-		const auto bd = hn::ShiftRight<8>(hn::Abs(sxy));
-		const auto corner = hn::And(hn::Lt(zero, c),
-					    hn::Lt(hn::Add(hn::Mul(ad, ad), hn::Mul(bd, bd)), hn::Mul(c, c)));
-		const auto v = hn::Or(hn::IfThenElseZero(edge, one), hn::IfThenElseZero(hn::And(edge, corner), two));
 		hn::StoreU(hn::DemoteTo(d8, v), d8, out + x);
+		if (x == w - 1 - N)
+			break;
 	}
-	/* The last few columns: the scalar rule. */
-	if (x < w - 1 && edgeSpan(rows, x, w - 1, params, out))
-		any = true;
 	return any;
 }
+
+#else // HWY_SCALAR: one-lane vectors hold no pairs; the scalar kernels.
+
+void GradientRow(const std::uint8_t *a, const std::uint8_t *b, const std::uint8_t *c, int w,
+		 std::int16_t *gx, std::int16_t *gy, std::int32_t *mag, std::int16_t *tmp,
+		 TensorRow tensor)
+{
+	gradientRow(a, b, c, w, gx, gy, mag, tmp, tensor);
+}
+
+bool EdgeRow(const GradRows &rows, int w, const FrontEndParams &params, std::uint8_t *out)
+{
+	return edgeRow(rows, w, params, out);
+}
+
+#endif
 
 } // namespace HWY_NAMESPACE
 } // namespace frappe::detail
