@@ -164,12 +164,11 @@ bool EdgeRow(const GradRows &rows, int w, const FrontEndParams &params, std::uin
 	bool any = false;
 	out[0] = 0;
 	out[w - 1] = 0;
-	/* The last vector overlaps the previous one instead of a scalar tail. */
-	for (int x = 1;; x += N) {
-		x = std::min(x, w - 1 - N);
+	/* Classifies the N pixels from x. */
+	auto edgeVector = [&](int x) {
 		const auto m = hn::LoadU(d32, mid + x);
 		const auto strong = hn::Lt(thr, m);
-		auto v = zero;
+		auto bytes = hn::Zero(d8); /* no edge: no demotion */
 		if (!hn::AllFalse(d32, strong)) {
 			const auto p = pairs(1, x);
 			const auto absP = hn::Abs(p);
@@ -213,13 +212,28 @@ bool EdgeRow(const GradRows &rows, int w, const FrontEndParams &params, std::uin
 				const auto bd = hn::ShiftRight<9>(hn::Abs(sxy2));
 				const auto corner = hn::And(hn::Lt(zero, c),
 							    hn::Lt(hn::Add(hn::Mul(ad, ad), hn::Mul(bd, bd)), hn::Mul(c, c)));
-				v = hn::IfThenElseZero(edge, hn::IfThenElse(corner, edgeCorner, edgeOnly));
+				bytes = hn::DemoteTo(d8, hn::IfThenElseZero(edge, hn::IfThenElse(corner, edgeCorner, edgeOnly)));
 			}
 		}
-		hn::StoreU(hn::DemoteTo(d8, v), d8, out + x);
-		if (x == w - 1 - N)
-			break;
+		hn::StoreU(bytes, d8, out + x);
+	};
+	/* Most of a frame is flat: skip four vectors at a time when none of
+	 * their magnitudes passes the threshold. */
+	const hn::ScalableTag<std::uint8_t> du8;
+	int x = 1;
+	for (; x + 4 * N <= w - 1; x += 4 * N) {
+		const auto m01 = hn::Max(hn::LoadU(d32, mid + x), hn::LoadU(d32, mid + x + N));
+		const auto m23 = hn::Max(hn::LoadU(d32, mid + x + 2 * N), hn::LoadU(d32, mid + x + 3 * N));
+		if (hn::AllFalse(d32, hn::Lt(thr, hn::Max(m01, m23)))) {
+			hn::StoreU(hn::Zero(du8), du8, out + x);
+			continue;
+		}
+		for (int i = 0; i < 4; ++i)
+			edgeVector(x + i * N);
 	}
+	/* The last vector overlaps the previous one instead of a scalar tail. */
+	for (; x < w - 1; x += N)
+		edgeVector(std::min(x, w - 1 - N));
 	return any;
 }
 
