@@ -1,10 +1,13 @@
 // SPDX-License-Identifier: MIT
 // Suzuki & Abe (1985) border following, list mode: every border of the
-// 8-connected edge pixels is followed exactly once. Label values:
-//   0 background, 1 edge not yet on a followed border,
-//   2 on a followed border, 3 on a followed border whose right neighbour
-//   (examined while following) is background: the paper's -NBD, which stops
-//   a second hole border from starting at the same place.
+// 8-connected edge pixels is followed exactly once. Label values (bit 0 set
+// on every non-zero label, so a neighbour test is one AND):
+//   0 background, 1 (kUnfollowed) edge not yet on a followed border,
+//   3 (kFollowed) on a followed border, 5 (kFollowedRightBg) on a followed
+//   border whose right neighbour (examined while following) is background:
+//   the paper's -NBD, which stops a second hole border from starting at the
+//   same place. Sealed marker insides are kFollowedRightBg too: nothing
+//   starts there.
 // Empty 16x16 tiles hold no edge pixel, so the raster scan jumps over them.
 #include "contour_trace.h"
 
@@ -16,6 +19,8 @@
 namespace frappe::detail {
 
 namespace {
+
+constexpr std::uint8_t kUnfollowed = 1, kFollowed = 3, kFollowedRightBg = 5;
 
 /* Neighbour offsets, counter-clockwise on screen starting at the right. */
 constexpr int kDx[8] = { 1, 1, 0, -1, -1, -1, 0, 1 };
@@ -68,13 +73,13 @@ struct RowStepTable {
 };
 constexpr RowStepTable kRowStep;
 
-/* Bit 0 of byte i: whether label p[i] is non-zero (labels are 0..3), for
- * i = 0, 1, 2. Reads p[3] too: the label image has padding. */
+/* Bit 0 of byte i: whether label p[i] is non-zero, for i = 0, 1, 2. Reads
+ * p[3] too: the label image has padding. */
 inline std::uint32_t rowNonZero(const std::uint8_t *p)
 {
 	std::uint32_t v;
 	std::memcpy(&v, p, 4);
-	return (v | (v >> 1)) & 0x00010101u;
+	return v & 0x00010101u;
 }
 
 /* The RowStepTable index of the 3x3 neighbourhood around p. */
@@ -95,8 +100,9 @@ inline unsigned neighbourIndex(const std::uint8_t *p, int w)
 
 /* Labels of eight pixels at p (and their neighbours at p - 1 .. p + 8, which
  * must be readable): bit 0 of byte i set where pixel i may start a border,
- * i.e. an unfollowed edge pixel (label 1) with background on its left (an
- * outer border), or label 1 or 2 with background on its right (a hole). */
+ * i.e. an unfollowed edge pixel with background on its left (an outer
+ * border), or an unfollowed or followed one (not kFollowedRightBg) with
+ * background on its right (a hole). */
 std::uint64_t borderStarts(const std::uint8_t *p)
 {
 	constexpr std::uint64_t kOnes = 0x0101010101010101ull;
@@ -106,10 +112,10 @@ std::uint64_t borderStarts(const std::uint8_t *p)
 		return 0;
 	std::memcpy(&left, p - 1, 8);
 	std::memcpy(&right, p + 1, 8);
-	const std::uint64_t b0 = here & kOnes, b1 = (here >> 1) & kOnes; /* labels are 0..3 */
-	const std::uint64_t leftZero = ~(left | (left >> 1)) & kOnes;
-	const std::uint64_t rightZero = ~(right | (right >> 1)) & kOnes;
-	return ((b0 & ~b1) & leftZero) | ((b0 ^ b1) & rightZero);
+	/* labels are 0, 1, 3, 5: bit 1 marks kFollowed, bit 2 kFollowedRightBg */
+	const std::uint64_t b0 = here & kOnes, b1 = (here >> 1) & kOnes, b2 = (here >> 2) & kOnes;
+	const std::uint64_t leftZero = ~left & kOnes, rightZero = ~right & kOnes;
+	return (b0 & ~(b1 | b2) & leftZero) | (b0 & ~b2 & rightZero);
 }
 
 /* Index of the lowest non-zero byte of a non-zero word. */
@@ -162,6 +168,17 @@ void ContourTracer::trace(const EdgeMap &edges, const TraceParams &params, std::
 	const int w = edges.width, h = edges.height;
 	if (w < 3 || h < 3)
 		return;
+	if (stride_ != w || stepTable_.empty()) {
+		/* kRowStep with each move's pointer offset: (offset << 4) | flag << 3 | d. */
+		stepTable_.resize(8 * 512);
+		for (int back = 0; back < 8; ++back)
+			for (int idx = 0; idx < 512; ++idx) {
+				const int e = kRowStep.entry[back][idx];
+				const int d = e & 7;
+				stepTable_[static_cast<std::size_t>(back) * 512 + idx] =
+					static_cast<std::int32_t>((kDx[d] + kDy[d] * w) * 16) | (e & 15);
+			}
+	}
 	stride_ = w;
 	radius2_ = params.cluster_radius * params.cluster_radius;
 	/* Four bytes of padding: follow reads neighbours a word at a time. */
@@ -208,9 +225,9 @@ void ContourTracer::trace(const EdgeMap &edges, const TraceParams &params, std::
 				if (f == 0)
 					continue;
 				int fromDir;
-				if (f == 1 && row[x - 1] == 0)
+				if (f == kUnfollowed && row[x - 1] == 0)
 					fromDir = 4; /* outer border: came from the left */
-				else if ((f == 1 || f == 2) && row[x + 1] == 0)
+				else if ((f == kUnfollowed || f == kFollowed) && row[x + 1] == 0)
 					fromDir = 0; /* hole border: the hole is to the right */
 				else
 					continue;
@@ -269,8 +286,8 @@ bool quadSpan(const std::array<Point2f, 4> &q, float v, bool byRows, float &lo, 
 
 } // namespace
 
-/* Labels the marker's inside 3: followed, with nothing to start (outer
- * borders start at a 1, hole borders before a 0), so neither the code's
+/* Labels the marker's inside kFollowedRightBg, where nothing starts (outer
+ * borders start at kUnfollowed, hole borders before a 0), so neither the code's
  * cells nor the hole border of the outline are followed. The quad's sides
  * run within a pixel of the outline, inside or outside it: rows (then
  * columns) are filled across the quad and on through the background left
@@ -297,7 +314,7 @@ void ContourTracer::sealInside(const Quad &quad, int w, int h)
 		for (int k = 1; k <= std::min(kReach, room); ++k) {
 			if (L[from + k * step] != 0) {
 				for (int j = 1; j < k; ++j)
-					L[from + j * step] = 3;
+					L[from + j * step] = kFollowedRightBg;
 				break;
 			}
 		}
@@ -311,7 +328,7 @@ void ContourTracer::sealInside(const Quad &quad, int w, int h)
 		if (x0 > x1)
 			continue;
 		const std::ptrdiff_t row = static_cast<std::ptrdiff_t>(y) * stride;
-		std::memset(L + row + x0, 3, static_cast<std::size_t>(x1 - x0 + 1));
+		std::memset(L + row + x0, kFollowedRightBg, static_cast<std::size_t>(x1 - x0 + 1));
 		reach(row + x0, -1, x0 - 1);
 		reach(row + x1, 1, w - 2 - x1);
 	}
@@ -366,12 +383,12 @@ void ContourTracer::follow(int x0, int y0, int fromDir, const EdgeMap &edges)
 		flush();
 		steps_ = steps;
 	};
-	auto visit = [&](int x, int y) __attribute__((always_inline)) {
+	auto visit = [&](int x, int y, const std::uint8_t *label) __attribute__((always_inline)) {
 		++steps;
 		chunk[inChunk++] = { x, y };
 		if (inChunk == kChunk)
 			flush();
-		if (!(E[static_cast<std::size_t>(y) * w + x] & EdgeMap::kCorner) || tooManyClusters_)
+		if (!(E[label - L] & EdgeMap::kCorner) || tooManyClusters_)
 			return;
 		const float fx = static_cast<float>(x), fy = static_cast<float>(y);
 		for (Cluster &c : clusters_) {
@@ -403,8 +420,8 @@ void ContourTracer::follow(int x0, int y0, int fromDir, const EdgeMap &edges)
 	std::uint8_t *p0 = &at(x0, y0);
 	const unsigned mask0 = neighbourMask(p0);
 	if (mask0 == 0) {
-		*p0 = 3; /* isolated pixel */
-		visit(x0, y0);
+		*p0 = kFollowedRightBg; /* isolated pixel */
+		visit(x0, y0, p0);
 		finish();
 		return;
 	}
@@ -414,25 +431,28 @@ void ContourTracer::follow(int x0, int y0, int fromDir, const EdgeMap &edges)
 	std::uint8_t *p1 = p0 + off[d1];
 	std::uint8_t *p3 = p0;
 	int x3 = x0, y3 = y0;
-	int back = d1; /* direction from p3 to the previous border pixel */
+	/* Row of the step table for the direction back to the previous pixel. */
+	const std::int32_t *stepRow = stepTable_.data() + d1 * 512;
 	const std::size_t maxSteps = 4 * labels_.size();
 	for (;;) {
-		/* 3.3: counter-clockwise from the pixel after `back`. */
-		const std::uint8_t step = kRowStep.entry[back][neighbourIndex(p3, w)];
+		/* 3.3: counter-clockwise from the pixel after `back`; the entry
+		 * holds the pointer offset of the move, so the next pixel is one
+		 * table load away from this one's neighbourhood. */
+		const std::int32_t step = stepRow[neighbourIndex(p3, w)];
 		const int d4 = step & 7;
 		/* 3.4: mark the current pixel. */
 		if (step & 8)
-			*p3 = 3;
-		else if (*p3 == 1)
-			*p3 = 2;
-		visit(x3, y3);
-		std::uint8_t *p4 = p3 + off[d4];
+			*p3 = kFollowedRightBg;
+		else if (*p3 == kUnfollowed)
+			*p3 = kFollowed;
+		visit(x3, y3, p3);
+		std::uint8_t *p4 = p3 + (step >> 4);
 		/* 3.5: back at the start, about to repeat the first move. */
 		if (p4 == p0 && p3 == p1) {
 			finish();
 			return;
 		}
-		back = (d4 + 4) & 7;
+		stepRow = stepTable_.data() + (((d4 + 4) & 7) << 9);
 		p3 = p4;
 		x3 += kDx[d4];
 		y3 += kDy[d4];
@@ -577,27 +597,34 @@ bool ContourTracer::acceptQuad(const TraceParams &params, int w, int h, Quad &qu
 	 * cluster that is no corner, leaves a side without border pixels. A
 	 * border that also wanders inside (through a gap in a blurred outline)
 	 * still covers the four sides, and is kept. */
-	float nx[4], ny[4], nc[4], ox[4], oy[4], len[4];
+	/* Per side: unit normal n and offset c (n . p = c on the side), and the
+	 * bin of a point along it, t = (u . p - t0) * kBins / len. */
+	constexpr int kBins = 16;
+	float nx[4], ny[4], nc[4], ux[4], uy[4], t0[4];
 	for (int i = 0; i < 4; ++i) {
 		const Point2f a = q[i], b = q[(i + 1) & 3];
-		len[i] = std::sqrt(dist2(a, b));
-		ox[i] = (b.x - a.x) / len[i];
-		oy[i] = (b.y - a.y) / len[i];
-		nx[i] = -oy[i];
-		ny[i] = ox[i];
+		const float len = std::sqrt(dist2(a, b));
+		nx[i] = -(b.y - a.y) / len;
+		ny[i] = (b.x - a.x) / len;
 		nc[i] = nx[i] * a.x + ny[i] * a.y;
+		ux[i] = (b.x - a.x) / (len * len) * kBins;
+		uy[i] = (b.y - a.y) / (len * len) * kBins;
+		t0[i] = ux[i] * a.x + uy[i] * a.y;
 	}
-	const float tol = std::max(1.5f, 0.06f * std::sqrt(shortest));
-	constexpr int kBins = 16;
+	const float shortSide = std::sqrt(shortest);
+	const float tol = std::max(1.5f, 0.06f * shortSide);
+	/* A bin is 1/16 of a side: on long sides every point is not needed to
+	 * cover one. Steps of at most a third of the shortest bin. */
+	const std::size_t stride = std::max(1, static_cast<int>(shortSide / (3.0f * kBins)));
 	std::uint32_t covered[4] = {};
-	for (const Pixel &p : points_) {
-		const float px = static_cast<float>(p.x), py = static_cast<float>(p.y);
+	for (std::size_t k = 0; k < points_.size(); k += stride) {
+		const float px = static_cast<float>(points_[k].x), py = static_cast<float>(points_[k].y);
 		for (int i = 0; i < 4; ++i) {
 			if (std::abs(nx[i] * px + ny[i] * py - nc[i]) > tol)
 				continue;
-			const float t = (ox[i] * (px - q[i].x) + oy[i] * (py - q[i].y)) / len[i];
-			if (t >= 0.0f && t < 1.0f)
-				covered[i] |= 1u << static_cast<int>(t * kBins);
+			const float t = ux[i] * px + uy[i] * py - t0[i];
+			if (t >= 0.0f && t < static_cast<float>(kBins))
+				covered[i] |= 1u << static_cast<int>(t);
 		}
 	}
 	for (int i = 0; i < 4; ++i) {

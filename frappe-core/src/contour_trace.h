@@ -67,6 +67,9 @@ private:
 	void sealInside(const Quad &quad, int w, int h);
 
 	std::vector<std::uint8_t> labels_;
+	/// Suzuki's step 3.3 for this width: per direction back and 3x3
+	/// neighbourhood, the move's pointer offset, flag and direction.
+	std::vector<std::int32_t> stepTable_;
 	std::vector<Cluster> clusters_;
 	std::vector<Pixel> points_;
 	int steps_ = 0;

@@ -14,6 +14,8 @@
 #include "contour_trace.h"
 #include "corner_refine.h"
 #include "decode.h"
+#include "sampling.h"
+#include "frappe/homography.h"
 
 namespace frappe {
 
@@ -95,15 +97,17 @@ bool surroundsDecoded(const std::array<Point2f, 4> &q, float area, const std::ve
 	return false;
 }
 
-/* Reads a traced quad as a marker, as finish() would without refining it,
- * so that the tracer can skip the marker's inside. A miss costs nothing but
- * the skip: the quad stays a candidate either way. */
+/* Reads a traced quad as a marker, so that the tracer can skip the
+ * marker's inside: one bilinear sample at each cell's centre (a quarter of
+ * the warp that finish() makes of the refined quad), thresholded half way
+ * between the darkest and brightest code cell, then the usual border and
+ * Hamming checks. A miss costs nothing but the skip: the quad stays a
+ * candidate either way. */
 class TracedMarkerProbe final : public detail::MarkerProbe
 {
 public:
-	TracedMarkerProbe(const ImageView &image, float scale, const Dictionary &dict, int maxHamming,
-			  detail::WarpedMarker &warped)
-		: image_(image), scale_(scale), dict_(dict), maxHamming_(maxHamming), warped_(warped)
+	TracedMarkerProbe(const ImageView &image, float scale, const Dictionary &dict, int maxHamming)
+		: image_(image), scale_(scale), dict_(dict), maxHamming_(maxHamming)
 	{
 	}
 	bool isMarker(const detail::Quad &quad) override
@@ -113,19 +117,44 @@ public:
 			p.x = (p.x + 0.5f) / scale_ - 0.5f;
 			p.y = (p.y + 0.5f) / scale_ - 0.5f;
 		}
-		if (!detail::warpMarker(image_, corners, dict_.bits, warped_))
+		const auto H = Homography::fromUnitSquare(corners);
+		if (!H)
 			return false;
-		const detail::Binarised b = detail::binarise(warped_, dict_.bits);
-		return b.contrast >= 10.0f && b.border_errors <= allowedBorderErrors(dict_.bits) &&
-		       detail::decode(dict_, b.code, maxHamming_).id >= 0;
+		const int bits = dict_.bits, cells = bits + 2;
+		std::array<float, kMaxCells * kMaxCells> v;
+		float lo = 1e9f, hi = -1e9f;
+		for (int cy = 0; cy < cells; ++cy)
+			for (int cx = 0; cx < cells; ++cx) {
+				const Point2f p = H->map((cx + 0.5) / cells, (cy + 0.5) / cells);
+				const float s = detail::sampleBilinear(image_, p.x, p.y);
+				v[static_cast<std::size_t>(cy * cells + cx)] = s;
+				if (cx > 0 && cy > 0 && cx <= bits && cy <= bits) {
+					lo = std::min(lo, s);
+					hi = std::max(hi, s);
+				}
+			}
+		if (hi - lo < 10.0f)
+			return false;
+		const float thr = 0.5f * (lo + hi);
+		int borderErrors = 0;
+		std::uint64_t code = 0;
+		for (int cy = 0; cy < cells; ++cy)
+			for (int cx = 0; cx < cells; ++cx) {
+				const bool white = v[static_cast<std::size_t>(cy * cells + cx)] > thr;
+				if (cx == 0 || cy == 0 || cx == cells - 1 || cy == cells - 1)
+					borderErrors += white;
+				else
+					code = (code << 1) | (white ? 1u : 0u);
+			}
+		return borderErrors <= allowedBorderErrors(bits) && detail::decode(dict_, code, maxHamming_).id >= 0;
 	}
 
 private:
+	static constexpr int kMaxCells = 10; /* 8x8 codes and their frame */
 	const ImageView &image_;
 	float scale_;
 	const Dictionary &dict_;
 	int maxHamming_;
-	detail::WarpedMarker &warped_;
 };
 
 /* Largest image side accepted: contour coordinates are ints and buffers are
@@ -172,7 +201,6 @@ struct Detector::Impl {
 	/* Used by one stage each, so that stages of different slots can run
 	 * at once: the tracer by runTrace(), the warp buffer by runFinish(). */
 	detail::ContourTracer tracer;
-	detail::WarpedMarker traceWarped;
 	detail::WarpedMarker warped;
 	/* With a batch warper (runFinish() only): per candidate its traced
 	 * outline, whether it refined, and its place in the warped batch (-1
@@ -225,7 +253,7 @@ void Detector::Impl::trace(Slot &slot)
 	tp.cluster_radius = config.corner_cluster_radius;
 	tp.min_side = std::max(4.0f, config.min_marker_side * scale);
 	tp.border_margin = 1.0f;
-	TracedMarkerProbe probe(slot.image, scale, *dict, maxHamming, traceWarped);
+	TracedMarkerProbe probe(slot.image, scale, *dict, maxHamming);
 	tracer.trace(edges, tp, quads, &probe);
 	detail::removeDuplicateQuads(quads, 2.5f);
 	/* Smallest first: a marker's own outline decodes before the outline of
