@@ -126,20 +126,20 @@ namespace {
 /* Set bits of a word. ARMv6 has no population count: GCC would call
  * libgcc's __popcountdi2 for every codeword and rotation, so there the
  * bits are summed in place; elsewhere the instruction (or libgcc's best). */
+#if defined(__arm__) && !defined(__ARM_NEON)
+inline int bitCount32(std::uint32_t x)
+{
+	x = x - ((x >> 1) & 0x55555555u);
+	x = (x & 0x33333333u) + ((x >> 2) & 0x33333333u);
+	x = (x + (x >> 4)) & 0x0F0F0F0Fu;
+	return static_cast<int>((x * 0x01010101u) >> 24);
+}
+#else
 inline int bitCount(std::uint64_t v)
 {
-#if defined(__arm__) && !defined(__ARM_NEON)
-	auto count32 = [](std::uint32_t x) {
-		x = x - ((x >> 1) & 0x55555555u);
-		x = (x & 0x33333333u) + ((x >> 2) & 0x33333333u);
-		x = (x + (x >> 4)) & 0x0F0F0F0Fu;
-		return static_cast<int>((x * 0x01010101u) >> 24);
-	};
-	return count32(static_cast<std::uint32_t>(v)) + count32(static_cast<std::uint32_t>(v >> 32));
-#else
 	return std::popcount(v);
-#endif
 }
+#endif
 
 } // namespace
 
@@ -169,7 +169,17 @@ Decoded decode(const Dictionary &dict, std::uint64_t code, int maxHamming)
 	for (int id = 0; id < n; ++id) {
 		const std::uint64_t word = dict.codes[id];
 		for (int r = 0; r < 4; ++r) {
+#if defined(__arm__) && !defined(__ARM_NEON)
+			/* Without a popcount instruction, count the low 32 bits first:
+			 * most words already differ there in more bits than the best. */
+			const std::uint64_t x = word ^ rotations[r];
+			const int low = bitCount32(static_cast<std::uint32_t>(x));
+			if (low > bestDist)
+				continue;
+			const int d = low + bitCount32(static_cast<std::uint32_t>(x >> 32));
+#else
 			const int d = bitCount(word ^ rotations[r]);
+#endif
 			if (d < bestDist) {
 				bestDist = d;
 				best = { id, d, r };
