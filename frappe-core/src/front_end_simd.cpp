@@ -20,6 +20,10 @@
 
 #include "front_end_rows.h"
 
+/* The row loops call their per-vector lambdas from two places; inlined,
+ * their constants stay in registers. */
+#define FRAPPE_INLINE_LAMBDA __attribute__((always_inline))
+
 HWY_BEFORE_NAMESPACE();
 namespace frappe::detail {
 namespace HWY_NAMESPACE {
@@ -83,6 +87,66 @@ hn::Vec<D32> PairDot(D32 d32, V16 a, V16 b)
 {
 	auto odd = hn::Zero(d32);
 	return hn::RearrangeToOddPlusEven(hn::ReorderWidenMulAccumulate(d32, a, b, hn::Zero(d32), odd), odd);
+}
+
+/* The int32 vector one column to the right of lo (lanes 1.. of lo, then
+ * lane 0 of the next vector hi), and one column to the left of cur. */
+template <class D>
+hn::Vec<D> NextColumn(D d, hn::Vec<D> lo, hn::Vec<D> hi)
+{
+#if HWY_ARCH_X86 && HWY_TARGET <= HWY_AVX3
+	(void)d;
+	return hn::Vec<D>{ _mm512_alignr_epi32(hi.raw, lo.raw, 1) };
+#elif HWY_ARCH_X86 && HWY_TARGET == HWY_AVX2
+	(void)d;
+	return hn::Vec<D>{ _mm256_alignr_epi8(_mm256_permute2x128_si256(lo.raw, hi.raw, 0x21), lo.raw, 4) };
+#else
+	if constexpr (HWY_MAX_BYTES == 16 && hn::MaxLanes(d) == 4)
+		return hn::CombineShiftRightBytes<4>(d, hi, lo);
+	HWY_ALIGN std::int32_t buf[2 * HWY_MAX_BYTES / 4];
+	const std::size_t n = hn::Lanes(d);
+	hn::Store(lo, d, buf);
+	hn::Store(hi, d, buf + n);
+	return hn::LoadU(d, buf + 1);
+#endif
+}
+
+template <class D>
+hn::Vec<D> PrevColumn(D d, hn::Vec<D> prev, hn::Vec<D> cur)
+{
+#if HWY_ARCH_X86 && HWY_TARGET <= HWY_AVX3
+	(void)d;
+	return hn::Vec<D>{ _mm512_alignr_epi32(cur.raw, prev.raw, 15) };
+#elif HWY_ARCH_X86 && HWY_TARGET == HWY_AVX2
+	(void)d;
+	return hn::Vec<D>{ _mm256_alignr_epi8(cur.raw, _mm256_permute2x128_si256(prev.raw, cur.raw, 0x21), 12) };
+#else
+	if constexpr (HWY_MAX_BYTES == 16 && hn::MaxLanes(d) == 4)
+		return hn::CombineShiftRightBytes<12>(d, cur, prev);
+	HWY_ALIGN std::int32_t buf[2 * HWY_MAX_BYTES / 4];
+	const std::size_t n = hn::Lanes(d);
+	hn::Store(prev, d, buf);
+	hn::Store(cur, d, buf + n);
+	return hn::LoadU(d, buf + n - 1);
+#endif
+}
+
+/* The EdgeMap bytes of an int32 vector's lanes: kEdge, plus kCorner. */
+template <class D32, class D8>
+hn::Vec<D8> EdgeBytes(D32 d32, D8 d8, hn::Mask<D32> edge, hn::Mask<D32> corner)
+{
+#if HWY_ARCH_X86 && HWY_TARGET <= HWY_AVX3
+	/* Byte-masked moves straight from the lane masks, no demotion. */
+	(void)d32;
+	(void)d8;
+	const __m128i e = _mm_maskz_mov_epi8(edge.raw, _mm_set1_epi8(EdgeMap::kEdge));
+	return hn::Vec<D8>{ _mm_mask_mov_epi8(e, hn::And(edge, corner).raw,
+					     _mm_set1_epi8(EdgeMap::kEdge | EdgeMap::kCorner)) };
+#else
+	const auto v = hn::IfThenElseZero(edge, hn::IfThenElse(corner, hn::Set(d32, EdgeMap::kEdge | EdgeMap::kCorner),
+							       hn::Set(d32, EdgeMap::kEdge)));
+	return hn::DemoteTo(d8, v);
+#endif
 }
 
 void GradientRow(const std::uint8_t *a, const std::uint8_t *b, const std::uint8_t *c, int w,
@@ -157,15 +221,30 @@ bool EdgeRow(const GradRows &rows, int w, const FrontEndParams &params, std::uin
 	const auto lowHalf = hn::BitCast(d16, hn::Set(d32, 0xFFFF));
 	const auto zero = hn::Zero(d32);
 	const auto gyPositive = hn::Set(d32, 0xFFFF); /* P > 0xFFFF exactly when gy > 0 */
-	const auto edgeOnly = hn::Set(d32, EdgeMap::kEdge);
-	const auto edgeCorner = hn::Set(d32, EdgeMap::kEdge | EdgeMap::kCorner);
 	const auto twoT = hn::Set(d32, 2 * static_cast<std::int32_t>(params.corner_threshold));
 
 	bool any = false;
 	out[0] = 0;
 	out[w - 1] = 0;
+	/* Per column x, over rows y-1..y+1: the sums of gx^2 and of 2 gx gy. */
+	struct ColumnSums {
+		hn::Vec<decltype(d32)> xx, xy2;
+	};
+	auto columnSums = [&](int x) FRAPPE_INLINE_LAMBDA {
+		ColumnSums sums{ zero, zero };
+		for (int r = 0; r < 3; ++r) {
+			const auto t = pairs(r, x);
+			const auto swapped = hn::BitCast(d16, hn::RotateRight<16>(hn::BitCast(du32, t)));
+			sums.xx = hn::Add(sums.xx, PairDot(d32, t, hn::And(t, lowHalf)));
+			sums.xy2 = hn::Add(sums.xy2, PairDot(d32, t, swapped));
+		}
+		return sums;
+	};
+	ColumnSums cached{ zero, zero }, cachedPrev{ zero, zero };
+	int cachedAt = -1; /* cached holds the column sums from here on */
+
 	/* Classifies the N pixels from x. */
-	auto edgeVector = [&](int x) {
+	auto edgeVector = [&](int x) FRAPPE_INLINE_LAMBDA {
 		const auto m = hn::LoadU(d32, mid + x);
 		const auto strong = hn::Lt(thr, m);
 		auto bytes = hn::Zero(d8); /* no edge: no demotion */
@@ -198,21 +277,35 @@ bool EdgeRow(const GradRows &rows, int w, const FrontEndParams &params, std::uin
 				 * Sxx + Syy is the sum of the nine magnitudes. */
 				const auto s = hn::Add(hn::Add(hn::Add(hn::Add(ul, um), hn::Add(ur, dl)),
 							       hn::Add(hn::Add(dm, dr), hn::Add(ml, mr))), m);
-				auto sxx = zero, sxy2 = zero;
-				for (int r = 0; r < 3; ++r)
-					for (int dx = -1; dx <= 1; ++dx) {
-						const auto t = pairs(r, x + dx);
-						const auto swapped = hn::BitCast(d16, hn::RotateRight<16>(hn::BitCast(du32, t)));
-						sxx = hn::Add(sxx, PairDot(d32, t, hn::And(t, lowHalf)));
-						sxy2 = hn::Add(sxy2, PairDot(d32, t, swapped));
-					}
+				/* The 3x3 sums as column sums over the three rows,
+				 * then across; the next vector's column sums are kept,
+				 * as edges run along rows. */
+				ColumnSums left, cur, right;
+				if (x == cachedAt) {
+					cur = cached;
+					left = { PrevColumn(d32, cachedPrev.xx, cur.xx), PrevColumn(d32, cachedPrev.xy2, cur.xy2) };
+				} else {
+					cur = columnSums(x);
+					left = columnSums(x - 1);
+				}
+				if (x + 2 * N <= w) {
+					const ColumnSums nextSums = columnSums(x + N);
+					right = { NextColumn(d32, cur.xx, nextSums.xx), NextColumn(d32, cur.xy2, nextSums.xy2) };
+					cachedPrev = cur;
+					cached = nextSums;
+					cachedAt = x + N;
+				} else {
+					right = columnSums(x + 1);
+				}
+				const auto sxx = hn::Add(hn::Add(left.xx, cur.xx), right.xx);
+				const auto sxy2 = hn::Add(hn::Add(left.xy2, cur.xy2), right.xy2);
 				/* Sxx - Syy = 2 Sxx - S; |Sxy| >> 8 = |2 Sxy| >> 9. */
 				const auto c = hn::ShiftRight<9>(hn::Sub(s, twoT));
 				const auto ad = hn::ShiftRight<9>(hn::Abs(hn::Sub(hn::Add(sxx, sxx), s)));
 				const auto bd = hn::ShiftRight<9>(hn::Abs(sxy2));
 				const auto corner = hn::And(hn::Lt(zero, c),
 							    hn::Lt(hn::Add(hn::Mul(ad, ad), hn::Mul(bd, bd)), hn::Mul(c, c)));
-				bytes = hn::DemoteTo(d8, hn::IfThenElseZero(edge, hn::IfThenElse(corner, edgeCorner, edgeOnly)));
+				bytes = EdgeBytes(d32, d8, edge, corner);
 			}
 		}
 		hn::StoreU(bytes, d8, out + x);
