@@ -177,15 +177,27 @@ void GradientRow(const std::uint8_t *a, const std::uint8_t *b, const std::uint8_
 					hn::Add(hn::Add(al, cl), hn::Add(bl, bl)));
 		const auto dm = hn::Sub(cm, am);
 		const auto sy = hn::Add(hn::Add(hn::Sub(cl, al), hn::Sub(cr, ar)), hn::Add(dm, dm));
-		/* Widen each half into pairs: gx zero-extended, gy in the top. */
-		auto store = [&](int x0, hn::Vec<decltype(d16h)> vx, hn::Vec<decltype(d16h)> vy) {
-			const auto p = hn::BitCast(d32, hn::Or(hn::PromoteTo(du32, hn::BitCast(du16h, vx)),
-							       hn::ShiftLeft<16>(hn::PromoteTo(du32, hn::BitCast(du16h, vy)))));
+		auto store = [&](int x0, hn::Vec<decltype(d32)> p) {
 			hn::StoreU(p, d32, pairs + x0);
 			hn::StoreU(PairDot(d32, hn::BitCast(d16, p), hn::BitCast(d16, p)), d32, mag + x0);
 		};
-		store(x, hn::LowerHalf(d16h, sx), hn::LowerHalf(d16h, sy));
-		store(x + N / 2, hn::UpperHalf(d16h, sx), hn::UpperHalf(d16h, sy));
+#if HWY_ARCH_X86 && HWY_TARGET <= HWY_AVX3
+		/* Interleave gx and gy into pixel order by a two-table permute. */
+		alignas(64) static constexpr std::int16_t kLo[32] = { 0, 32, 1, 33, 2, 34, 3, 35, 4, 36, 5, 37, 6, 38, 7, 39,
+			8, 40, 9, 41, 10, 42, 11, 43, 12, 44, 13, 45, 14, 46, 15, 47 };
+		alignas(64) static constexpr std::int16_t kHi[32] = { 16, 48, 17, 49, 18, 50, 19, 51, 20, 52, 21, 53, 22, 54, 23, 55,
+			24, 56, 25, 57, 26, 58, 27, 59, 28, 60, 29, 61, 30, 62, 31, 63 };
+		store(x, hn::Vec<decltype(d32)>{ _mm512_permutex2var_epi16(sx.raw, _mm512_load_si512(kLo), sy.raw) });
+		store(x + N / 2, hn::Vec<decltype(d32)>{ _mm512_permutex2var_epi16(sx.raw, _mm512_load_si512(kHi), sy.raw) });
+#else
+		/* Widen each half into pairs: gx zero-extended, gy in the top. */
+		auto widen = [&](hn::Vec<decltype(d16h)> vx, hn::Vec<decltype(d16h)> vy) {
+			return hn::BitCast(d32, hn::Or(hn::PromoteTo(du32, hn::BitCast(du16h, vx)),
+						       hn::ShiftLeft<16>(hn::PromoteTo(du32, hn::BitCast(du16h, vy)))));
+		};
+		store(x, widen(hn::LowerHalf(d16h, sx), hn::LowerHalf(d16h, sy)));
+		store(x + N / 2, widen(hn::UpperHalf(d16h, sx), hn::UpperHalf(d16h, sy)));
+#endif
 		if (x == w - 1 - N)
 			break;
 	}
