@@ -1,10 +1,33 @@
 // SPDX-License-Identifier: MIT
+// CORNER_REFINE: sub-pixel corners from straight-line fits to the four sides.
+//
+// Each side is measured along image columns (sides nearer horizontal) or rows
+// (nearer vertical), at whole pixels: no interpolation, and integer arithmetic
+// from the pixels to the line's sums. Call u the axis along the side (x for a
+// flat side) and v the axis across it. At a column u, the pixels along v
+// cross the side's light-to-dark step; the centroid of the falls between
+// consecutive pixels lies exactly where the column crosses the edge line, for
+// any sub-pixel phase and any symmetric blur: pixels integrate over their
+// area, so the falls sum the edge's profile exactly, and across a slanted
+// edge the pixel's footprint only widens that profile symmetrically. The
+// crossings (u, v) are fitted by weighted least squares of v on u (u is
+// exact, v carries the error), and the corners are the intersections of
+// adjacent lines.
+//
+// The falls are cut to a window, since neighbouring edges (code cells, the
+// quiet zone's outer edge) lie a cell away on small markers. A window placed
+// on the steepest pixel would pull every crossing towards the pixel grid,
+// so the window is centred on a first centroid, with fractional weights at
+// its ends.
+//
+// Two passes: a wide one from the tracer's corners with few columns, then a
+// narrow one with more columns from corners that are now within a fraction of
+// a pixel, so its columns stay clear of the corners exactly.
 #include "corner_refine.h"
 
 #include <algorithm>
 #include <cmath>
-
-#include "sampling.h"
+#include <cstdint>
 
 namespace frappe::detail {
 
@@ -15,147 +38,183 @@ struct Line {
 	double nx, ny, c;
 };
 
-constexpr int kMaxSamples = 48;  /* edge points per side, final pass */
-constexpr int kCoarseSamples = 16; /* edge points per side, first pass */
-constexpr int kMaxProfile = 64;  /* samples along one normal */
-constexpr float kProfileStep = 0.5f;
+constexpr int kCoarsePoints = 12; /* columns per side, first pass */
+constexpr int kFinePoints = 48;  /* columns per side, second pass */
+/* How far (pixels along the column) the falls may extend beyond the two
+ * differences at the steepest point: a blurred edge spreads over a few
+ * pixels, but more lets noise and neighbouring edges in. */
+constexpr int kRun = 3;
+/* Half the final window, in 1/16 pixel, plus half a pixel: the window is
+ * 1.5 px either side of the first centroid, and a difference (a pixel wide)
+ * counts by how much of it lies inside. */
+constexpr int kWindow16 = 32;
+constexpr int kMaxReach = 23; /* search window, pixels either side */
+constexpr int kMaxProfile = 2 * (kMaxReach + kRun + 1) + 1;
+/* Steepest fall over two pixels below which a column is noise, not edge. */
+constexpr int kMinDrop = 6;
 
-/* sampleBilinear for 0 <= x <= width - 2, 0 <= y <= height - 2, where its
- * clamps do nothing: the same arithmetic, without them. */
-inline float sampleInside(const ImageView &img, float x, float y)
+/* floor and ceil with conversions only (ARMv6 has no rounding instruction,
+ * and these run a few times per side). */
+inline int floorInt(float x)
 {
-	const int x0 = static_cast<int>(x), y0 = static_cast<int>(y);
-	const float fx = x - static_cast<float>(x0), fy = y - static_cast<float>(y0);
-	const std::uint8_t *r0 = img.row(y0);
-	const std::uint8_t *r1 = img.row(y0 + 1);
-	const float top = static_cast<float>(r0[x0]) + fx * static_cast<float>(r0[x0 + 1] - r0[x0]);
-	const float bot = static_cast<float>(r1[x0]) + fx * static_cast<float>(r1[x0 + 1] - r1[x0]);
-	return top + fy * (bot - top);
+	const int i = static_cast<int>(x);
+	return static_cast<float>(i) > x ? i - 1 : i;
+}
+inline int ceilInt(float x)
+{
+	const int i = static_cast<int>(x);
+	return static_cast<float>(i) < x ? i + 1 : i;
 }
 
 /* Measures one side from a to b (clockwise quad, so the marker interior is
  * on the right of a->b on screen). */
-bool fitSide(const ImageView &img, Point2f a, Point2f b, float search, int maxSamples, Line &line)
+bool fitSide(const ImageView &img, Point2f a, Point2f b, float search, int maxPoints, Line &line)
 {
 	const float dx = b.x - a.x, dy = b.y - a.y;
 	const float len = std::sqrt(dx * dx + dy * dy);
-	if (len < 2.0f)
+	if (len < 2.0f || img.width < 1 || img.height < 1)
 		return false;
-	const float ux = dx / len, uy = dy / len;
-	const float nx = -uy, ny = ux; /* inward normal */
+	/* u along the side's dominant axis, v across it. */
+	const bool flat = std::abs(dx) >= std::abs(dy);
+	const float au = flat ? a.x : a.y, av = flat ? a.y : a.x;
+	const float du = flat ? dx : dy, dv = flat ? dy : dx;
+	/* The inward normal is (-dy, dx) / len; its v component says which way
+	 * along the column is inwards, its size how much of the normal one pixel
+	 * of column covers (at least 1/sqrt(2)). */
+	const float nv = (flat ? dx : -dy) / len;
+	const int dir = nv > 0.0f ? 1 : -1;
+	const float cosV = std::abs(nv);
+	const int uDim = flat ? img.width : img.height, vDim = flat ? img.height : img.width;
+	/* One step along u or v, in bytes; along v inwards. */
+	const std::ptrdiff_t uStep = flat ? 1 : img.stride, vStep = flat ? img.stride : 1;
+	const std::ptrdiff_t step = dir * vStep;
 
 	/* Stay clear of the corners, where the neighbouring side interferes. */
 	const float margin = std::max(1.5f, 0.12f * len);
-	const float usable = len - 2.0f * margin;
-	if (usable <= 0.0f)
+	if (len <= 2.0f * margin)
 		return false;
-	const int nSamples = std::clamp(static_cast<int>(usable / 1.5f), 3, maxSamples);
-	/* ceil without libm (ARMv6 has no rounding instruction) */
-	const float steps = search / kProfileStep;
-	int stepsUp = static_cast<int>(steps);
-	stepsUp += static_cast<float>(stepsUp) < steps;
-	const int half = std::min(kMaxProfile / 2 - 1, stepsUp + 1);
+	const float marginU = margin * cosV;
+	const int u0 = ceilInt(std::min(au, au + du) + marginU);
+	const int u1 = floorInt(std::max(au, au + du) - marginU);
+	const int count = u1 - u0 + 1;
+	if (count < 3)
+		return false;
+	const int nPoints = std::min(count, maxPoints);
 
-	/* The offsets along the normal, once. */
-	float offsets[kMaxProfile];
-	for (int k = 0; k < 2 * half + 1; ++k)
-		offsets[k] = static_cast<float>(k - half) * kProfileStep;
+	/* The side's v at column u, in 16.16 fixed point: it only places the
+	 * window and checks the search distance, so its rounding is harmless. */
+	const float slope = dv / du;
+	const std::int32_t vFix0 = floorInt((av + (static_cast<float>(u0) - au) * slope) * 65536.0f + 0.5f);
+	const std::int32_t slopeFix = floorInt(slope * 65536.0f + 0.5f);
+	const int vRef = (vFix0 + 32768) >> 16;
+	/* The steepest fall may lie up to search - 1/2 from the side along its
+	 * normal (as when profiles were sampled along it in half pixels), its
+	 * centroid up to search; in pixels along the column, 16.16. */
+	const float peakV = std::max(0.0f, search - 0.5f) / cosV;
+	const std::int32_t peakFix = floorInt(std::min(peakV, static_cast<float>(kMaxReach) - 0.5f) * 65536.0f);
+	const std::int64_t reachFix = static_cast<std::int64_t>(search / cosV * 65536.0f);
+	const int reach = ceilInt(std::min(peakV, static_cast<float>(kMaxReach) - 0.5f) + 0.5f);
+	const int half = reach + kRun + 1; /* the profile: -half..half */
 
-	/* Where sampleInside may be used (-1: nowhere). */
-	const float xMax = img.width >= 2 && img.height >= 2 ? static_cast<float>(img.width - 2) : -1.0f;
-	const float yMax = img.width >= 2 && img.height >= 2 ? static_cast<float>(img.height - 2) : -1.0f;
+	/* Columns spread evenly, in 16.16 steps (one division per side). */
+	const std::int32_t stepFix = (count << 16) / nPoints;
+	std::int32_t accFix = stepFix >> 1;
 
-	double sw = 0, sx = 0, sy = 0, sxx = 0, syy = 0, sxy = 0;
+	/* Weighted sums over the crossings, weight = the windowed falls' total
+	 * w; with U = u - u0 and q = 2 w (v - vRef) they are all integers. */
+	std::int64_t sw = 0, su = 0, suu = 0, sq = 0, suq = 0;
 	int used = 0;
-	float profile[kMaxProfile];
-	for (int i = 0; i < nSamples; ++i) {
-		const float t = margin + usable * (static_cast<float>(i) + 0.5f) / static_cast<float>(nSamples);
-		const float px = a.x + ux * t, py = a.y + uy * t;
-		const int n = 2 * half + 1;
-		/* The samples lie on a segment, in order (float rounding is
-		 * monotonic), so when both ends are at least a pixel inside the
-		 * image all are, and sampleBilinear's clamps change nothing. */
-		const float sA = offsets[0], sB = offsets[n - 1];
-		const float xA = px + nx * sA, xB = px + nx * sB, yA = py + ny * sA, yB = py + ny * sB;
-		if (xA >= 0.0f && xB >= 0.0f && xA <= xMax && xB <= xMax && yA >= 0.0f && yB >= 0.0f &&
-		    yA <= yMax && yB <= yMax) {
-			for (int k = 0; k < n; ++k)
-				profile[k] = sampleInside(img, px + nx * offsets[k], py + ny * offsets[k]);
+	int buf[kMaxProfile];
+	int *const p = buf + half; /* p[j]: the pixel j steps inwards of the side's */
+	for (int i = 0; i < nPoints; ++i, accFix += stepFix) {
+		const int U = accFix >> 16;
+		const int u = u0 + U;
+		const std::int32_t vFix = vFix0 + slopeFix * U;
+		const int vc = (vFix + 32768) >> 16;
+		if (u >= 0 && u < uDim && vc - half >= 0 && vc + half < vDim) {
+			const std::uint8_t *px = img.data + u * uStep + vc * vStep - half * step;
+			for (int j = -half; j <= half; ++j, px += step)
+				p[j] = *px;
 		} else {
-			for (int k = 0; k < n; ++k)
-				profile[k] = sampleBilinear(img, px + nx * offsets[k], py + ny * offsets[k]);
+			/* Clamped to the image, as a bilinear sampler would. */
+			const int uc = std::clamp(u, 0, uDim - 1);
+			for (int j = -half; j <= half; ++j)
+				p[j] = img.data[uc * uStep + std::clamp(vc + dir * j, 0, vDim - 1) * vStep];
 		}
-		/* Strongest drop in intensity going inwards (white border outside,
-		 * black frame inside); steps of the other sign belong to other edges. */
-		int best = -1;
-		float bestDrop = 0.0f;
-		for (int k = 1; k < n - 1; ++k) {
-			const float drop = profile[k - 1] - profile[k + 1];
+		/* Strongest fall in intensity going inwards (white border outside,
+		 * black frame inside); rises belong to other edges. */
+		const std::int32_t frac = dir * (vFix - (vc << 16)); /* the side at p[frac], |frac| <= 1/2 */
+		const int kLo = (frac - peakFix + 65535) >> 16, kHi = (frac + peakFix) >> 16;
+		int best = 0, bestDrop = 0;
+		for (int k = kLo; k <= kHi; ++k) {
+			const int drop = p[k - 1] - p[k + 1];
 			if (drop > bestDrop) {
 				bestDrop = drop;
 				best = k;
 			}
 		}
-		/* Below ~4 grey levels per pixel it is noise, not an edge. */
-		if (best < 2 || best > n - 3 || bestDrop < 4.0f)
+		if (bestDrop < kMinDrop)
 			continue;
-		/* The edge lies at the centroid of the intensity drop: exact for an
-		 * area-sampled step whatever its sub-pixel phase, and unbiased under
-		 * symmetric blur (a parabola through the peak is not: it pulls the
-		 * estimate towards pixel-grid positions by up to a third of a pixel).
-		 * The window is the run of falling samples around the peak, at most
-		 * 3 px either side, so neighbouring edges stay out. */
-		int lo = best, hi = best;
-		while (lo > 1 && best - lo < 4 && profile[lo - 1] - profile[lo] > 0.0f)
+		/* The falls around it: the two differences at the peak, extended
+		 * while the intensity keeps falling, at most kRun pixels. The
+		 * difference p[k] - p[k + 1] lies at k + 1/2. */
+		int lo = best - 1, hi = best;
+		while (lo > best - 1 - kRun && p[lo - 1] > p[lo])
 			--lo;
-		while (hi < n - 2 && hi - best < 4 && profile[hi] - profile[hi + 1] > 0.0f)
+		while (hi < best + kRun && p[hi + 1] > p[hi + 2])
 			++hi;
-		float mass = 0.0f, moment = 0.0f;
-		for (int k = lo - 1; k < hi + 1; ++k) {
-			const float fall = profile[k] - profile[k + 1];
-			if (fall <= 0.0f)
-				continue;
-			mass += fall;
-			moment += fall * (static_cast<float>(k - half) + 0.5f);
+		int mass = 0, moment2 = 0;
+		for (int k = lo; k <= hi; ++k) {
+			const int fall = p[k] - p[k + 1];
+			if (fall > 0) {
+				mass += fall;
+				moment2 += fall * (2 * k + 1);
+			}
 		}
-		const float s = moment / mass * kProfileStep;
-		if (std::abs(s) > search)
+		/* Their centroid, in 1/16 pixel (rounded), centres the window. */
+		const int c16 = (8 * moment2 + (moment2 >= 0 ? mass / 2 : -mass / 2)) / mass;
+		int wMass = 0, wMoment2 = 0;
+		for (int k = lo; k <= hi; ++k) {
+			const int fall = p[k] - p[k + 1];
+			const int d16 = std::abs(8 * (2 * k + 1) - c16);
+			const int f16 = std::min(16, kWindow16 - d16);
+			if (fall > 0 && f16 > 0) {
+				wMass += f16 * fall;
+				wMoment2 += f16 * fall * (2 * k + 1);
+			}
+		}
+		if (wMass <= 0)
 			continue;
-		const double ex = px + nx * s, ey = py + ny * s;
-		const double wgt = bestDrop;
-		sw += wgt;
-		sx += wgt * ex;
-		sy += wgt * ey;
-		sxx += wgt * ex * ex;
-		syy += wgt * ey * ey;
-		sxy += wgt * ex * ey;
+		/* The crossing is at vc + dir * wMoment2 / (2 wMass); it must lie
+		 * within the search of the side. Both sides times 2 wMass 2^16. */
+		const std::int64_t m2 = 2 * static_cast<std::int64_t>(wMass);
+		const std::int64_t off = m2 * ((static_cast<std::int64_t>(vc) << 16) - vFix) +
+					 static_cast<std::int64_t>(dir * wMoment2) * 65536;
+		if ((off < 0 ? -off : off) > m2 * reachFix)
+			continue;
+		const std::int64_t q = m2 * (vc - vRef) + dir * wMoment2;
+		sw += wMass;
+		su += static_cast<std::int64_t>(wMass) * U;
+		suu += static_cast<std::int64_t>(wMass) * U * U;
+		sq += q;
+		suq += q * U;
 		++used;
 	}
-	if (used < 3 || used * 2 < nSamples)
+	if (used < 3 || used * 2 < nPoints)
 		return false;
-	/* Weighted total least squares: the normal is the covariance's
-	 * eigenvector of the smaller eigenvalue. */
-	const double mx = sx / sw, my = sy / sw;
-	const double cxx = sxx / sw - mx * mx, cyy = syy / sw - my * my, cxy = sxy / sw - mx * my;
-	/* The major axis is at theta = atan2(2 cxy, cxx - cyy) / 2, in
-	 * (-pi/2, pi/2]; its cosine and sine from the half-angle formulas, with
-	 * square roots only (one VFP instruction each; atan2, sin and cos are
-	 * thousands of instructions in a soft-float libm). */
-	const double d = cxx - cyy, e = 2.0 * cxy;
-	const double r = std::sqrt(d * d + e * e);
-	double cosT = 1.0, sinT = 0.0;
-	if (r > 0.0) {
-		if (d >= 0.0) {
-			cosT = std::sqrt((r + d) / (2.0 * r));
-			sinT = e / (2.0 * r * cosT);
-		} else {
-			sinT = std::copysign(std::sqrt((r - d) / (2.0 * r)), e);
-			cosT = e / (2.0 * r * sinT);
-		}
-	}
-	line.nx = -sinT;
-	line.ny = cosT;
-	line.c = line.nx * mx + line.ny * my;
+	/* v = vRef + meanV + m (u - u0 - meanU), by weighted least squares. */
+	const double w = static_cast<double>(sw);
+	const double den = w * static_cast<double>(suu) - static_cast<double>(su) * static_cast<double>(su);
+	if (den <= 0.0)
+		return false;
+	const double m = (w * static_cast<double>(suq) - static_cast<double>(su) * static_cast<double>(sq)) / (2.0 * den);
+	const double meanU = static_cast<double>(su) / w, meanV = static_cast<double>(sq) / (2.0 * w);
+	/* As n . (u, v) = c with n = (-m, 1) / |(-m, 1)|, then back to (x, y). */
+	const double norm = 1.0 / std::sqrt(1.0 + m * m);
+	const double nu = -m * norm;
+	line.c = (static_cast<double>(vRef) + meanV - m * (static_cast<double>(u0) + meanU)) * norm;
+	line.nx = flat ? nu : norm;
+	line.ny = flat ? norm : nu;
 	return true;
 }
 
@@ -169,11 +228,11 @@ bool intersect(const Line &l1, const Line &l2, Point2f &p)
 	return true;
 }
 
-bool refineOnce(const ImageView &img, std::array<Point2f, 4> &q, float search, int maxSamples)
+bool refineOnce(const ImageView &img, std::array<Point2f, 4> &q, float search, int maxPoints)
 {
 	Line lines[4];
 	for (int i = 0; i < 4; ++i) {
-		if (!fitSide(img, q[i], q[(i + 1) & 3], search, maxSamples, lines[i]))
+		if (!fitSide(img, q[i], q[(i + 1) & 3], search, maxPoints, lines[i]))
 			return false;
 	}
 	std::array<Point2f, 4> r;
@@ -195,11 +254,11 @@ bool refineCorners(const ImageView &image, std::array<Point2f, 4> &corners, floa
 {
 	std::array<Point2f, 4> q = corners;
 	/* The wide first pass only has to place the sides roughly: few points. */
-	if (!refineOnce(image, q, search, kCoarseSamples))
+	if (!refineOnce(image, q, search, kCoarsePoints))
 		return false;
 	/* A second, narrow pass: the sides are now well placed, so the
 	 * measurement points avoid the corners exactly and the window shrinks. */
-	refineOnce(image, q, std::min(search, 1.5f), kMaxSamples);
+	refineOnce(image, q, std::min(search, 1.5f), kFinePoints);
 	corners = q;
 	return true;
 }
