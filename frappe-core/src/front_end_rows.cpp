@@ -149,8 +149,8 @@ void markTiles(const std::uint8_t *edgeRow, int w, std::uint8_t *tileRow)
 		std::uint64_t a, b;
 		std::memcpy(&a, edgeRow + x0, 8);
 		std::memcpy(&b, edgeRow + x0 + 8, 8);
-		if (a | b)
-			tileRow[t] = 1;
+		/* Branchless: whether a tile holds an edge is not predictable. */
+		tileRow[t] |= static_cast<std::uint8_t>((a | b) != 0);
 	}
 	if (x0 < w) {
 		std::uint8_t acc = 0;
