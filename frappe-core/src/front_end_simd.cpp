@@ -259,7 +259,7 @@ bool EdgeRow(const GradRows &rows, int w, const FrontEndParams &params, std::uin
 	auto edgeVector = [&](int x) FRAPPE_INLINE_LAMBDA {
 		const auto m = hn::LoadU(d32, mid + x);
 		const auto strong = hn::Lt(thr, m);
-		auto bytes = hn::Zero(d8); /* no edge: no demotion */
+		auto bytes = hn::Zero(d8);
 		if (!hn::AllFalse(d32, strong)) {
 			const auto p = pairs(1, x);
 			const auto absP = hn::Abs(p);
@@ -282,43 +282,42 @@ bool EdgeRow(const GradRows &rows, int w, const FrontEndParams &params, std::uin
 			prev = hn::IfThenElse(notHorizontal, prev, ml);
 			next = hn::IfThenElse(notHorizontal, next, mr);
 			const auto edge = hn::And(hn::And(strong, hn::Lt(prev, m)), hn::Not(hn::Lt(m, next)));
-			if (!hn::AllFalse(d32, edge)) {
-				any = true;
-				/* Shi-Tomasi in isCorner's int32 form, summed here from
-				 * the pairs: only vectors holding an edge need it.
-				 * Sxx + Syy is the sum of the nine magnitudes. */
-				const auto s = hn::Add(hn::Add(hn::Add(hn::Add(ul, um), hn::Add(ur, dl)),
-							       hn::Add(hn::Add(dm, dr), hn::Add(ml, mr))), m);
-				/* The 3x3 sums as column sums over the three rows,
-				 * then across; the next vector's column sums are kept,
-				 * as edges run along rows. */
-				ColumnSums left, cur, right;
-				if (x == cachedAt) {
-					cur = cached;
-					left = { PrevColumn(d32, cachedPrev.xx, cur.xx), PrevColumn(d32, cachedPrev.xy2, cur.xy2) };
-				} else {
-					cur = columnSums(x);
-					left = columnSums(x - 1);
-				}
-				if (x + 2 * N <= w) {
-					const ColumnSums nextSums = columnSums(x + N);
-					right = { NextColumn(d32, cur.xx, nextSums.xx), NextColumn(d32, cur.xy2, nextSums.xy2) };
-					cachedPrev = cur;
-					cached = nextSums;
-					cachedAt = x + N;
-				} else {
-					right = columnSums(x + 1);
-				}
-				const auto sxx = hn::Add(hn::Add(left.xx, cur.xx), right.xx);
-				const auto sxy2 = hn::Add(hn::Add(left.xy2, cur.xy2), right.xy2);
-				/* Sxx - Syy = 2 Sxx - S; |Sxy| >> 8 = |2 Sxy| >> 9. */
-				const auto c = hn::ShiftRight<9>(hn::Sub(s, twoT));
-				const auto ad = hn::ShiftRight<9>(hn::Abs(hn::Sub(hn::Add(sxx, sxx), s)));
-				const auto bd = hn::ShiftRight<9>(hn::Abs(sxy2));
-				const auto corner = hn::And(hn::Lt(zero, c),
-							    hn::Lt(hn::Add(hn::Mul(ad, ad), hn::Mul(bd, bd)), hn::Mul(c, c)));
-				bytes = EdgeBytes(d32, d8, edge, corner);
+			any |= !hn::AllFalse(d32, edge);
+			/* Shi-Tomasi in isCorner's int32 form, summed here from the
+			 * pairs, for every vector with a strong pixel: a branch on
+			 * edge mispredicts on textured frames more often than the
+			 * test costs. Sxx + Syy is the sum of the nine magnitudes. */
+			const auto s = hn::Add(hn::Add(hn::Add(hn::Add(ul, um), hn::Add(ur, dl)),
+						       hn::Add(hn::Add(dm, dr), hn::Add(ml, mr))), m);
+			/* The 3x3 sums as column sums over the three rows,
+			 * then across; the next vector's column sums are kept,
+			 * as edges run along rows. */
+			ColumnSums left, cur, right;
+			if (x == cachedAt) {
+				cur = cached;
+				left = { PrevColumn(d32, cachedPrev.xx, cur.xx), PrevColumn(d32, cachedPrev.xy2, cur.xy2) };
+			} else {
+				cur = columnSums(x);
+				left = columnSums(x - 1);
 			}
+			if (x + 2 * N <= w) {
+				const ColumnSums nextSums = columnSums(x + N);
+				right = { NextColumn(d32, cur.xx, nextSums.xx), NextColumn(d32, cur.xy2, nextSums.xy2) };
+				cachedPrev = cur;
+				cached = nextSums;
+				cachedAt = x + N;
+			} else {
+				right = columnSums(x + 1);
+			}
+			const auto sxx = hn::Add(hn::Add(left.xx, cur.xx), right.xx);
+			const auto sxy2 = hn::Add(hn::Add(left.xy2, cur.xy2), right.xy2);
+			/* Sxx - Syy = 2 Sxx - S; |Sxy| >> 8 = |2 Sxy| >> 9. */
+			const auto c = hn::ShiftRight<9>(hn::Sub(s, twoT));
+			const auto ad = hn::ShiftRight<9>(hn::Abs(hn::Sub(hn::Add(sxx, sxx), s)));
+			const auto bd = hn::ShiftRight<9>(hn::Abs(sxy2));
+			const auto corner = hn::And(hn::Lt(zero, c),
+						    hn::Lt(hn::Add(hn::Mul(ad, ad), hn::Mul(bd, bd)), hn::Mul(c, c)));
+			bytes = EdgeBytes(d32, d8, edge, corner);
 		}
 		hn::StoreU(bytes, d8, out + x);
 	};
