@@ -14,7 +14,7 @@
 // (Debian's libapriltag) runs too, single-threaded, at decimate 1 and 2.
 //
 // Then, unless --no-extras: throughput with two threads (front-end bands,
-// and the pipelined mode) against one; the cost of the same frames at
+// the pipelined mode, whole frames on two detectors) against one; the cost of the same frames at
 // 1280x960 against 640x480; and of a frame with 24 markers against one.
 // Not a test: speed is never asserted.
 #include <algorithm>
@@ -162,7 +162,7 @@ void reportThroughput(const frappe::Config &base, const std::vector<cv::Mat> &im
 	one.threads = 1;
 	two.threads = 2;
 	frappe::Detector d1(one), d2(two);
-	frappe::Pipeline pipe(one);
+	frappe::Pipeline pipe(one), frames(one, frappe::Pipeline::Mode::Frames);
 	std::size_t sink = 0;
 	auto single = [&](const cv::Mat &g) { sink += d1.detect(viewOf(g)).markers.size(); };
 	auto bands = [&](const cv::Mat &g) { sink += d2.detect(viewOf(g)).markers.size(); };
@@ -170,22 +170,31 @@ void reportThroughput(const frappe::Config &base, const std::vector<cv::Mat> &im
 		if (const frappe::Result *r = pipe.push(viewOf(g)))
 			sink += r->markers.size();
 	};
+	auto whole = [&](const cv::Mat &g) {
+		if (const frappe::Result *r = frames.push(viewOf(g)))
+			sink += r->markers.size();
+	};
 	/* Warm-up: buffers and worker threads. */
 	throughputMs(images, 1, single);
 	throughputMs(images, 1, bands);
 	throughputMs(images, 1, pipelined);
 	while (pipe.flush()) {}
-	double t1 = 0, t2 = 0, tp = 0;
+	throughputMs(images, 1, whole);
+	while (frames.flush()) {}
+	double t1 = 0, t2 = 0, tp = 0, tf = 0;
 	for (int r = 0; r < repeat; ++r) { /* interleaved runs */
 		t1 += throughputMs(images, 1, single);
 		t2 += throughputMs(images, 1, bands);
 		tp += throughputMs(images, 1, pipelined);
 		while (pipe.flush()) {}
+		tf += throughputMs(images, 1, whole);
+		while (frames.flush()) {}
 	}
 	std::printf("\nthroughput, frames per second over %zu frames x %d:\n", images.size(), repeat);
 	std::printf("  1 thread                     %8.1f fps\n", 1000.0 * repeat / t1);
 	std::printf("  2 threads, front-end bands   %8.1f fps  (%.2fx)\n", 1000.0 * repeat / t2, t1 / t2);
 	std::printf("  2 threads, pipelined (3 stg) %8.1f fps  (%.2fx)\n", 1000.0 * repeat / tp, t1 / tp);
+	std::printf("  2 threads, whole frames      %8.1f fps  (%.2fx)\n", 1000.0 * repeat / tf, t1 / tf);
 	if (sink == 0)
 		std::printf("  (no markers found)\n");
 }

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
-// The pipelined mode gives, two frames late and in order, exactly what
-// detect() gives frame by frame; bad frames are refused without losing the
-// ones in flight.
+// Both two-thread modes give, latency() frames late and in order, exactly
+// what detect() gives frame by frame; bad frames are refused without losing
+// the ones in flight.
 #include <gtest/gtest.h>
 
 #include "frappe/frappe.h"
@@ -43,7 +43,11 @@ void expectSame(const Result &a, const Result &b, int frame)
 
 } // namespace
 
-TEST(Pipeline, SameMarkersAsDetectTwoFramesLateInOrder)
+class PipelineModes : public ::testing::TestWithParam<Pipeline::Mode>
+{
+};
+
+TEST_P(PipelineModes, SameMarkersAsDetectLatencyFramesLateInOrder)
 {
 	const std::vector<Image> frames = sequence(9);
 	Detector reference(Config{});
@@ -51,12 +55,13 @@ TEST(Pipeline, SameMarkersAsDetectTwoFramesLateInOrder)
 	for (const Image &f : frames)
 		expected.push_back(reference.detect(f.view()));
 
-	Pipeline pipeline(Config{});
+	Pipeline pipeline(Config{}, GetParam());
+	EXPECT_EQ(pipeline.latency(), GetParam() == Pipeline::Mode::Stages ? 2 : 1);
 	std::vector<Result> got;
 	int pushes = 0;
 	for (const Image &f : frames) {
 		const Result *r = pipeline.push(f.view());
-		EXPECT_EQ(r != nullptr, pushes >= 2) << "push " << pushes;
+		EXPECT_EQ(r != nullptr, pushes >= pipeline.latency()) << "push " << pushes;
 		if (r)
 			got.push_back(*r);
 		++pushes;
@@ -95,13 +100,43 @@ TEST(Pipeline, BadFrameIsRefusedAndTheFrameInFlightSurvives)
 	EXPECT_EQ(pipeline.flush(), nullptr);
 }
 
-TEST(Pipeline, FlushWithNothingInFlight)
+TEST_P(PipelineModes, FlushWithNothingInFlight)
 {
-	Pipeline pipeline(Config{});
+	Pipeline pipeline(Config{}, GetParam());
 	EXPECT_FALSE(pipeline.pending());
 	EXPECT_EQ(pipeline.flush(), nullptr);
-	/* A pipeline may be destroyed with frames in flight. */
-	const std::vector<Image> frames = sequence(1);
-	Pipeline other(Config{});
+	/* A pipeline may be destroyed with frames in flight, in Frames mode
+	 * with the worker still on one. */
+	const std::vector<Image> frames = sequence(2);
+	Pipeline other(Config{}, GetParam());
 	EXPECT_EQ(other.push(frames[0].view()), nullptr);
+	other.push(frames[1].view());
 }
+
+/* Frames mode: a refused frame changes neither the parity nor the frames
+ * in flight. */
+TEST(Pipeline, FramesModeRefusesABadFrameAndKeepsTheOrder)
+{
+	const std::vector<Image> frames = sequence(3);
+	Detector reference(Config{});
+	Pipeline pipeline(Config{}, Pipeline::Mode::Frames);
+	EXPECT_EQ(pipeline.push(frames[0].view()), nullptr);
+	const Result *r0 = pipeline.push(frames[1].view());
+	ASSERT_NE(r0, nullptr);
+	expectSame(*r0, reference.detect(frames[0].view()), 0);
+	EXPECT_THROW(pipeline.push(ImageView(nullptr, 10, 10, 10)), std::invalid_argument);
+	const Result *r1 = pipeline.push(frames[2].view());
+	ASSERT_NE(r1, nullptr);
+	expectSame(*r1, reference.detect(frames[1].view()), 1);
+	const Result *r2 = pipeline.flush();
+	ASSERT_NE(r2, nullptr);
+	expectSame(*r2, reference.detect(frames[2].view()), 2);
+	EXPECT_EQ(pipeline.flush(), nullptr);
+	EXPECT_FALSE(pipeline.pending());
+}
+
+INSTANTIATE_TEST_SUITE_P(Both, PipelineModes,
+			 ::testing::Values(Pipeline::Mode::Stages, Pipeline::Mode::Frames),
+			 [](const auto &info) {
+				 return std::string(info.param == Pipeline::Mode::Stages ? "Stages" : "Frames");
+			 });

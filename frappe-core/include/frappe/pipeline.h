@@ -10,25 +10,35 @@
 
 namespace frappe {
 
-/// Runs a Detector over a stream with two threads, in three stages: while
-/// the calling thread traces the contours of frame N, a worker thread runs
-/// the front end of frame N+1 and then refines, warps and decodes frame N-1.
-/// Results come out two frames late, in order.
+/// Runs detection over a stream with two threads, results in order.
 ///
-/// Throughput is bounded by the slower of the trace and the rest, instead
-/// of their sum. In AScale mode a frame's scale comes from the last frame
-/// finished before its front end started (three frames earlier).
+/// Mode::Stages (the paper's pipelined mode), three stages: while the
+/// calling thread traces the contours of frame N, a worker thread runs the
+/// front end of frame N+1 and then refines, warps and decodes frame N-1.
+/// Results come out two frames late. Throughput is bounded by the slower of
+/// the trace and the rest, instead of their sum; one detector's memory. In
+/// AScale mode a frame's scale comes from the last frame finished before its
+/// front end started (three frames earlier).
+///
+/// Mode::Frames: whole frames on two detectors, the even ones on the
+/// calling thread, the odd ones on a worker that runs on while the caller
+/// returns. Results come out one frame late. Throughput approaches twice a
+/// detector's whatever the balance of the stages, for twice the memory. In
+/// AScale mode each detector scales from its own previous frame (two frames
+/// earlier).
 class Pipeline {
 public:
+	enum class Mode { Stages, Frames };
+
 	/// Throws std::invalid_argument like Detector's constructor.
-	explicit Pipeline(const Config &config);
+	explicit Pipeline(const Config &config, Mode mode = Mode::Stages);
 	~Pipeline();
 	Pipeline(const Pipeline &) = delete;
 	Pipeline &operator=(const Pipeline &) = delete;
 
 	/// Starts `image`, which must stay valid until its result has been
-	/// returned, and returns the result of the frame pushed two calls
-	/// before, or nullptr for the first two frames. A returned Result stays
+	/// returned, and returns the result of the frame pushed latency() calls
+	/// before, or nullptr for the first latency() frames. A returned Result stays
 	/// valid until the next push() or flush(). Throws std::invalid_argument
 	/// for a bad image, before starting it; the frames already in flight are
 	/// unaffected.
@@ -41,6 +51,11 @@ public:
 	/// Whether frames are in flight (pushed, results not yet returned).
 	bool pending() const;
 
+	/// Frames between a push and its result: 2 for Stages, 1 for Frames.
+	int latency() const;
+
+	/// The detector of the calling thread (Mode::Frames has a second one,
+	/// configured alike, for the odd frames).
 	Detector &detector();
 
 private:
