@@ -66,6 +66,61 @@ inline int ceilInt(float x)
 	return static_cast<float>(i) < x ? i + 1 : i;
 }
 
+/* The edge's crossing of one column. p(j) is the pixel j steps inwards of
+ * the side's nearest pixel, for |j| <= kLo/kHi's reach + kRun + 1; the
+ * steepest fall is looked for at kLo..kHi. Returns the windowed falls' total
+ * w (0: no edge) and their moment2, so that the crossing is at
+ * moment2 / (2 w) steps, both in sixteenths of the falls. */
+template <typename Pixel>
+inline int measureColumn(Pixel p, int kLo, int kHi, int &moment2Out)
+{
+	/* Strongest fall in intensity going inwards (white border outside,
+	 * black frame inside); rises belong to other edges. */
+	int best = 0, bestDrop = 0;
+	for (int k = kLo; k <= kHi; ++k) {
+		const int drop = p(k - 1) - p(k + 1);
+		if (drop > bestDrop) {
+			bestDrop = drop;
+			best = k;
+		}
+	}
+	if (bestDrop < kMinDrop)
+		return 0;
+	/* The falls around it: the two differences at the peak, extended while
+	 * the intensity keeps falling, at most kRun pixels. The difference
+	 * p(k) - p(k + 1) lies at k + 1/2. */
+	int lo = best - 1, hi = best + 1;
+	int prev = p(lo);
+	for (int next; lo > best - 1 - kRun && (next = p(lo - 1)) > prev; prev = next)
+		--lo;
+	prev = p(hi);
+	for (int next; hi <= best + kRun && prev > (next = p(hi + 1)); prev = next)
+		++hi;
+	/* falls[i] at lo + i; hi is one past the last. */
+	int falls[2 * kRun + 2];
+	int mass = 0, moment2 = 0;
+	prev = p(lo);
+	for (int k = lo; k < hi; ++k) {
+		const int next = p(k + 1);
+		const int fall = std::max(prev - next, 0);
+		prev = next;
+		falls[k - lo] = fall;
+		mass += fall;
+		moment2 += fall * (2 * k + 1);
+	}
+	/* Their centroid, in 1/16 pixel (rounded), centres the window. */
+	const int c16 = (8 * moment2 + (moment2 >= 0 ? mass / 2 : -mass / 2)) / mass;
+	int wMass = 0, wMoment2 = 0;
+	for (int k = lo; k < hi; ++k) {
+		const int f16 = std::clamp(kWindow16 - std::abs(16 * k + 8 - c16), 0, 16);
+		const int wf = f16 * falls[k - lo];
+		wMass += wf;
+		wMoment2 += wf * (2 * k + 1);
+	}
+	moment2Out = wMoment2;
+	return wMass;
+}
+
 /* Measures one side from a to b (clockwise quad, so the marker interior is
  * on the right of a->b on screen). */
 bool fitSide(const ImageView &img, Point2f a, Point2f b, float search, int maxPoints, Line &line)
@@ -131,57 +186,19 @@ bool fitSide(const ImageView &img, Point2f a, Point2f b, float search, int maxPo
 		const int u = u0 + U;
 		const std::int32_t vFix = vFix0 + slopeFix * U;
 		const int vc = (vFix + 32768) >> 16;
+		const std::int32_t frac = dir * (vFix - (vc << 16)); /* the side at p[frac], |frac| <= 1/2 */
+		const int kLo = (frac - peakFix + 65535) >> 16, kHi = (frac + peakFix) >> 16;
+		int wMass, wMoment2 = 0;
 		if (u >= 0 && u < uDim && vc - half >= 0 && vc + half < vDim) {
-			const std::uint8_t *px = img.data + u * uStep + vc * vStep - half * step;
-			for (int j = -half; j <= half; ++j, px += step)
-				p[j] = *px;
+			const std::uint8_t *px = img.data + u * uStep + vc * vStep;
+			wMass = measureColumn([px, step](int j) { return static_cast<int>(px[j * step]); }, kLo, kHi,
+					      wMoment2);
 		} else {
 			/* Clamped to the image, as a bilinear sampler would. */
 			const int uc = std::clamp(u, 0, uDim - 1);
 			for (int j = -half; j <= half; ++j)
 				p[j] = img.data[uc * uStep + std::clamp(vc + dir * j, 0, vDim - 1) * vStep];
-		}
-		/* Strongest fall in intensity going inwards (white border outside,
-		 * black frame inside); rises belong to other edges. */
-		const std::int32_t frac = dir * (vFix - (vc << 16)); /* the side at p[frac], |frac| <= 1/2 */
-		const int kLo = (frac - peakFix + 65535) >> 16, kHi = (frac + peakFix) >> 16;
-		int best = 0, bestDrop = 0;
-		for (int k = kLo; k <= kHi; ++k) {
-			const int drop = p[k - 1] - p[k + 1];
-			if (drop > bestDrop) {
-				bestDrop = drop;
-				best = k;
-			}
-		}
-		if (bestDrop < kMinDrop)
-			continue;
-		/* The falls around it: the two differences at the peak, extended
-		 * while the intensity keeps falling, at most kRun pixels. The
-		 * difference p[k] - p[k + 1] lies at k + 1/2. */
-		int lo = best - 1, hi = best;
-		while (lo > best - 1 - kRun && p[lo - 1] > p[lo])
-			--lo;
-		while (hi < best + kRun && p[hi + 1] > p[hi + 2])
-			++hi;
-		int mass = 0, moment2 = 0;
-		for (int k = lo; k <= hi; ++k) {
-			const int fall = p[k] - p[k + 1];
-			if (fall > 0) {
-				mass += fall;
-				moment2 += fall * (2 * k + 1);
-			}
-		}
-		/* Their centroid, in 1/16 pixel (rounded), centres the window. */
-		const int c16 = (8 * moment2 + (moment2 >= 0 ? mass / 2 : -mass / 2)) / mass;
-		int wMass = 0, wMoment2 = 0;
-		for (int k = lo; k <= hi; ++k) {
-			const int fall = p[k] - p[k + 1];
-			const int d16 = std::abs(8 * (2 * k + 1) - c16);
-			const int f16 = std::min(16, kWindow16 - d16);
-			if (fall > 0 && f16 > 0) {
-				wMass += f16 * fall;
-				wMoment2 += f16 * fall * (2 * k + 1);
-			}
+			wMass = measureColumn([p](int j) { return p[j]; }, kLo, kHi, wMoment2);
 		}
 		if (wMass <= 0)
 			continue;
