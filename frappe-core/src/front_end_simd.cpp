@@ -59,7 +59,12 @@ void SmoothRow(const std::uint8_t *a, const std::uint8_t *b, const std::uint8_t 
 		const auto m = hn::LoadU(d16, tmp + x);
 		const auto r = hn::LoadU(d16, tmp + x + 1);
 		const auto s = hn::ShiftRight<4>(hn::Add(hn::Add(l, r), hn::Add(hn::Add(m, m), round)));
+#if HWY_ARCH_X86 && HWY_TARGET <= HWY_AVX3
+		/* s <= 255: truncation is exact, one instruction. */
+		hn::StoreU(hn::Vec<decltype(d8)>{ _mm512_cvtepi16_epi8(s.raw) }, d8, out + x);
+#else
 		hn::StoreU(hn::DemoteTo(d8, s), d8, out + x);
+#endif
 	}
 	for (; x < w - 1; ++x)
 		out[x] = static_cast<std::uint8_t>((tmp[x - 1] + 2 * tmp[x] + tmp[x + 1] + 8) >> 4);
