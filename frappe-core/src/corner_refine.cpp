@@ -180,7 +180,7 @@ bool fitSide(const ImageView &img, Point2f a, Point2f b, float search, int maxPo
 	std::int64_t sw = 0, su = 0, suu = 0, sq = 0, suq = 0;
 	int used = 0;
 	int buf[kMaxProfile];
-	int *const p = buf + half; /* p[j]: the pixel j steps inwards of the side's */
+	int *const p = buf + half; /* near the image border: p[j], the pixel j steps inwards of the side, clamped */
 	for (int i = 0; i < nPoints; ++i, accFix += stepFix) {
 		const int U = accFix >> 16;
 		const int u = u0 + U;
