@@ -1,9 +1,10 @@
 // SPDX-License-Identifier: MIT
 // Suzuki & Abe (1985) border following, list mode: every border of the
 // 8-connected edge pixels is followed exactly once. Label values (bit 0 set
-// on every non-zero label, so a neighbour test is one AND):
+// on every non-zero label, so a neighbour test is one AND; the other bits
+// are 3 and 4, so that three rows' bit 0 can be gathered with one AND):
 //   0 background, 1 (kUnfollowed) edge not yet on a followed border,
-//   3 (kFollowed) on a followed border, 5 (kFollowedRightBg) on a followed
+//   9 (kFollowed) on a followed border, 25 (kFollowedRightBg) on a followed
 //   border whose right neighbour (examined while following) is background:
 //   the paper's -NBD, which stops a second hole border from starting at the
 //   same place. Sealed marker insides are kFollowedRightBg too: nothing
@@ -20,7 +21,10 @@ namespace frappe::detail {
 
 namespace {
 
-constexpr std::uint8_t kUnfollowed = 1, kFollowed = 3, kFollowedRightBg = 5;
+/* Following a pixel ORs one of the two marks into its label: 1 -> 9 or 25,
+ * 9 -> 9 or 25, 25 stays. */
+constexpr std::uint8_t kUnfollowed = 1, kFollowed = 9, kFollowedRightBg = 25;
+constexpr std::uint8_t kMarkFollowed = 8, kMarkRightBg = 24;
 
 /* Neighbour offsets, counter-clockwise on screen starting at the right. */
 constexpr int kDx[8] = { 1, 1, 0, -1, -1, -1, 0, 1 };
@@ -53,15 +57,15 @@ struct NextStepTable {
 };
 constexpr NextStepTable kNextStep;
 
-/* The same table indexed by the neighbourhood read a row at a time: bits
- * 0..2 column x-1 (rows above, this, below), 3..5 column x (the centre, bit
- * 4, is ignored), 6..8 column x+1. */
+/* The same table indexed by the neighbourhood read a row at a time (see
+ * neighbourIndex): bits 0..2 column x+1 (rows above, this, below), 3..5
+ * column x (the centre, bit 4, is ignored), 6..8 column x-1. */
 struct RowStepTable {
 	std::uint8_t entry[8][512];
 	constexpr RowStepTable() : entry{}
 	{
 		/* Index bit of each direction, in kDx/kDy order. */
-		constexpr int kBit[8] = { 7, 6, 3, 0, 1, 2, 5, 8 };
+		constexpr int kBit[8] = { 1, 0, 3, 6, 7, 8, 5, 2 };
 		for (int back = 0; back < 8; ++back)
 			for (int idx = 0; idx < 512; ++idx) {
 				int mask = 0;
@@ -73,27 +77,30 @@ struct RowStepTable {
 };
 constexpr RowStepTable kRowStep;
 
-/* Bit 0 of byte i: whether label p[i] is non-zero, for i = 0, 1, 2. Reads
- * p[3] too: the label image has padding. */
-inline std::uint32_t rowNonZero(const std::uint8_t *p)
+inline std::uint32_t load32(const std::uint8_t *p)
 {
 	std::uint32_t v;
 	std::memcpy(&v, p, 4);
-	return v & 0x00010101u;
+	return v;
 }
 
-/* The RowStepTable index of the 3x3 neighbourhood around p. */
-inline unsigned neighbourIndex(const std::uint8_t *p, int w)
+/* The RowStepTable index of the 3x3 neighbourhood around p. The three rows'
+ * words (p[3] is read too: the label image has padding) are ORed with
+ * shifts of 0, 1, 2, so that bits 0..2 of byte i hold column x-1+i's
+ * rows; labels use no bit above 4, so nothing crosses into the next byte.
+ * One multiply then moves byte 0's three bits to 29..31, byte 1's to
+ * 26..28, byte 2's to 23..25 (the other products land below bit 21 and
+ * apart, so nothing carries), and the index is the top nine bits. */
+inline unsigned neighbourIndex(const std::uint8_t *p, std::ptrdiff_t w)
 {
 	if constexpr (std::endian::native == std::endian::little) {
-		const std::uint32_t raw =
-			rowNonZero(p - w - 1) | rowNonZero(p - 1) << 1 | rowNonZero(p + w - 1) << 2;
-		return (raw & 7u) | ((raw >> 5) & 0x38u) | ((raw >> 10) & 0x1C0u);
+		const std::uint32_t raw = (load32(p - w - 1) | load32(p - 1) << 1 | load32(p + w - 1) << 2) & 0x00070707u;
+		return (raw * ((1u << 29) | (1u << 18) | (1u << 7))) >> 23;
 	} else {
 		unsigned idx = 0;
 		for (int dx = -1; dx <= 1; ++dx)
 			for (int dy = -1; dy <= 1; ++dy)
-				idx |= static_cast<unsigned>(p[dy * w + dx] != 0) << (3 * (dx + 1) + dy + 1);
+				idx |= static_cast<unsigned>(p[dy * w + dx] != 0) << (3 * (1 - dx) + dy + 1);
 		return idx;
 	}
 }
@@ -112,10 +119,11 @@ std::uint64_t borderStarts(const std::uint8_t *p)
 		return 0;
 	std::memcpy(&left, p - 1, 8);
 	std::memcpy(&right, p + 1, 8);
-	/* labels are 0, 1, 3, 5: bit 1 marks kFollowed, bit 2 kFollowedRightBg */
-	const std::uint64_t b0 = here & kOnes, b1 = (here >> 1) & kOnes, b2 = (here >> 2) & kOnes;
+	/* labels are 0, 1, 9, 25: bit 3 marks a followed pixel, bit 4 one
+	 * whose right neighbour is background */
+	const std::uint64_t b0 = here & kOnes, b3 = (here >> 3) & kOnes, b4 = (here >> 4) & kOnes;
 	const std::uint64_t leftZero = ~left & kOnes, rightZero = ~right & kOnes;
-	return (b0 & ~(b1 | b2) & leftZero) | (b0 & ~b2 & rightZero);
+	return (b0 & ~b3 & leftZero) | (b0 & ~b4 & rightZero);
 }
 
 /* Index of the lowest non-zero byte of a non-zero word. */
@@ -169,14 +177,19 @@ void ContourTracer::trace(const EdgeMap &edges, const TraceParams &params, std::
 	if (w < 3 || h < 3)
 		return;
 	if (stride_ != w || stepTable_.empty()) {
-		/* kRowStep with each move's pointer offset: (offset << 4) | flag << 3 | d. */
+		/* kRowStep as (offset << 12) | back' << 9 | mark: the move's
+		 * pointer offset, the direction back from the pixel it reaches
+		 * (which selects the next row of the table), and the label mark
+		 * of the pixel it leaves. */
 		stepTable_.resize(8 * 512);
 		for (int back = 0; back < 8; ++back)
 			for (int idx = 0; idx < 512; ++idx) {
 				const int e = kRowStep.entry[back][idx];
 				const int d = e & 7;
-				stepTable_[static_cast<std::size_t>(back) * 512 + idx] =
-					static_cast<std::int32_t>((kDx[d] + kDy[d] * w) * 16) | (e & 15);
+				const auto offset = static_cast<std::uint32_t>(kDx[d] + kDy[d] * w);
+				stepTable_[static_cast<std::size_t>(back) * 512 + idx] = static_cast<std::int32_t>(
+					offset << 12 | static_cast<std::uint32_t>((d + 4) & 7) << 9 |
+					((e & 8) ? kMarkRightBg : kMarkFollowed));
 			}
 	}
 	stride_ = w;
@@ -227,7 +240,7 @@ void ContourTracer::trace(const EdgeMap &edges, const TraceParams &params, std::
 				int fromDir;
 				if (f == kUnfollowed && row[x - 1] == 0)
 					fromDir = 4; /* outer border: came from the left */
-				else if ((f == kUnfollowed || f == kFollowed) && row[x + 1] == 0)
+				else if (!(f & (kFollowedRightBg ^ kFollowed)) && row[x + 1] == 0)
 					fromDir = 0; /* hole border: the hole is to the right */
 				else
 					continue;
@@ -237,6 +250,9 @@ void ContourTracer::trace(const EdgeMap &edges, const TraceParams &params, std::
 				/* A marker outline is at least four sides of min_side pixels,
 				 * and spans at least min_side / sqrt(2) each way. */
 				if (static_cast<float>(steps_) < 2.8f * params.min_side)
+					continue;
+				/* Both ways of making a quad below need two clusters. */
+				if (clusters_.size() < 2)
 					continue;
 				if (!spansAtLeast(0.7f * params.min_side))
 					continue;
@@ -346,14 +362,18 @@ void ContourTracer::sealInside(const Quad &quad, int w, int h)
 
 bool ContourTracer::spansAtLeast(float span) const
 {
-	int minX = points_[0].x, maxX = minX, minY = points_[0].y, maxY = minY;
-	for (const Pixel &p : points_) {
-		minX = std::min(minX, p.x);
-		maxX = std::max(maxX, p.x);
-		minY = std::min(minY, p.y);
-		maxY = std::max(maxY, p.y);
+	/* y is the high half of a point: the extreme words give its extremes. */
+	const std::uint32_t *pt = points_.data();
+	const int n = steps_;
+	std::uint32_t lo = pt[0], hi = lo, minX = lo & 0xFFFFu, maxX = minX;
+	for (int i = 0; i < n; ++i) {
+		const std::uint32_t v = pt[i], x = v & 0xFFFFu;
+		lo = std::min(lo, v);
+		hi = std::max(hi, v);
+		minX = std::min(minX, x);
+		maxX = std::max(maxX, x);
 	}
-	return static_cast<float>(maxX - minX) >= span && static_cast<float>(maxY - minY) >= span;
+	return static_cast<float>(maxX - minX) >= span && static_cast<float>((hi >> 16) - (lo >> 16)) >= span;
 }
 
 /* Follows one border from (x, y); (x, y) + kD[fromDir] is the background
@@ -362,34 +382,20 @@ void ContourTracer::follow(int x0, int y0, int fromDir, const EdgeMap &edges)
 {
 	clusters_.clear();
 	tooManyClusters_ = false;
-	std::uint8_t *L = labels_.data();
-	const std::uint8_t *E = edges.pixels.data();
-	const int w = stride_;
-	auto at = [&](int x, int y) -> std::uint8_t & { return L[static_cast<std::size_t>(y) * w + x]; };
-
-	points_.clear();
-	/* The points go through a small local buffer and the step count is a
-	 * local: the label stores (bytes, which may alias anything) would make
-	 * the compiler reload the members on every step. */
-	constexpr int kChunk = 128;
-	Pixel chunk[kChunk];
-	int inChunk = 0;
-	int steps = 0;
-	auto flush = [&] {
-		points_.insert(points_.end(), chunk, chunk + inChunk);
-		inChunk = 0;
+	std::uint8_t *const L = labels_.data();
+	const std::ptrdiff_t w = stride_;
+	/* The edge map's byte of a label pointer (same layout). */
+	const std::uintptr_t toEdge =
+		reinterpret_cast<std::uintptr_t>(edges.pixels.data()) - reinterpret_cast<std::uintptr_t>(L);
+	auto isCorner = [toEdge](const std::uint8_t *label) {
+		return (*reinterpret_cast<const std::uint8_t *>(reinterpret_cast<std::uintptr_t>(label) + toEdge) &
+			EdgeMap::kCorner) != 0;
 	};
-	auto finish = [&] {
-		flush();
-		steps_ = steps;
-	};
-	auto visit = [&](int x, int y, const std::uint8_t *label) __attribute__((always_inline)) {
-		++steps;
-		chunk[inChunk++] = { x, y };
-		if (inChunk == kChunk)
-			flush();
-		if (!(E[label - L] & EdgeMap::kCorner) || tooManyClusters_)
+	/* Not inlined into the loop: one in ten border pixels or fewer is a corner. */
+	auto cluster = [this](std::uint32_t xy) __attribute__((noinline)) {
+		if (tooManyClusters_)
 			return;
+		const int x = static_cast<int>(xy & 0xFFFFu), y = static_cast<int>(xy >> 16);
 		const float fx = static_cast<float>(x), fy = static_cast<float>(y);
 		for (Cluster &c : clusters_) {
 			const float dx = fx - static_cast<float>(c.fx), dy = fy - static_cast<float>(c.fy);
@@ -407,60 +413,70 @@ void ContourTracer::follow(int x0, int y0, int fromDir, const EdgeMap &edges)
 		clusters_.push_back({ fx, fy, 1, x, y });
 	};
 
+	/* The points are written through local pointers, and the loop reads
+	 * no member: the label stores (bytes, which may alias anything) would
+	 * make the compiler reload members on every step. */
+	if (points_.size() < 1024)
+		points_.resize(1024);
+	std::uint32_t *out = points_.data(), *outEnd = out + points_.size();
+	std::uint32_t xy = static_cast<std::uint32_t>(x0) | static_cast<std::uint32_t>(y0) << 16;
+
 	/* Pointer offsets of the eight neighbours, in kDx/kDy order. */
 	const std::ptrdiff_t off[8] = { 1, 1 - w, -w, -1 - w, -1, w - 1, w, w + 1 };
-	auto neighbourMask = [&](const std::uint8_t *p) {
-		unsigned m = 0;
-		for (int d = 0; d < 8; ++d)
-			m |= static_cast<unsigned>(p[off[d]] != 0) << d;
-		return m;
-	};
-
 	/* 3.1: clockwise from fromDir, find the first non-zero neighbour. */
-	std::uint8_t *p0 = &at(x0, y0);
-	const unsigned mask0 = neighbourMask(p0);
+	std::uint8_t *const p0 = L + y0 * w + x0;
+	unsigned mask0 = 0;
+	for (int d = 0; d < 8; ++d)
+		mask0 |= static_cast<unsigned>(p0[off[d]] != 0) << d;
 	if (mask0 == 0) {
 		*p0 = kFollowedRightBg; /* isolated pixel */
-		visit(x0, y0, p0);
-		finish();
+		*out++ = xy;
+		if (isCorner(p0))
+			cluster(xy);
+		steps_ = 1;
 		return;
 	}
 	int d1 = fromDir;
 	while (!(mask0 & (1u << d1)))
 		d1 = (d1 + 7) & 7;
-	std::uint8_t *p1 = p0 + off[d1];
-	std::uint8_t *p3 = p0;
-	int x3 = x0, y3 = y0;
-	/* Row of the step table for the direction back to the previous pixel. */
-	const std::int32_t *stepRow = stepTable_.data() + d1 * 512;
+	const std::uint8_t *const p1 = p0 + off[d1];
+	/* xy steps per direction back (the move is the opposite direction). */
+	static constexpr std::int32_t kDxyBack[8] = { -kDx[0] - kDy[0] * 65536, -kDx[1] - kDy[1] * 65536,
+						      -kDx[2] - kDy[2] * 65536, -kDx[3] - kDy[3] * 65536,
+						      -kDx[4] - kDy[4] * 65536, -kDx[5] - kDy[5] * 65536,
+						      -kDx[6] - kDy[6] * 65536, -kDx[7] - kDy[7] * 65536 };
+	const std::int32_t *const table = stepTable_.data();
 	const std::size_t maxSteps = 4 * labels_.size();
+	std::uint8_t *p = p0;
+	/* The table row for the direction back to the previous pixel. */
+	std::uint32_t row = static_cast<std::uint32_t>(d1) << 9;
 	for (;;) {
 		/* 3.3: counter-clockwise from the pixel after `back`; the entry
 		 * holds the pointer offset of the move, so the next pixel is one
 		 * table load away from this one's neighbourhood. */
-		const std::int32_t step = stepRow[neighbourIndex(p3, w)];
-		const int d4 = step & 7;
+		const std::int32_t step = table[row | neighbourIndex(p, w)];
 		/* 3.4: mark the current pixel. */
-		if (step & 8)
-			*p3 = kFollowedRightBg;
-		else if (*p3 == kUnfollowed)
-			*p3 = kFollowed;
-		visit(x3, y3, p3);
-		std::uint8_t *p4 = p3 + (step >> 4);
+		*p |= static_cast<std::uint8_t>(step & kMarkRightBg);
+		*out++ = xy;
+		if (isCorner(p)) [[unlikely]]
+			cluster(xy);
+		if (out == outEnd) [[unlikely]] {
+			const std::size_t n = points_.size();
+			if (n > maxSteps) /* only on a corrupt label image */
+				break;
+			points_.resize(2 * n);
+			out = points_.data() + n;
+			outEnd = points_.data() + points_.size();
+		}
+		std::uint8_t *const next = p + (step >> 12);
 		/* 3.5: back at the start, about to repeat the first move. */
-		if (p4 == p0 && p3 == p1) {
-			finish();
-			return;
-		}
-		stepRow = stepTable_.data() + (((d4 + 4) & 7) << 9);
-		p3 = p4;
-		x3 += kDx[d4];
-		y3 += kDy[d4];
-		if (static_cast<std::size_t>(steps) > maxSteps) { /* only on a corrupt label image */
-			finish();
-			return;
-		}
+		if (p == p1 && next == p0) [[unlikely]]
+			break;
+		row = static_cast<std::uint32_t>(step) & 0xE00u;
+		xy += static_cast<std::uint32_t>(kDxyBack[row >> 9]);
+		p = next;
 	}
+	steps_ = static_cast<int>(out - points_.data());
 }
 
 /* The paper's rule is "exactly four corner clusters". Noise adds clusters
@@ -508,20 +524,23 @@ bool ContourTracer::quadFromClusters(Quad &quad) const
  * diagonal they span. */
 bool ContourTracer::quadFromOutline(Quad &quad) const
 {
-	const std::size_t n = points_.size();
+	const std::size_t n = static_cast<std::size_t>(steps_);
 	if (n < 8)
 		return false;
-	double mx = 0, my = 0;
-	for (const Pixel &p : points_) {
-		mx += p.x;
-		my += p.y;
+	const std::uint32_t *pts = points_.data();
+	auto X = [pts](std::size_t i) { return static_cast<std::int32_t>(pts[i] & 0xFFFFu); };
+	auto Y = [pts](std::size_t i) { return static_cast<std::int32_t>(pts[i] >> 16); };
+	std::int64_t sx = 0, sy = 0;
+	for (std::size_t i = 0; i < n; ++i) {
+		sx += X(i);
+		sy += Y(i);
 	}
-	mx /= static_cast<double>(n);
-	my /= static_cast<double>(n);
+	const double mx = static_cast<double>(sx) / static_cast<double>(n);
+	const double my = static_cast<double>(sy) / static_cast<double>(n);
 	std::size_t i0 = 0;
 	double bd = -1;
 	for (std::size_t i = 0; i < n; ++i) {
-		const double dx = points_[i].x - mx, dy = points_[i].y - my;
+		const double dx = X(i) - mx, dy = Y(i) - my;
 		if (dx * dx + dy * dy > bd) {
 			bd = dx * dx + dy * dy;
 			i0 = i;
@@ -529,22 +548,22 @@ bool ContourTracer::quadFromOutline(Quad &quad) const
 	}
 	/* The rest in integers (coordinates below 2^15, so squares and cross
 	 * products fit an int32; in float they were exact too). */
-	const int x0 = points_[i0].x, y0 = points_[i0].y;
+	const int x0 = X(i0), y0 = Y(i0);
 	std::size_t i2 = 0;
 	std::int32_t bd2 = -1;
 	for (std::size_t i = 0; i < n; ++i) {
-		const std::int32_t dx = points_[i].x - x0, dy = points_[i].y - y0;
+		const std::int32_t dx = X(i) - x0, dy = Y(i) - y0;
 		if (dx * dx + dy * dy > bd2) {
 			bd2 = dx * dx + dy * dy;
 			i2 = i;
 		}
 	}
-	const int ex = points_[i2].x - x0, ey = points_[i2].y - y0;
+	const int ex = X(i2) - x0, ey = Y(i2) - y0;
 	std::int32_t most = 0, least = 0;
 	std::size_t i1 = 0, i3 = 0;
 	for (std::size_t i = 0; i < n; ++i) {
 		/* cross(p0, p2, p) */
-		const std::int32_t c = ex * (points_[i].y - y0) - ey * (points_[i].x - x0);
+		const std::int32_t c = ex * (Y(i) - y0) - ey * (X(i) - x0);
 		if (c > most) {
 			most = c;
 			i1 = i;
@@ -554,7 +573,7 @@ bool ContourTracer::quadFromOutline(Quad &quad) const
 		}
 	}
 	auto pt = [&](std::size_t i) {
-		return Point2f{ static_cast<float>(points_[i].x), static_cast<float>(points_[i].y) };
+		return Point2f{ static_cast<float>(X(i)), static_cast<float>(Y(i)) };
 	};
 	const Point2f p0 = pt(i0), p1 = pt(i1), p2 = pt(i2), p3 = pt(i3);
 	if (most <= 0 || least >= 0)
@@ -617,8 +636,9 @@ bool ContourTracer::acceptQuad(const TraceParams &params, int w, int h, Quad &qu
 	 * cover one. Steps of at most a third of the shortest bin. */
 	const std::size_t stride = std::max(1, static_cast<int>(shortSide / (3.0f * kBins)));
 	std::uint32_t covered[4] = {};
-	for (std::size_t k = 0; k < points_.size(); k += stride) {
-		const float px = static_cast<float>(points_[k].x), py = static_cast<float>(points_[k].y);
+	const std::size_t n = static_cast<std::size_t>(steps_);
+	for (std::size_t k = 0; k < n; k += stride) {
+		const float px = static_cast<float>(points_[k] & 0xFFFFu), py = static_cast<float>(points_[k] >> 16);
 		for (int i = 0; i < 4; ++i) {
 			if (std::abs(nx[i] * px + ny[i] * py - nc[i]) > tol)
 				continue;

@@ -51,9 +51,6 @@ public:
 	int bordersFollowed() const { return borders_; }
 
 private:
-	struct Pixel {
-		int x, y;
-	};
 	struct Cluster {
 		float sx, sy; ///< sums of member coordinates
 		int n;
@@ -68,10 +65,13 @@ private:
 
 	std::vector<std::uint8_t> labels_;
 	/// Suzuki's step 3.3 for this width: per direction back and 3x3
-	/// neighbourhood, the move's pointer offset, flag and direction.
+	/// neighbourhood, the move's pointer offset, the next direction back
+	/// and the label bits to set.
 	std::vector<std::int32_t> stepTable_;
 	std::vector<Cluster> clusters_;
-	std::vector<Pixel> points_;
+	/// The last border's pixels as x | y << 16; only the first steps_ are
+	/// valid (follow writes through a local pointer and grows it itself).
+	std::vector<std::uint32_t> points_;
 	int steps_ = 0;
 	bool tooManyClusters_ = false;
 	int borders_ = 0;
