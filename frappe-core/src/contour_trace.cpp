@@ -126,6 +126,14 @@ std::uint64_t borderStarts(const std::uint8_t *p)
 	return (b0 & ~b3 & leftZero) | (b0 & ~b4 & rightZero);
 }
 
+/* borderStarts for four pixels, given their labels `here`: the form for
+ * 32-bit targets, where 64-bit shifts take several instructions. */
+inline std::uint32_t borderStarts4(const std::uint8_t *p, std::uint32_t here)
+{
+	/* bit 0 of (left | b3) & (right | b4) clear: an outer or a hole start */
+	return here & ~((load32(p - 1) | here >> 3) & (load32(p + 1) | here >> 4)) & 0x01010101u;
+}
+
 /* Index of the lowest non-zero byte of a non-zero word. */
 int firstByte(std::uint64_t v)
 {
@@ -224,7 +232,25 @@ void ContourTracer::trace(const EdgeMap &edges, const TraceParams &params, std::
 				 * followed: find the next pixel where a border can start,
 				 * eight at a time (little-endian: the lowest byte is the
 				 * leftmost pixel). */
-				if constexpr (std::endian::native == std::endian::little) {
+				if constexpr (std::endian::native == std::endian::little && sizeof(void *) < 8) {
+					if (x + 8 <= x1) {
+						const std::uint32_t h0 = load32(row + x), h1 = load32(row + x + 4);
+						if ((h0 | h1) == 0) {
+							x += 7;
+							continue;
+						}
+						std::uint32_t starts = borderStarts4(row + x, h0);
+						if (starts == 0) {
+							starts = borderStarts4(row + x + 4, h1);
+							if (starts == 0) {
+								x += 7;
+								continue;
+							}
+							x += 4;
+						}
+						x += std::countr_zero(starts) >> 3;
+					}
+				} else if constexpr (std::endian::native == std::endian::little) {
 					if (x + 8 <= x1) {
 						const std::uint64_t starts = borderStarts(row + x);
 						if (starts == 0) {
