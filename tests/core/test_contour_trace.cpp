@@ -225,3 +225,31 @@ TEST(ContourTrace, SealDoesNotReachNeighbours)
 	removeDuplicateQuads(quads, 2.5f);
 	EXPECT_EQ(quads.size(), 3u);
 }
+
+/* A border longer than the tracer's first point buffer (1024 steps) is
+ * followed whole, and the tracer gives the same answer on its next frame
+ * of the same size (its label image and step table are reused). */
+TEST(ContourTrace, LongBorderAndReuseGiveTheSameQuad)
+{
+	EdgeMap em = emptyMap(640, 480);
+	ring(em, 30, 20, 600, 450);
+	ContourTracer tracer;
+	std::vector<Quad> first, second;
+	tracer.trace(em, TraceParams{}, first);
+	EXPECT_EQ(tracer.bordersFollowed(), 2);
+	tracer.trace(em, TraceParams{}, second);
+	ASSERT_EQ(first.size(), 2u);
+	ASSERT_EQ(second.size(), 2u);
+	for (std::size_t k = 0; k < 2; ++k)
+		for (int i = 0; i < 4; ++i) {
+			EXPECT_EQ(first[k].corners[i].x, second[k].corners[i].x);
+			EXPECT_EQ(first[k].corners[i].y, second[k].corners[i].y);
+		}
+	const float ex[4] = { 30, 600, 600, 30 }, ey[4] = { 20, 20, 450, 450 };
+	for (const Point2f &c : first[0].corners) {
+		bool near = false;
+		for (int k = 0; k < 4; ++k)
+			near = near || (std::abs(c.x - ex[k]) <= 1.0f && std::abs(c.y - ey[k]) <= 1.0f);
+		EXPECT_TRUE(near) << c.x << "," << c.y;
+	}
+}
