@@ -23,6 +23,7 @@
 #include <arm_acle.h>
 
 #include <algorithm>
+#include <cstddef>
 #include <cstdlib>
 #include <cstring>
 
@@ -465,19 +466,259 @@ __attribute__((noinline)) u32 edgeGroup(const EdgeRowCtx &e, int x, std::int32_t
 	return v;
 }
 
+/* The edge pass over the groups of eight pixels of a row, in one assembly
+ * function (GCC's code for the group work spilled): frappe_armv6_edge_row8.
+ *
+ * Scan: one LDM of eight magnitudes, their OR against the threshold, two
+ * word stores of zeros: 15 instructions per eight pixels. A group whose OR
+ * is above it ("hit"): for each half whose OR is above, non-maximum
+ * suppression of its four pixels as in nmsGroup, but |gx|, |gy| by
+ * SSUB16 + SEL on the pair and the direction tests by SMUSD / SMUSDX with
+ * (53, 128); then the corner test of each edge pixel as isCornerV6 (its
+ * three rows of three pairs by LDM), and the eight result bytes from two
+ * 16-entry tables. */
+struct EdgeRowAsm {
+	std::int32_t du, dd, dp1, k;	  ///< 0: up, down, pairs[1] minus mid (bytes); k = (53, 128)
+	std::int32_t dq0, dq1, dq2, twoT; ///< 16: pairs[r] minus mid plus 88 (bytes); 2T
+	const std::int32_t *pm;		  ///< 32: mid + first pixel of the first group
+	std::uint8_t *po;		  ///< 36: out + that pixel
+	const std::int32_t *end;	  ///< 40: pm + 8 * groups (groups >= 1)
+	std::int32_t thr;		  ///< 44
+	u32 any;			  ///< 48: out: the OR of the edge bits found
+};
+static_assert(offsetof(EdgeRowAsm, pm) == 32 && offsetof(EdgeRowAsm, any) == 48);
+
+extern "C" void frappe_armv6_edge_row8(EdgeRowAsm *a);
+
+/* Registers. Scan: r4 pm (after the group once loaded), r5 po, r6 end,
+ * r7 thr, r8 zero, lr any; r0-r3, r9-r12 the magnitudes. Hit: r4-r8 and
+ * lr saved; r1 up, r2 down, r3 pairs (all at pm), r10 k, r11 mask, r0 m,
+ * r12 the pair, r5 |pair| / previous, r6 next, r9 the upper half's OR.
+ * Corners: r1-r3 the pairs rows (see dq), r7 2T, r8 corner bits, r11 the
+ * edge bits left, r0 the lowest, r12 its CLZ, r4 Sxx + Syy, r5 Sxx - Syy,
+ * r6 Sxy, r9 r10 lr one row's three pairs. */
+__asm__(R"(
+	.text
+	.arm
+	.syntax unified
+	.p2align 2
+	.type frappe_armv6_edge_row8, %function
+frappe_armv6_edge_row8:
+	push    {r0, r4-r11, lr}
+	add     r1, r0, #32
+	ldm     r1, {r4, r5, r6, r7}
+	mov     r8, #0
+	mov     lr, #0
+.Lfe8_scan:
+	ldmia   r4!, {r0, r1, r2, r3, r9, r10, r11, r12}
+	orr     r0, r0, r1
+	orr     r2, r2, r3
+	orr     r9, r9, r10
+	orr     r11, r11, r12
+	orr     r0, r0, r2
+	orr     r9, r9, r11
+	orr     r1, r0, r9
+	cmp     r1, r7
+	bgt     .Lfe8_hit
+	str     r8, [r5], #4
+	str     r8, [r5], #4
+	cmp     r4, r6
+	bne     .Lfe8_scan
+.Lfe8_done:
+	ldr     r0, [sp]
+	str     lr, [r0, #48]
+	pop     {r0, r4-r11, pc}
+
+	.macro  FE8_NMS off, bit
+	ldr     r0, [r4, #\off]
+	cmp     r0, r7
+	ble     .Lfe8_n\@
+	ldr     r12, [r3, #\off]
+	ssub16  r5, r8, r12
+	sel     r5, r5, r12                 @ (|gx|, |gy|)
+	smusd   r6, r5, r10                 @ 53|gx| - 128|gy|
+	cmp     r6, #0
+	bge     .Lfe8_h\@
+	smusdx  r6, r5, r10                 @ 128|gx| - 53|gy|
+	cmp     r6, #0
+	ble     .Lfe8_v\@
+	teq     r12, r12, lsl #16           @ N: the signs of gx and gy differ
+	ldrpl   r5, [r1, #\off - 4]
+	ldrpl   r6, [r2, #\off + 4]
+	ldrmi   r5, [r1, #\off + 4]
+	ldrmi   r6, [r2, #\off - 4]
+	b       .Lfe8_c\@
+.Lfe8_h\@:
+	ldr     r5, [r4, #\off - 4]
+	ldr     r6, [r4, #\off + 4]
+	b       .Lfe8_c\@
+.Lfe8_v\@:
+	ldr     r5, [r1, #\off]
+	ldr     r6, [r2, #\off]
+.Lfe8_c\@:
+	cmp     r0, r5
+	ble     .Lfe8_n\@
+	cmp     r0, r6
+	orrge   r11, r11, #\bit
+.Lfe8_n\@:
+	.endm
+
+	.macro  FE8_ROW rp, first
+	sub     lr, \rp, r12, lsl #2
+	ldm     lr, {r9, r10, lr}
+	.if \first
+	smuad   r4, r9, r9
+	smusd   r5, r9, r9
+	smultb  r6, r9, r9
+	.else
+	smlad   r4, r9, r9, r4
+	smlsd   r5, r9, r9, r5
+	smlatb  r6, r9, r9, r6
+	.endif
+	smlad   r4, r10, r10, r4
+	smlsd   r5, r10, r10, r5
+	smlatb  r6, r10, r10, r6
+	smlad   r4, lr, lr, r4
+	smlsd   r5, lr, lr, r5
+	smlatb  r6, lr, lr, r6
+	.endm
+
+.Lfe8_hit:                                  @ r0: OR of the lower half, r9: upper
+	push    {r4-r8, lr}
+	ldr     r12, [sp, #24]
+	ldm     r12, {r1, r2, r3, r10}
+	add     r1, r1, r4
+	add     r2, r2, r4
+	add     r3, r3, r4
+	mov     r11, #0
+	cmp     r0, r7
+	ble     .Lfe8_hi
+	FE8_NMS -32, 1
+	FE8_NMS -28, 2
+	FE8_NMS -24, 4
+	FE8_NMS -20, 8
+.Lfe8_hi:
+	cmp     r9, r7
+	ble     .Lfe8_nmsdone
+	FE8_NMS -16, 16
+	FE8_NMS -12, 32
+	FE8_NMS -8, 64
+	FE8_NMS -4, 128
+.Lfe8_nmsdone:
+	cmp     r11, #0                     @ also clears V for the loop below
+	bne     .Lfe8_corners
+	pop     {r4-r8, lr}
+	str     r8, [r5], #4
+	str     r8, [r5], #4
+	cmp     r4, r6
+	bne     .Lfe8_scan
+	b       .Lfe8_done
+
+.Lfe8_corners:
+	push    {r11}
+	ldr     r12, [sp, #28]
+	add     r12, r12, #16
+	ldm     r12, {r1, r2, r3, r7}
+	add     r1, r1, r4
+	add     r2, r2, r4
+	add     r3, r3, r4
+	mov     r8, #0
+.Lfe8_cl:                                   @ V is clear here (CMP with 0 or of two values below 2^31)
+	rsb     r12, r11, #0
+	and     r0, r11, r12                @ the lowest edge bit, pixel i
+	clz     r12, r0                     @ 31 - i
+	FE8_ROW r1, 1
+	FE8_ROW r2, 0
+	FE8_ROW r3, 0
+	sub     r4, r4, r7
+	movs    r4, r4, asr #9              @ c
+	ble     .Lfe8_cn
+	cmp     r5, #0
+	rsblt   r5, r5, #0
+	asr     r5, r5, #9                  @ a
+	cmp     r6, #0
+	rsblt   r6, r6, #0
+	asr     r6, r6, #8                  @ b
+	mul     r9, r5, r5
+	mla     r9, r6, r6, r9
+	mul     r10, r4, r4
+	cmp     r10, r9
+	orrgt   r8, r8, r0
+.Lfe8_cn:
+	bics    r11, r11, r0
+	bne     .Lfe8_cl
+	pop     {r11}
+	adr     r12, .Lfe8_spread
+	and     r0, r11, #15
+	ldr     r0, [r12, r0, lsl #2]
+	lsr     r1, r11, #4
+	ldr     r1, [r12, r1, lsl #2]
+	cmp     r8, #0
+	beq     .Lfe8_out
+	and     r2, r8, #15
+	ldr     r2, [r12, r2, lsl #2]
+	add     r0, r0, r2, lsl #1
+	lsr     r2, r8, #4
+	ldr     r2, [r12, r2, lsl #2]
+	add     r1, r1, r2, lsl #1
+.Lfe8_out:
+	pop     {r4-r8, lr}
+	str     r0, [r5], #4
+	str     r1, [r5], #4
+	orr     lr, lr, r11
+	cmp     r4, r6
+	bne     .Lfe8_scan
+	b       .Lfe8_done
+	.p2align 2
+.Lfe8_spread:                               @ bit j of the index -> byte j = 1
+	.word   0x00000000, 0x00000001, 0x00000100, 0x00000101
+	.word   0x00010000, 0x00010001, 0x00010100, 0x00010101
+	.word   0x01000000, 0x01000001, 0x01000100, 0x01000101
+	.word   0x01010000, 0x01010001, 0x01010100, 0x01010101
+	.size frappe_armv6_edge_row8, .-frappe_armv6_edge_row8
+	.purgem FE8_NMS
+	.purgem FE8_ROW
+)"
+#if defined(__thumb__)
+	"\t.thumb\n"
+#endif
+);
+
 bool edgeRowV6(const GradRows &rows, int w, const FrontEndParams &params, std::uint8_t *out)
 {
 	out[0] = 0;
 	out[w - 1] = 0;
-	const EdgeRowCtx e{ rows.mag[0], rows.mag[1], rows.mag[2], { rows.gx[0], rows.gx[1], rows.gx[2] },
-			    2 * static_cast<std::int32_t>(params.corner_threshold) };
-	const std::int32_t *mid = rows.mag[1];
 	/* m >= 0 and m < 2^31: clamping the threshold keeps m > thr. */
 	const std::int32_t thr = static_cast<std::int32_t>(
 		std::clamp<std::int64_t>(params.edge_threshold_sq, -1, INT32_MAX));
-	u32 any = 0;
+	const EdgeRowCtx e{ rows.mag[0], rows.mag[1], rows.mag[2], { rows.gx[0], rows.gx[1], rows.gx[2] },
+			    2 * static_cast<std::int32_t>(params.corner_threshold) };
+	const std::int32_t *mid = rows.mag[1];
 	const int x1 = w - 1;
 	int x = 1;
+	u32 any = 0;
+	if (const int groups = (x1 - 1) / 8; groups > 0) {
+		auto bytesFromMid = [&](const void *p) {
+			return static_cast<std::int32_t>(reinterpret_cast<std::intptr_t>(p) -
+							 reinterpret_cast<std::intptr_t>(mid));
+		};
+		EdgeRowAsm a{ bytesFromMid(e.up),
+			      bytesFromMid(e.down),
+			      bytesFromMid(e.pairs[1]),
+			      53 | 128 << 16,
+			      bytesFromMid(e.pairs[0]) + 88,
+			      bytesFromMid(e.pairs[1]) + 88,
+			      bytesFromMid(e.pairs[2]) + 88,
+			      e.twoT,
+			      mid + 1,
+			      out + 1,
+			      mid + 1 + 8 * groups,
+			      thr,
+			      0 };
+		frappe_armv6_edge_row8(&a);
+		x = 1 + 8 * groups;
+		any = a.any;
+	}
 	for (; x + 4 <= x1; x += 4) {
 		/* Most pixels are far below the threshold: the OR of four
 		 * non-negative magnitudes bounds their maximum. */
