@@ -14,8 +14,9 @@
 // (Debian's libapriltag) runs too, single-threaded, at decimate 1 and 2.
 //
 // Then, unless --no-extras: throughput with two threads (front-end bands,
-// the pipelined mode, whole frames on two detectors) against one; the cost of the same frames at
-// 1280x960 against 640x480; and of a frame with 24 markers against one.
+// the pipelined mode, whole frames on two detectors) against one; the cost
+// of the same frames at 1280x960 against 640x480; and of a frame with 24
+// markers against one.
 // Not a test: speed is never asserted.
 #include <algorithm>
 #include <chrono>
