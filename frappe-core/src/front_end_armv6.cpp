@@ -247,20 +247,29 @@ void gradientRowV6(const std::uint8_t *a, const std::uint8_t *b, const std::uint
 			const std::uint8_t *pa = a, *pb = b, *pc = c;
 			const std::uint8_t *const aEnd = a + 8 * words;
 			std::uint8_t *pt = blocks;
-			__asm__ volatile(
-				"1:\n\t"
-				"ldmia   %[pa]!, {r4, r5}\n\t"     /* ea, oa */
-				"ldmia   %[pc]!, {r6, r7}\n\t"     /* ec, oc */
-				"ldmia   %[pb]!, {r8, r9}\n\t"     /* eb, ob */
-				"ssub16  r10, r6, r4\n\t"          /* dE */
-				"ssub16  r11, r7, r5\n\t"          /* dO */
-				"add     r4, r4, r6\n\t"
-				"add     r5, r5, r7\n\t"
-				"add     r8, r4, r8, lsl #1\n\t"   /* sE */
-				"add     r9, r5, r9, lsl #1\n\t"   /* sO */
+			/* Two blocks a loop; an odd count enters at the second. */
+#define FRAPPE_GRAD_COLUMNS                                                                      \
+				"ldmia   %[pa]!, {r4, r5}\n\t"     /* ea, oa */            \
+				"ldmia   %[pc]!, {r6, r7}\n\t"     /* ec, oc */            \
+				"ldmia   %[pb]!, {r8, r9}\n\t"     /* eb, ob */            \
+				"ssub16  r10, r6, r4\n\t"          /* dE */                \
+				"ssub16  r11, r7, r5\n\t"          /* dO */                \
+				"add     r4, r4, r6\n\t"                                   \
+				"add     r5, r5, r7\n\t"                                   \
+				"add     r8, r4, r8, lsl #1\n\t"   /* sE */                \
+				"add     r9, r5, r9, lsl #1\n\t"   /* sO */                \
 				"stmia   %[pt]!, {r8-r11}\n\t"
+			__asm__ volatile(
+				"sub     r4, %[end], %[pa]\n\t"
+				"tst     r4, #8\n\t"
+				"bne     3f\n"
+				"1:\n\t"
+				FRAPPE_GRAD_COLUMNS
+				"3:\n\t"
+				FRAPPE_GRAD_COLUMNS
 				"cmp     %[pa], %[end]\n\t"
 				"bne     1b"
+#undef FRAPPE_GRAD_COLUMNS
 				: [pa] "+r"(pa), [pb] "+r"(pb), [pc] "+r"(pc), [pt] "+r"(pt)
 				: [end] "r"(aEnd)
 				: "r4", "r5", "r6", "r7", "r8", "r9", "r10", "r11", "cc", "memory");
@@ -287,41 +296,55 @@ void gradientRowV6(const std::uint8_t *a, const std::uint8_t *b, const std::uint
 		std::uint8_t *m = reinterpret_cast<std::uint8_t *>(mag + 1);
 		const std::uint8_t *const ppEnd = pp + 16 * steps;
 		const std::uint8_t *pt = blocks;
+		/* Block k+1 stays in registers as the next step's block k: two
+		 * steps a loop with the register sets swapped (C, N = r4-r7,
+		 * r8-r11 and then r8-r11, r4-r7); an odd count of steps enters
+		 * at the second. */
+#define FRAPPE_GRAD_STEP(C0, C1, C2, C3, N0, N1, N2, N3, N)                                                      \
+			"ldmia   %[pt]!, {" N "}\n\t"                                      \
+			"lsr     r12, " C0 ", #16\n\t"                                     \
+			"orr     r12, r12, " N0 ", lsl #16\n\t"  /* F(sE) */              \
+			"ssub16  " C0 ", r12, " C0 "\n\t"        /* gx odd */             \
+			"lsr     r12, " C1 ", #16\n\t"                                     \
+			"orr     r12, r12, " N1 ", lsl #16\n\t"  /* F(sO) */              \
+			"ssub16  " C1 ", r12, " C1 "\n\t"        /* gx even */            \
+			"lsr     r12, " C2 ", #16\n\t"                                     \
+			"orr     r12, r12, " N2 ", lsl #16\n\t"  /* F(dE) */              \
+			"lsr     lr, " C3 ", #16\n\t"                                      \
+			"orr     lr, lr, " N3 ", lsl #16\n\t"    /* F(dO) */              \
+			"sadd16  " C2 ", " C2 ", r12\n\t"                                  \
+			"sadd16  " C2 ", " C2 ", " C3 "\n\t"                               \
+			"sadd16  " C2 ", " C2 ", " C3 "\n\t"     /* gy odd */             \
+			"sadd16  " C3 ", " C3 ", lr\n\t"                                   \
+			"sadd16  " C3 ", " C3 ", r12\n\t"                                  \
+			"sadd16  " C3 ", " C3 ", r12\n\t"        /* gy even */            \
+			"pkhtb   r12, " C2 ", " C0 ", asr #16\n\t" /* pixel 4k+3 */       \
+			"pkhtb   lr, " C3 ", " C1 ", asr #16\n\t"  /* pixel 4k+4 */       \
+			"pkhbt   " C0 ", " C0 ", " C2 ", lsl #16\n\t" /* pixel 4k+1 */    \
+			"pkhbt   " C1 ", " C1 ", " C3 ", lsl #16\n\t" /* pixel 4k+2 */    \
+			"stmia   %[pp]!, {" C0 ", " C1 ", r12, lr}\n\t"                    \
+			"smuad   " C0 ", " C0 ", " C0 "\n\t"                               \
+			"smuad   " C1 ", " C1 ", " C1 "\n\t"                               \
+			"smuad   r12, r12, r12\n\t"                                        \
+			"smuad   lr, lr, lr\n\t"                                           \
+			"stmia   %[m]!, {" C0 ", " C1 ", r12, lr}\n\t"
 		__asm__ volatile(
+			"sub     r12, %[end], %[pp]\n\t"
+			"tst     r12, #16\n\t"
+			"it      ne\n\t"
+			"ldmne   %[pt]!, {r8-r11}\n\t"
+			"bne     3f\n\t"
+			"ldmia   %[pt]!, {r4-r7}\n"
 			"1:\n\t"
-			"ldm     %[pt], {r4-r11}\n\t"            /* C: r4-r7, N: r8-r11 */
-			"add     %[pt], %[pt], #16\n\t"
-			"lsl     r8, r8, #16\n\t"
-			"orr     r8, r8, r4, lsr #16\n\t"        /* F(sE) */
-			"ssub16  r4, r8, r4\n\t"                 /* gx odd */
-			"lsl     r9, r9, #16\n\t"
-			"orr     r9, r9, r5, lsr #16\n\t"        /* F(sO) */
-			"ssub16  r5, r9, r5\n\t"                 /* gx even */
-			"lsl     r10, r10, #16\n\t"
-			"orr     r10, r10, r6, lsr #16\n\t"      /* F(dE) */
-			"lsl     r11, r11, #16\n\t"
-			"orr     r11, r11, r7, lsr #16\n\t"      /* F(dO) */
-			"sadd16  r6, r6, r10\n\t"
-			"sadd16  r6, r6, r7\n\t"
-			"sadd16  r6, r6, r7\n\t"                 /* gy odd */
-			"sadd16  r7, r7, r11\n\t"
-			"sadd16  r7, r7, r10\n\t"
-			"sadd16  r7, r7, r10\n\t"                /* gy even */
-			"pkhbt   r8, r4, r6, lsl #16\n\t"        /* pixel 4k+1 */
-			"pkhbt   r9, r5, r7, lsl #16\n\t"        /* pixel 4k+2 */
-			"pkhtb   r10, r6, r4, asr #16\n\t"       /* pixel 4k+3 */
-			"pkhtb   r11, r7, r5, asr #16\n\t"       /* pixel 4k+4 */
-			"stmia   %[pp]!, {r8-r11}\n\t"
-			"smuad   r8, r8, r8\n\t"
-			"smuad   r9, r9, r9\n\t"
-			"smuad   r10, r10, r10\n\t"
-			"smuad   r11, r11, r11\n\t"
-			"stmia   %[m]!, {r8-r11}\n\t"
+			FRAPPE_GRAD_STEP("r4", "r5", "r6", "r7", "r8", "r9", "r10", "r11", "r8-r11")
+			"3:\n\t"
+			FRAPPE_GRAD_STEP("r8", "r9", "r10", "r11", "r4", "r5", "r6", "r7", "r4-r7")
 			"cmp     %[pp], %[end]\n\t"
 			"bne     1b"
+#undef FRAPPE_GRAD_STEP
 			: [pt] "+r"(pt), [pp] "+r"(pp), [m] "+r"(m)
 			: [end] "r"(ppEnd)
-			: "r4", "r5", "r6", "r7", "r8", "r9", "r10", "r11", "cc", "memory");
+			: "r4", "r5", "r6", "r7", "r8", "r9", "r10", "r11", "r12", "lr", "cc", "memory");
 		x = 1 + 4 * steps;
 	}
 	for (; x < w - 1; ++x)
