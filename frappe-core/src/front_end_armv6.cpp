@@ -127,7 +127,9 @@ inline u32 gradientPair(const std::uint8_t *a, const std::uint8_t *b, const std:
 	return static_cast<std::uint16_t>(sx) | static_cast<u32>(static_cast<std::uint16_t>(sy)) << 16;
 }
 
-void smoothRowV6(const std::uint8_t *a, const std::uint8_t *b, const std::uint8_t *c, int w,
+/* The loops below name r4-r11 (and need 14 registers): no frame pointer,
+ * also in a -O0 build. */
+__attribute__((optimize("omit-frame-pointer"))) void smoothRowV6(const std::uint8_t *a, const std::uint8_t *b, const std::uint8_t *c, int w,
 		 std::uint8_t *out, std::uint16_t *tmp)
 {
 	if (w < 16) {
@@ -160,48 +162,56 @@ void smoothRowV6(const std::uint8_t *a, const std::uint8_t *b, const std::uint8_
 	int k = 0;
 	if (words >= 2) {
 		/* Two words a step, written out (GCC spills and reloads its
-		 * constants): 24 instructions per four pixels. The results are
+		 * constants): 21 instructions per four pixels. The results are
 		 * bits 4..11 of the lanes of sE (even pixels) and sO (odd ones),
-		 * stored as they are (see putSmoothed). */
+		 * stored as they are (see putSmoothed):
+		 *   sE = O + 2E + (Oprev >> 16) + (O << 16),
+		 *   sO = E + 2O + (E >> 16) + (En << 16),
+		 * plain adds, as no lane carries into the next. The previous
+		 * word's E, O stay in the registers the next word's are loaded
+		 * into, so sE comes first. */
 		const std::uint8_t *pa = a, *pb = b, *pc = c;
 		std::uint8_t *po = out;
 		const std::uint8_t *const oEnd = out + 16 * (words / 2);
-		u32 En, On, t0, t1;
+		register u32 rE __asm__("r4") = E;
+		register u32 rO __asm__("r5") = O;
+		register u32 rOprev __asm__("r7") = prevHi << 16;
+		register u32 rOne __asm__("r11") = kOne;
 		__asm__ volatile(
 			"1:\n\t"
 #define FRAPPE_SMOOTH_WORD(E, O, EN, ON)                                                          \
-			"ldr     %[t0], [%[pa], #4]!\n\t"                                         \
-			"ldr     %[t1], [%[pc], #4]!\n\t"                                         \
-			"uxtb16  %[" EN "], %[t0]\n\t"                                            \
-			"uxtab16 %[" EN "], %[" EN "], %[t1]\n\t"                                 \
-			"uxtb16  %[" ON "], %[t0], ror #8\n\t"                                    \
-			"uxtab16 %[" ON "], %[" ON "], %[t1], ror #8\n\t"                         \
-			"ldr     %[t0], [%[pb], #4]!\n\t"                                         \
-			"uxtab16 %[t1], %[one], %[t0]\n\t"                                        \
-			"add     %[" EN "], %[" EN "], %[t1], lsl #1\n\t"                         \
-			"uxtab16 %[t1], %[one], %[t0], ror #8\n\t"                                \
-			"add     %[" ON "], %[" ON "], %[t1], lsl #1\n\t"                         \
-			"orr     %[t0], %[P], %[" O "], lsl #16\n\t"                              \
-			"add     %[t0], %[t0], %[" O "]\n\t"                                      \
-			"add     %[t0], %[t0], %[" E "], lsl #1\n\t"    /* sE */                  \
-			"mov     %[t1], %[" E "], lsr #16\n\t"                                    \
-			"orr     %[t1], %[t1], %[" EN "], lsl #16\n\t"                            \
-			"add     %[t1], %[t1], %[" E "]\n\t"                                      \
-			"add     %[t1], %[t1], %[" O "], lsl #1\n\t"    /* sO */                  \
-			"and     %[t0], %[mask], %[t0], lsr #4\n\t"                              \
-			"and     %[t1], %[mask], %[t1], lsr #4\n\t"                              \
-			"str     %[t0], [%[po]], #8\n\t"                                          \
-			"str     %[t1], [%[po], #-4]\n\t"                                         \
-			"mov     %[P], %[" O "], lsr #16\n\t"
-			FRAPPE_SMOOTH_WORD("E", "O", "En", "On")
-			FRAPPE_SMOOTH_WORD("En", "On", "E", "O")
+			"add     r8, " O ", " E ", lsl #1\n\t"                                  \
+			"add     r8, r8, " O ", lsl #16\n\t"                                    \
+			"add     r8, r8, " ON ", lsr #16\n\t"        /* sE */                   \
+			"ldr     r9, [%[pa], #4]!\n\t"                                          \
+			"ldr     r10, [%[pc], #4]!\n\t"                                         \
+			"uxtb16  " EN ", r9\n\t"                                                \
+			"uxtab16 " EN ", " EN ", r10\n\t"                                       \
+			"uxtb16  " ON ", r9, ror #8\n\t"                                        \
+			"uxtab16 " ON ", " ON ", r10, ror #8\n\t"                               \
+			"ldr     r9, [%[pb], #4]!\n\t"                                          \
+			"uxtab16 r10, r11, r9\n\t"                                              \
+			"add     " EN ", " EN ", r10, lsl #1\n\t"                               \
+			"uxtab16 r10, r11, r9, ror #8\n\t"                                      \
+			"add     " ON ", " ON ", r10, lsl #1\n\t"                               \
+			"add     r9, " E ", " O ", lsl #1\n\t"                                  \
+			"add     r9, r9, " E ", lsr #16\n\t"                                    \
+			"add     r9, r9, " EN ", lsl #16\n\t"        /* sO */                   \
+			"and     r8, %[mask], r8, lsr #4\n\t"                                   \
+			"and     r9, %[mask], r9, lsr #4\n\t"                                   \
+			"stmia   %[po]!, {r8, r9}\n\t"
+			FRAPPE_SMOOTH_WORD("r4", "r5", "r6", "r7")
+			FRAPPE_SMOOTH_WORD("r6", "r7", "r4", "r5")
 #undef FRAPPE_SMOOTH_WORD
 			"cmp     %[po], %[end]\n\t"
 			"bne     1b"
-			: [pa] "+r"(pa), [pb] "+r"(pb), [pc] "+r"(pc), [po] "+r"(po), [E] "+r"(E), [O] "+r"(O),
-			  [P] "+r"(prevHi), [En] "=&r"(En), [On] "=&r"(On), [t0] "=&r"(t0), [t1] "=&r"(t1)
-			: [one] "r"(kOne), [mask] "r"(kMask), [end] "r"(oEnd)
-			: "cc", "memory");
+			: [pa] "+r"(pa), [pb] "+r"(pb), [pc] "+r"(pc), [po] "+r"(po), "+r"(rE), "+r"(rO),
+			  "+r"(rOprev)
+			: "r"(rOne), [mask] "r"(kMask), [end] "r"(oEnd)
+			: "r6", "r8", "r9", "r10", "cc", "memory");
+		E = rE;
+		O = rO;
+		prevHi = rOprev >> 16;
 		k = 2 * (words / 2);
 	}
 	for (; k < words; ++k) {
@@ -222,7 +232,7 @@ void smoothRowV6(const std::uint8_t *a, const std::uint8_t *b, const std::uint8_
 		putSmoothed(out, x, static_cast<std::uint8_t>((t(x - 1) + 2 * t(x) + t(x + 1) + 8) >> 4));
 }
 
-void gradientRowV6(const std::uint8_t *a, const std::uint8_t *b, const std::uint8_t *c, int w,
+__attribute__((optimize("omit-frame-pointer"))) void gradientRowV6(const std::uint8_t *a, const std::uint8_t *b, const std::uint8_t *c, int w,
 		   std::int16_t *gx, std::int16_t * /* gy: the pairs hold it */, std::int32_t *mag,
 		   std::int16_t *tmp, TensorRow /* the corner test sums on demand */)
 {
