@@ -1,9 +1,9 @@
 // SPDX-License-Identifier: MIT
 // Two threads over a stream. Stages: each call runs the front end of the new
 // frame and the finish (refine, warp, decode) of the oldest on the worker,
-// while the caller traces the frame in between. Frames: odd frames go whole
-// to a second detector on the worker, which runs on after push() returns;
-// even frames run on the caller while the worker finishes the odd one before.
+// while the caller traces the frame in between. Frames: whole frames, each
+// to a second detector on the worker when it is free (it runs on after
+// push() returns), else to the caller's.
 #include "frappe/pipeline.h"
 
 #include <exception>
@@ -21,8 +21,8 @@ struct Pipeline::Impl {
 	}
 	~Impl()
 	{
-		/* The worker may still be on an odd frame, with `second`. */
-		if (workerBusy)
+		/* The worker may still be on a frame, with `second`. */
+		if (onWorker)
 			worker.wait();
 	}
 
@@ -36,28 +36,42 @@ struct Pipeline::Impl {
 	Detector detector;
 	detail::Worker worker;
 
-	/* Mode::Frames: the odd frames' detector and the worker's round; the
-	 * caller's last result not yet returned; frames pushed. */
+	/* Mode::Frames: up to three frames in flight in a ring, oldest at
+	 * `head`. A new frame goes to the worker's detector when the worker is
+	 * free, else it runs here on `detector`; so a slow frame on one side is
+	 * made up by the other taking the next ones. Results are copied into
+	 * the frame's own Result (its vectors keep their capacity), and the
+	 * returned one is swapped out to `returned`. */
 	std::unique_ptr<Detector> second;
+	struct InFlight {
+		ImageView image;
+		Result result;
+		bool done = false;
+	};
+	static constexpr int kInFlight = 3;
+	InFlight ring[kInFlight];
+	int head = 0, inFlight = 0;
+	InFlight *onWorker = nullptr;
+	Result returned;
 	struct WholeFrame {
 		Impl *self;
-		ImageView image;
-		const Result *result = nullptr;
 		void operator()()
 		{
+			InFlight &f = *self->onWorker;
 			try {
-				result = &self->second->detect(image);
+				f.result = self->second->detect(f.image);
 			} catch (...) {
+				f.result = Result{};
 				self->failure = std::current_exception();
 			}
 		}
-	} whole{ this, {} };
-	bool workerBusy = false;
-	const Result *held = nullptr;
-	long pushed = 0;
+	} whole{ this };
 	const Result *pushFrames(const ImageView &image);
-	const Result *waitWorker();
-	/* Frames in flight, oldest first; at most one traced and one not. */
+	const Result *popFrames();
+	void collectWorker();
+
+	/* Mode::Stages: frames in flight, oldest first; at most one traced and
+	 * one not. */
 	Frame frames[Detector::kSlots];
 	int count = 0;
 
@@ -106,40 +120,54 @@ Pipeline::Pipeline(const Config &config, Mode mode) : impl_(std::make_unique<Imp
 
 Pipeline::~Pipeline() = default;
 
-const Result *Pipeline::Impl::waitWorker()
+/* Waits for the worker's frame, if any, and marks it done. */
+void Pipeline::Impl::collectWorker()
 {
+	if (!onWorker)
+		return;
 	worker.wait();
-	workerBusy = false;
-	if (failure)
+	onWorker->done = true;
+	onWorker = nullptr;
+	if (failure) /* that frame comes out with no markers */
 		std::rethrow_exception(std::exchange(failure, nullptr));
-	return whole.result;
+}
+
+/* The oldest frame's result, waiting for it when the worker has it. */
+const Result *Pipeline::Impl::popFrames()
+{
+	if (inFlight == 0)
+		return nullptr;
+	InFlight &oldest = ring[head];
+	if (!oldest.done)
+		collectWorker();
+	std::swap(returned, oldest.result);
+	oldest.done = false;
+	head = (head + 1) % kInFlight;
+	--inFlight;
+	return &returned;
 }
 
 const Result *Pipeline::Impl::pushFrames(const ImageView &image)
 {
-	if (pushed++ % 2 == 1) {
-		/* Odd: to the worker, which runs on after we return the even
-		 * frame before it. */
-		whole.image = image;
+	if (onWorker && worker.finished())
+		collectWorker();
+	InFlight &fresh = ring[(head + inFlight) % kInFlight];
+	fresh.image = image;
+	fresh.done = false;
+	++inFlight;
+	if (!onWorker) {
+		onWorker = &fresh;
 		worker.post(whole);
-		workerBusy = true;
-		return std::exchange(held, nullptr);
+	} else {
+		try {
+			fresh.result = detector.detect(image);
+		} catch (...) { /* out of memory: this frame is lost, not the others */
+			--inFlight;
+			throw;
+		}
+		fresh.done = true;
 	}
-	/* Even: here, while the worker finishes the odd frame before. */
-	const Result *mine = nullptr;
-	std::exception_ptr mineFailed;
-	try {
-		mine = &detector.detect(image);
-	} catch (...) {
-		mineFailed = std::current_exception();
-	}
-	if (mineFailed) { /* out of memory: this frame is lost, not the one before */
-		if (workerBusy)
-			held = waitWorker();
-		std::rethrow_exception(mineFailed);
-	}
-	held = mine;
-	return workerBusy ? waitWorker() : nullptr;
+	return inFlight > 2 ? popFrames() : nullptr;
 }
 
 const Result *Pipeline::push(const ImageView &image)
@@ -180,11 +208,8 @@ const Result *Pipeline::push(const ImageView &image)
 const Result *Pipeline::flush()
 {
 	Impl &d = *impl_;
-	if (d.mode == Mode::Frames) {
-		if (d.held)
-			return std::exchange(d.held, nullptr);
-		return d.workerBusy ? d.waitWorker() : nullptr;
-	}
+	if (d.mode == Mode::Frames)
+		return d.popFrames();
 	if (d.count == 0)
 		return nullptr;
 	const Impl::Frame oldest = d.frames[0];
@@ -196,10 +221,10 @@ const Result *Pipeline::flush()
 
 bool Pipeline::pending() const
 {
-	return impl_->mode == Mode::Frames ? impl_->held || impl_->workerBusy : impl_->count > 0;
+	return impl_->mode == Mode::Frames ? impl_->inFlight > 0 : impl_->count > 0;
 }
 
-int Pipeline::latency() const { return impl_->mode == Mode::Frames ? 1 : 2; }
+int Pipeline::latency() const { return 2; }
 Detector &Pipeline::detector() { return impl_->detector; }
 
 } // namespace frappe

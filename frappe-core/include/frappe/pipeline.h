@@ -20,12 +20,13 @@ namespace frappe {
 /// AScale mode a frame's scale comes from the last frame finished before its
 /// front end started (three frames earlier).
 ///
-/// Mode::Frames: whole frames on two detectors, the even ones on the
-/// calling thread, the odd ones on a worker that runs on while the caller
-/// returns. Results come out one frame late. Throughput approaches twice a
-/// detector's whatever the balance of the stages, for twice the memory. In
-/// AScale mode each detector scales from its own previous frame (two frames
-/// earlier).
+/// Mode::Frames: whole frames on two detectors: a new frame goes to a
+/// worker thread's detector when that is free (it runs on after push()
+/// returns), else it runs on the calling thread's. Results come out two
+/// frames late. Throughput approaches twice a detector's whatever the
+/// balance of the stages, and a slow frame on one thread is made up by the
+/// other taking the next ones; twice the memory. In AScale mode each
+/// detector scales from the last frame it ran.
 class Pipeline {
 public:
 	enum class Mode { Stages, Frames };
@@ -51,7 +52,7 @@ public:
 	/// Whether frames are in flight (pushed, results not yet returned).
 	bool pending() const;
 
-	/// Frames between a push and its result: 2 for Stages, 1 for Frames.
+	/// Frames between a push and its result (2).
 	int latency() const;
 
 	/// The detector of the calling thread (Mode::Frames has a second one,
