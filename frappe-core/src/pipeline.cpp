@@ -1,29 +1,183 @@
 // SPDX-License-Identifier: MIT
 // Two threads over a stream. Stages: each call runs the front end of the new
 // frame and the finish (refine, warp, decode) of the oldest on the worker,
-// while the caller traces the frame in between. Frames: whole frames, each
-// to a second detector on the worker when it is free (it runs on after
-// push() returns), else to the caller's.
+// while the caller traces the frame in between. Frames: whole frames from a
+// queue, taken by a worker with its own detector as soon as it is free, and
+// by the caller only when it must return a frame that nobody has started.
 #include "frappe/pipeline.h"
 
+#include <condition_variable>
 #include <exception>
+#include <mutex>
 #include <utility>
 
 #include "worker.h"
 
 namespace frappe {
 
+namespace detail {
+
+/// Mode::Frames. Frames wait in a ring; the worker drains it with its own
+/// detector and runs on after push() returns; the caller runs a frame only
+/// when the result it must return belongs to a frame nobody has started.
+/// Results come out kLatency frames late, in order; each frame's Result is
+/// copied into the ring (its vectors keep their capacity, so nothing is
+/// allocated once warm) and swapped out to `returned_`.
+class FrameQueue
+{
+public:
+	static constexpr int kLatency = 2;
+
+	FrameQueue(const Config &config, Detector &mine, Worker &worker)
+		: mine_(mine), theirs_(config), worker_(worker)
+	{
+	}
+	~FrameQueue()
+	{
+		{
+			std::lock_guard<std::mutex> guard(lock_);
+			stopping_ = true; /* the worker takes no new frame */
+		}
+		worker_.wait(); /* returns at once when nothing was posted */
+	}
+
+	const Result *push(const ImageView &image)
+	{
+		bool start = false;
+		{
+			std::lock_guard<std::mutex> guard(lock_);
+			Entry &e = ring_[(head_ + count_) % kRing];
+			e.image = image;
+			e.state = State::Waiting;
+			++count_;
+			if (!draining_) {
+				draining_ = true;
+				start = true;
+			}
+		}
+		if (start) {
+			worker_.wait(); /* its last drain has returned or is returning */
+			worker_.post(drain_);
+		}
+		return count_ > kLatency ? pop(kLatency) : nullptr;
+	}
+
+	/* The oldest frame's result once more than `keep` frames are in
+	 * flight; runs waiting frames here rather than wait idle. */
+	const Result *pop(int keep)
+	{
+		std::unique_lock<std::mutex> guard(lock_);
+		if (count_ <= keep)
+			return nullptr;
+		Entry &oldest = ring_[head_];
+		while (oldest.state != State::Done) {
+			Entry *next = nextWaiting();
+			if (!next) {
+				done_.wait(guard, [&] { return oldest.state == State::Done; });
+				break;
+			}
+			next->state = State::Running;
+			guard.unlock();
+			run(mine_, *next);
+			guard.lock();
+		}
+		std::swap(returned_, oldest.result);
+		head_ = (head_ + 1) % kRing;
+		--count_;
+		if (failure_)
+			std::rethrow_exception(std::exchange(failure_, nullptr));
+		return &returned_;
+	}
+
+	bool pending() const
+	{
+		std::lock_guard<std::mutex> guard(lock_);
+		return count_ > 0;
+	}
+
+private:
+	enum class State { Waiting, Running, Done };
+	struct Entry {
+		ImageView image;
+		Result result;
+		State state = State::Done;
+	};
+	static constexpr int kRing = kLatency + 1;
+
+	/* The oldest frame nobody has started; lock held. */
+	Entry *nextWaiting()
+	{
+		for (int i = 0; i < count_; ++i) {
+			Entry &e = ring_[(head_ + i) % kRing];
+			if (e.state == State::Waiting)
+				return &e;
+		}
+		return nullptr;
+	}
+
+	/* Runs one frame, lock not held; a frame that fails (out of memory)
+	 * comes out with no markers and the error is thrown by the pop. */
+	void run(Detector &detector, Entry &e)
+	{
+		std::exception_ptr failed;
+		try {
+			e.result = detector.detect(e.image);
+		} catch (...) {
+			failed = std::current_exception();
+		}
+		std::lock_guard<std::mutex> guard(lock_);
+		if (failed) {
+			e.result.markers.clear();
+			failure_ = failed;
+		}
+		e.state = State::Done;
+		done_.notify_all();
+	}
+
+	/* The worker's task: frames until none waits. */
+	struct Drain {
+		FrameQueue *q;
+		void operator()() const
+		{
+			std::unique_lock<std::mutex> guard(q->lock_);
+			for (;;) {
+				Entry *e = q->stopping_ ? nullptr : q->nextWaiting();
+				if (!e) {
+					q->draining_ = false;
+					return;
+				}
+				e->state = State::Running;
+				guard.unlock();
+				q->run(q->theirs_, *e);
+				guard.lock();
+			}
+		}
+	} drain_{ this };
+
+	Detector &mine_;
+	Detector theirs_;
+	Worker &worker_;
+	mutable std::mutex lock_;
+	std::condition_variable done_;
+	Entry ring_[kRing];
+	int head_ = 0, count_ = 0;
+	bool draining_ = false, stopping_ = false;
+	std::exception_ptr failure_;
+	Result returned_;
+};
+
+} // namespace detail
+
 struct Pipeline::Impl {
 	Impl(const Config &config, Mode m) : mode(m), detector(config)
 	{
 		if (mode == Mode::Frames)
-			second = std::make_unique<Detector>(config);
+			frameQueue = std::make_unique<detail::FrameQueue>(config, detector, worker);
 	}
 	~Impl()
 	{
-		/* The worker may still be on a frame, with `second`. */
-		if (onWorker)
-			worker.wait();
+		/* Before the worker and the detectors it uses go. */
+		frameQueue.reset();
 	}
 
 	struct Frame {
@@ -36,39 +190,8 @@ struct Pipeline::Impl {
 	Detector detector;
 	detail::Worker worker;
 
-	/* Mode::Frames: up to three frames in flight in a ring, oldest at
-	 * `head`. A new frame goes to the worker's detector when the worker is
-	 * free, else it runs here on `detector`; so a slow frame on one side is
-	 * made up by the other taking the next ones. Results are copied into
-	 * the frame's own Result (its vectors keep their capacity), and the
-	 * returned one is swapped out to `returned`. */
-	std::unique_ptr<Detector> second;
-	struct InFlight {
-		ImageView image;
-		Result result;
-		bool done = false;
-	};
-	static constexpr int kInFlight = 3;
-	InFlight ring[kInFlight];
-	int head = 0, inFlight = 0;
-	InFlight *onWorker = nullptr;
-	Result returned;
-	struct WholeFrame {
-		Impl *self;
-		void operator()()
-		{
-			InFlight &f = *self->onWorker;
-			try {
-				f.result = self->second->detect(f.image);
-			} catch (...) {
-				f.result = Result{};
-				self->failure = std::current_exception();
-			}
-		}
-	} whole{ this };
-	const Result *pushFrames(const ImageView &image);
-	const Result *popFrames();
-	void collectWorker();
+	/* Mode::Frames */
+	std::unique_ptr<detail::FrameQueue> frameQueue;
 
 	/* Mode::Stages: frames in flight, oldest first; at most one traced and
 	 * one not. */
@@ -120,62 +243,12 @@ Pipeline::Pipeline(const Config &config, Mode mode) : impl_(std::make_unique<Imp
 
 Pipeline::~Pipeline() = default;
 
-/* Waits for the worker's frame, if any, and marks it done. */
-void Pipeline::Impl::collectWorker()
-{
-	if (!onWorker)
-		return;
-	worker.wait();
-	onWorker->done = true;
-	onWorker = nullptr;
-	if (failure) /* that frame comes out with no markers */
-		std::rethrow_exception(std::exchange(failure, nullptr));
-}
-
-/* The oldest frame's result, waiting for it when the worker has it. */
-const Result *Pipeline::Impl::popFrames()
-{
-	if (inFlight == 0)
-		return nullptr;
-	InFlight &oldest = ring[head];
-	if (!oldest.done)
-		collectWorker();
-	std::swap(returned, oldest.result);
-	oldest.done = false;
-	head = (head + 1) % kInFlight;
-	--inFlight;
-	return &returned;
-}
-
-const Result *Pipeline::Impl::pushFrames(const ImageView &image)
-{
-	if (onWorker && worker.finished())
-		collectWorker();
-	InFlight &fresh = ring[(head + inFlight) % kInFlight];
-	fresh.image = image;
-	fresh.done = false;
-	++inFlight;
-	if (!onWorker) {
-		onWorker = &fresh;
-		worker.post(whole);
-	} else {
-		try {
-			fresh.result = detector.detect(image);
-		} catch (...) { /* out of memory: this frame is lost, not the others */
-			--inFlight;
-			throw;
-		}
-		fresh.done = true;
-	}
-	return inFlight > 2 ? popFrames() : nullptr;
-}
-
 const Result *Pipeline::push(const ImageView &image)
 {
 	Impl &d = *impl_;
 	d.detector.checkImage(image);
-	if (d.mode == Mode::Frames)
-		return d.pushFrames(image);
+	if (d.frameQueue)
+		return d.frameQueue->push(image);
 
 	d.frames[d.count] = { image, d.freeSlot(), false };
 	Impl::Frame &fresh = d.frames[d.count];
@@ -208,8 +281,8 @@ const Result *Pipeline::push(const ImageView &image)
 const Result *Pipeline::flush()
 {
 	Impl &d = *impl_;
-	if (d.mode == Mode::Frames)
-		return d.popFrames();
+	if (d.frameQueue)
+		return d.frameQueue->pop(0);
 	if (d.count == 0)
 		return nullptr;
 	const Impl::Frame oldest = d.frames[0];
@@ -221,10 +294,10 @@ const Result *Pipeline::flush()
 
 bool Pipeline::pending() const
 {
-	return impl_->mode == Mode::Frames ? impl_->inFlight > 0 : impl_->count > 0;
+	return impl_->frameQueue ? impl_->frameQueue->pending() : impl_->count > 0;
 }
 
-int Pipeline::latency() const { return 2; }
+int Pipeline::latency() const { return impl_->frameQueue ? detail::FrameQueue::kLatency : 2; }
 Detector &Pipeline::detector() { return impl_->detector; }
 
 } // namespace frappe

@@ -43,8 +43,6 @@ public:
 	void post(TaskRef task);
 	/// Blocks until the posted task has finished.
 	void wait();
-	/// Whether the posted task has finished (wait() would return at once).
-	bool finished() const { return !busyFlag_.load(std::memory_order_acquire); }
 
 private:
 	void loop();
