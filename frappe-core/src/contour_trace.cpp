@@ -302,29 +302,49 @@ void ContourTracer::trace(const EdgeMap &edges, const TraceParams &params, std::
 
 namespace {
 
-/* Where the line `along` = v (y = v when byRows, else x = v) crosses the
- * convex quad: false when it misses it. */
-bool quadSpan(const std::array<Point2f, 4> &q, float v, bool byRows, float &lo, float &hi)
+/* Where the lines y = v (byRows) or x = v cross a convex quad: its four
+ * sides as u = u0 + slope (v - v0) over [vLo, vHi], slopes computed once. */
+class QuadSpans
 {
-	lo = 1e30f;
-	hi = -1e30f;
-	for (int i = 0; i < 4; ++i) {
-		const float au = byRows ? q[i].x : q[i].y, av = byRows ? q[i].y : q[i].x;
-		const Point2f &n = q[(i + 1) & 3];
-		const float bu = byRows ? n.x : n.y, bv = byRows ? n.y : n.x;
-		if ((v < av && v < bv) || (v > av && v > bv))
-			continue;
-		if (av == bv) {
-			lo = std::min(lo, std::min(au, bu));
-			hi = std::max(hi, std::max(au, bu));
-		} else {
-			const float u = au + (bu - au) * (v - av) / (bv - av);
-			lo = std::min(lo, u);
-			hi = std::max(hi, u);
+public:
+	QuadSpans(const std::array<Point2f, 4> &q, bool byRows)
+	{
+		for (int i = 0; i < 4; ++i) {
+			const Point2f &a = q[i], &b = q[(i + 1) & 3];
+			const float au = byRows ? a.x : a.y, av = byRows ? a.y : a.x;
+			const float bu = byRows ? b.x : b.y, bv = byRows ? b.y : b.x;
+			Side &s = sides_[i];
+			s.vLo = std::min(av, bv);
+			s.vHi = std::max(av, bv);
+			s.flat = av == bv;
+			s.u0 = s.flat ? std::min(au, bu) : au;
+			s.u1 = std::max(au, bu);
+			s.v0 = av;
+			s.slope = s.flat ? 0.0f : (bu - au) / (bv - av);
 		}
 	}
-	return lo <= hi;
-}
+	/* False when the line misses the quad. */
+	bool span(float v, float &lo, float &hi) const
+	{
+		lo = 1e30f;
+		hi = -1e30f;
+		for (const Side &s : sides_) {
+			if (v < s.vLo || v > s.vHi)
+				continue;
+			const float u = s.flat ? s.u0 : s.u0 + s.slope * (v - s.v0);
+			lo = std::min(lo, u);
+			hi = std::max(hi, s.flat ? s.u1 : u);
+		}
+		return lo <= hi;
+	}
+
+private:
+	struct Side {
+		float vLo, vHi, u0, u1, v0, slope;
+		bool flat;
+	};
+	std::array<Side, 4> sides_;
+};
 
 } // namespace
 
@@ -362,8 +382,9 @@ void ContourTracer::sealInside(const Quad &quad, int w, int h)
 		}
 	};
 	float lo, hi;
+	const QuadSpans rows(q, true), columns(q, false);
 	for (int y = std::max(1, static_cast<int>(std::ceil(minY))); y <= std::min(h - 2, static_cast<int>(maxY)); ++y) {
-		if (!quadSpan(q, static_cast<float>(y), true, lo, hi))
+		if (!rows.span(static_cast<float>(y), lo, hi))
 			continue;
 		const int x0 = std::max(1, static_cast<int>(std::ceil(lo)));
 		const int x1 = std::min(w - 2, static_cast<int>(std::floor(hi)));
@@ -375,7 +396,7 @@ void ContourTracer::sealInside(const Quad &quad, int w, int h)
 		reach(row + x1, 1, w - 2 - x1);
 	}
 	for (int x = std::max(1, static_cast<int>(std::ceil(minX))); x <= std::min(w - 2, static_cast<int>(maxX)); ++x) {
-		if (!quadSpan(q, static_cast<float>(x), false, lo, hi))
+		if (!columns.span(static_cast<float>(x), lo, hi))
 			continue;
 		const int y0 = std::max(1, static_cast<int>(std::ceil(lo)));
 		const int y1 = std::min(h - 2, static_cast<int>(std::floor(hi)));
@@ -659,8 +680,9 @@ bool ContourTracer::acceptQuad(const TraceParams &params, int w, int h, Quad &qu
 	const float shortSide = std::sqrt(shortest);
 	const float tol = std::max(1.5f, 0.06f * shortSide);
 	/* A bin is 1/16 of a side: on long sides every point is not needed to
-	 * cover one. Steps of at most a third of the shortest bin. */
-	const std::size_t stride = std::max(1, static_cast<int>(shortSide / (3.0f * kBins)));
+	 * cover one. A border step is at most sqrt(2) px, so every L/24-th point
+	 * is at most L/17 apart: still one in every bin the border runs along. */
+	const std::size_t stride = std::max(1, static_cast<int>(shortSide / (1.5f * kBins)));
 	std::uint32_t covered[4] = {};
 	const std::size_t n = static_cast<std::size_t>(steps_);
 	for (std::size_t k = 0; k < n; k += stride) {
