@@ -448,7 +448,7 @@ int main(int argc, char **argv)
 	std::printf("\n");
 
 	if (extras) {
-		reportThroughput(cfg, images, std::max(1, repeat / 2));
+		reportThroughput(cfg, images, std::max(2, repeat));
 		frappe::Config single = cfg;
 		single.threads = 1;
 		frappe::Detector scalingDet(single);
