@@ -106,8 +106,8 @@ bool surroundsDecoded(const std::array<Point2f, 4> &q, float area, const std::ve
 class TracedMarkerProbe final : public detail::MarkerProbe
 {
 public:
-	TracedMarkerProbe(const ImageView &image, float scale, const Dictionary &dict, int maxHamming)
-		: image_(image), scale_(scale), dict_(dict), maxHamming_(maxHamming)
+	TracedMarkerProbe(const ImageView &image, float scale, const Dictionary &dict)
+		: image_(image), scale_(scale), dict_(dict)
 	{
 	}
 	bool isMarker(const detail::Quad &quad) override
@@ -146,7 +146,11 @@ public:
 				else
 					code = (code << 1) | (white ? 1u : 0u);
 			}
-		return borderErrors <= allowedBorderErrors(bits) && detail::decode(dict_, code, maxHamming_).id >= 0;
+		/* Only an exact codeword: a wrong "yes" would hide whatever lies
+		 * inside the quad (markers on a dark panel, say), and with a small
+		 * dictionary and a generous max_hamming a third of all bit patterns
+		 * are within reach of some codeword. */
+		return borderErrors <= allowedBorderErrors(bits) && detail::decode(dict_, code, 0).id >= 0;
 	}
 
 private:
@@ -154,7 +158,6 @@ private:
 	const ImageView &image_;
 	float scale_;
 	const Dictionary &dict_;
-	int maxHamming_;
 };
 
 /* Largest image side accepted: contour coordinates are ints and buffers are
@@ -253,7 +256,7 @@ void Detector::Impl::trace(Slot &slot)
 	tp.cluster_radius = config.corner_cluster_radius;
 	tp.min_side = std::max(4.0f, config.min_marker_side * scale);
 	tp.border_margin = 1.0f;
-	TracedMarkerProbe probe(slot.image, scale, *dict, maxHamming);
+	TracedMarkerProbe probe(slot.image, scale, *dict);
 	tracer.trace(edges, tp, quads, &probe);
 	detail::removeDuplicateQuads(quads, 2.5f);
 	/* Smallest first: a marker's own outline decodes before the outline of

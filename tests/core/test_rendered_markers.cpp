@@ -199,3 +199,56 @@ TEST(RenderedMarkers, BoardWithOneCellGaps)
 		EXPECT_LT(meanCornerError(m->corners, q), 0.1f) << "id " << id;
 	}
 }
+
+/* The tracer skips the inside of a quad only when its traced outline reads
+ * as an exact codeword. A dark panel whose cells read one bit away from a
+ * codeword is decoded (max_hamming 2 allows it), but a small marker lying in
+ * one of its white cells must still be found: with the skip allowed on any
+ * decodable read, it was hidden. */
+TEST(RenderedMarkers, MarkerInsideANearCodewordPanelIsFound)
+{
+	const Dictionary &dict = *findDictionary("4x4_50");
+	Config config;
+	config.dictionary = "4x4_50";
+	config.max_hamming = 2;
+	Detector det(config);
+	Image img(640, 480, 200);
+	/* The panel: marker 0 drawn as 6 x 6 cells of 70 px, then one code cell
+	 * flipped. */
+	constexpr int kCell = 70, x0 = 110, y0 = 30;
+	const std::array<Point2f, 4> panel = { Point2f{ x0, y0 }, Point2f{ x0 + 6 * kCell, y0 },
+					       Point2f{ x0 + 6 * kCell, y0 + 6 * kCell }, Point2f{ x0, y0 + 6 * kCell } };
+	RenderOptions quiet;
+	renderMarker(img.mut(), dict, 0, panel, quiet);
+	auto cellIsWhite = [&](int cx, int cy) { return img.at(x0 + cx * kCell + kCell / 2, y0 + cy * kCell + kCell / 2) > 128; };
+	auto fillCell = [&](int cx, int cy, std::uint8_t v) {
+		for (int y = 0; y < kCell; ++y)
+			for (int x = 0; x < kCell; ++x)
+				img.at(x0 + cx * kCell + x, y0 + cy * kCell + y) = v;
+	};
+	/* A white code cell to hold the small marker, another cell to flip. */
+	int hx = -1, hy = -1;
+	for (int cy = 1; cy <= 4 && hx < 0; ++cy)
+		for (int cx = 1; cx <= 4 && hx < 0; ++cx)
+			if (cellIsWhite(cx, cy)) {
+				hx = cx;
+				hy = cy;
+			}
+	ASSERT_GE(hx, 1);
+	const int fx = hx == 4 ? 3 : hx + 1, fy = hy;
+	fillCell(fx, fy, cellIsWhite(fx, fy) ? 0 : 255);
+	/* The small marker in the holder cell's corner, clear of its centre,
+	 * where the panel's cell is sampled. */
+	const float sx = static_cast<float>(x0 + hx * kCell + 8), sy = static_cast<float>(y0 + hy * kCell + 8);
+	const std::array<Point2f, 4> small = { Point2f{ sx, sy }, Point2f{ sx + 24, sy }, Point2f{ sx + 24, sy + 24 },
+					       Point2f{ sx, sy + 24 } };
+	renderMarker(img.mut(), dict, 7, small, quiet);
+
+	const Result &res = det.detect(img.view());
+	const Marker *p = findMarker(res.markers, 0);
+	ASSERT_NE(p, nullptr) << "the panel itself decodes, one bit away";
+	EXPECT_EQ(p->hamming, 1);
+	const Marker *m = findMarker(res.markers, 7);
+	ASSERT_NE(m, nullptr) << "the marker inside the panel";
+	EXPECT_LT(meanCornerError(m->corners, small), 0.3f);
+}
