@@ -100,8 +100,8 @@ bool surroundsDecoded(const std::array<Point2f, 4> &q, float area, const std::ve
 /* Reads a traced quad as a marker, so that the tracer can skip the
  * marker's inside: one bilinear sample at each cell's centre (a quarter of
  * the warp that finish() makes of the refined quad), thresholded half way
- * between the darkest and brightest code cell, then the usual border and
- * Hamming checks. A miss costs nothing but the skip: the quad stays a
+ * between the darkest and brightest code cell, then the usual border check
+ * and an exact codeword. A miss costs nothing but the skip: the quad stays a
  * candidate either way. */
 class TracedMarkerProbe final : public detail::MarkerProbe
 {
