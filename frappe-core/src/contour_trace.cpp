@@ -115,8 +115,6 @@ std::uint64_t borderStarts(const std::uint8_t *p)
 	constexpr std::uint64_t kOnes = 0x0101010101010101ull;
 	std::uint64_t here, left, right;
 	std::memcpy(&here, p, 8);
-	if (here == 0)
-		return 0;
 	std::memcpy(&left, p - 1, 8);
 	std::memcpy(&right, p + 1, 8);
 	/* labels are 0, 1, 9, 25: bit 3 marks a followed pixel, bit 4 one
@@ -214,7 +212,47 @@ void ContourTracer::trace(const EdgeMap &edges, const TraceParams &params, std::
 			dst[i] = src[i] & EdgeMap::kEdge;
 	}
 
+	/* A border may start at x of row y: follow it and keep it if it makes a
+	 * candidate. */
+	auto tryStart = [&](std::uint8_t *row, int x, int y) {
+		const std::uint8_t f = row[x];
+		if (f == 0)
+			return;
+		int fromDir;
+		if (f == kUnfollowed && row[x - 1] == 0)
+			fromDir = 4; /* outer border: came from the left */
+		else if (!(f & (kFollowedRightBg ^ kFollowed)) && row[x + 1] == 0)
+			fromDir = 0; /* hole border: the hole is to the right */
+		else
+			return;
+
+		++borders_;
+		follow(x, y, fromDir, edges);
+		/* A marker outline is at least four sides of min_side pixels,
+		 * and spans at least min_side / sqrt(2) each way. */
+		if (static_cast<float>(steps_) < 2.8f * params.min_side)
+			return;
+		/* Both ways of making a quad below need two clusters. */
+		if (clusters_.size() < 2)
+			return;
+		if (!spansAtLeast(0.7f * params.min_side))
+			return;
+		/* The paper's rule first: the corner clusters; failing that, the
+		 * outline's extreme points, for a border with at least two corner
+		 * clusters (a marker whose faint corners did not all register
+		 * still has two; clutter with none is most of what reaches here). */
+		Quad quad;
+		if ((!tooManyClusters_ && clusters_.size() >= 4 && quadFromClusters(quad) &&
+		     acceptQuad(params, w, h, quad)) ||
+		    (clusters_.size() >= 2 && quadFromOutline(quad) && acceptQuad(params, w, h, quad))) {
+			out.push_back(quad);
+			if (probe && probe->isMarker(quad))
+				sealInside(quad, w, h);
+		}
+	};
+
 	constexpr int T = EdgeMap::kTile;
+	startWords_.resize(static_cast<std::size_t>(w) / 8 + 2);
 	for (int y = 1; y < h - 1; ++y) {
 		const std::uint8_t *tileRow = edges.tiles.data() + static_cast<std::size_t>(y / T) * edges.tiles_x;
 		std::uint8_t *row = labels_.data() + static_cast<std::size_t>(y) * w;
@@ -227,73 +265,49 @@ void ContourTracer::trace(const EdgeMap &edges, const TraceParams &params, std::
 				++tEnd;
 			const int x0 = std::max(1, tx * T), x1 = std::min(w - 1, tEnd * T);
 			tx = tEnd;
-			for (int x = x0; x < x1; ++x) {
-				/* Most pixels are background or lie on a border already
-				 * followed: find the next pixel where a border can start,
-				 * eight at a time (little-endian: the lowest byte is the
-				 * leftmost pixel). */
-				if constexpr (std::endian::native == std::endian::little && sizeof(void *) < 8) {
-					if (x + 8 <= x1) {
-						const std::uint32_t h0 = load32(row + x), h1 = load32(row + x + 4);
-						if ((h0 | h1) == 0) {
-							x += 7;
-							continue;
-						}
-						std::uint32_t starts = borderStarts4(row + x, h0);
-						if (starts == 0) {
-							starts = borderStarts4(row + x + 4, h1);
-							if (starts == 0) {
+			if constexpr (std::endian::native == std::endian::little && sizeof(void *) >= 8) {
+				/* Where borders may start, for the whole stretch first,
+				 * without a branch per word (most words hold none, but
+				 * which ones is unpredictable); then each candidate is
+				 * checked again, since following and sealing only ever
+				 * take starts away, never add one. Little-endian: the
+				 * lowest byte is the leftmost pixel. */
+				const int words = (x1 - x0 + 7) / 8;
+				std::uint64_t *starts = startWords_.data();
+				for (int k = 0; k < words; ++k)
+					starts[k] = borderStarts(row + x0 + 8 * k);
+				const int tail = (x1 - x0) - 8 * (words - 1); /* 1..8 valid bytes */
+				if (tail < 8)
+					starts[words - 1] &= (std::uint64_t{ 1 } << (8 * tail)) - 1;
+				for (int k = 0; k < words; ++k)
+					for (std::uint64_t m = starts[k]; m != 0; m &= m - 1)
+						tryStart(row, x0 + 8 * k + firstByte(m), y);
+			} else {
+				for (int x = x0; x < x1; ++x) {
+					/* Most pixels are background or lie on a border
+					 * already followed: find the next pixel where a
+					 * border can start, eight at a time, as two words
+					 * (64-bit shifts are library calls here). */
+					if constexpr (std::endian::native == std::endian::little) {
+						if (x + 8 <= x1) {
+							const std::uint32_t h0 = load32(row + x), h1 = load32(row + x + 4);
+							if ((h0 | h1) == 0) {
 								x += 7;
 								continue;
 							}
-							x += 4;
+							std::uint32_t s4 = borderStarts4(row + x, h0);
+							if (s4 == 0) {
+								s4 = borderStarts4(row + x + 4, h1);
+								if (s4 == 0) {
+									x += 7;
+									continue;
+								}
+								x += 4;
+							}
+							x += std::countr_zero(s4) >> 3;
 						}
-						x += std::countr_zero(starts) >> 3;
 					}
-				} else if constexpr (std::endian::native == std::endian::little) {
-					if (x + 8 <= x1) {
-						const std::uint64_t starts = borderStarts(row + x);
-						if (starts == 0) {
-							x += 7;
-							continue;
-						}
-						x += firstByte(starts);
-					}
-				}
-				const std::uint8_t f = row[x];
-				if (f == 0)
-					continue;
-				int fromDir;
-				if (f == kUnfollowed && row[x - 1] == 0)
-					fromDir = 4; /* outer border: came from the left */
-				else if (!(f & (kFollowedRightBg ^ kFollowed)) && row[x + 1] == 0)
-					fromDir = 0; /* hole border: the hole is to the right */
-				else
-					continue;
-
-				++borders_;
-				follow(x, y, fromDir, edges);
-				/* A marker outline is at least four sides of min_side pixels,
-				 * and spans at least min_side / sqrt(2) each way. */
-				if (static_cast<float>(steps_) < 2.8f * params.min_side)
-					continue;
-				/* Both ways of making a quad below need two clusters. */
-				if (clusters_.size() < 2)
-					continue;
-				if (!spansAtLeast(0.7f * params.min_side))
-					continue;
-				/* The paper's rule first: the corner clusters; failing that,
-				 * the outline's extreme points, for a border with at least
-				 * two corner clusters (a marker whose faint corners did not
-				 * all register still has two; clutter with none is most of
-				 * what reaches here). */
-				Quad quad;
-				if ((!tooManyClusters_ && clusters_.size() >= 4 && quadFromClusters(quad) &&
-				     acceptQuad(params, w, h, quad)) ||
-				    (clusters_.size() >= 2 && quadFromOutline(quad) && acceptQuad(params, w, h, quad))) {
-					out.push_back(quad);
-					if (probe && probe->isMarker(quad))
-						sealInside(quad, w, h);
+					tryStart(row, x, y);
 				}
 			}
 		}

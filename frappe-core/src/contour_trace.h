@@ -64,6 +64,7 @@ private:
 	void sealInside(const Quad &quad, int w, int h);
 
 	std::vector<std::uint8_t> labels_;
+	std::vector<std::uint64_t> startWords_; ///< border starts of a row's stretch, 8 pixels a word
 	/// Suzuki's step 3.3 for this width: per direction back and 3x3
 	/// neighbourhood, the move's pointer offset, the next direction back
 	/// and the label bits to set.
