@@ -88,7 +88,7 @@ bool insetQuad(const ImageView &image, std::array<Point2f, 4> &corners, int bits
 Binarised binarise(const WarpedMarker &w, int bits)
 {
 	const int cells = bits + 2;
-	const int k = kSamplesPerCell;
+	const int k = std::max(1, w.side / cells); /* samples per cell side */
 	float lo = 1e9f, hi = -1e9f;
 	for (int y = k; y < (bits + 1) * k; ++y) {
 		for (int x = k; x < (bits + 1) * k; ++x) {

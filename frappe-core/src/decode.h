@@ -44,7 +44,9 @@ struct Binarised {
 };
 
 /// Thresholds the payload at the mid-point of its darkest and brightest
-/// samples, averages 2x2 samples per cell, and checks the border cells.
+/// samples, averages the k x k samples of each cell (k = side / (bits + 2):
+/// 2 for warpMarker's grid, 1 for a grid of cell centres), and checks the
+/// border cells.
 Binarised binarise(const WarpedMarker &warped, int bits);
 
 struct Decoded {

@@ -14,8 +14,6 @@
 #include "contour_trace.h"
 #include "corner_refine.h"
 #include "decode.h"
-#include "sampling.h"
-#include "frappe/homography.h"
 
 namespace frappe {
 
@@ -97,11 +95,17 @@ bool surroundsDecoded(const std::array<Point2f, 4> &q, float area, const std::ve
 	return false;
 }
 
+/* A point of the traced (possibly scaled) frame in full-resolution pixels;
+ * pixel centres are at integers in both. */
+Point2f toFullResolution(Point2f p, float scale)
+{
+	return { (p.x + 0.5f) / scale - 0.5f, (p.y + 0.5f) / scale - 0.5f };
+}
+
 /* Reads a traced quad as a marker, so that the tracer can skip the
- * marker's inside: one bilinear sample at each cell's centre (a quarter of
- * the warp that finish() makes of the refined quad), thresholded half way
- * between the darkest and brightest code cell, then the usual border check
- * and an exact codeword. A miss costs nothing but the skip: the quad stays a
+ * marker's inside: one sample at each cell's centre (a quarter of the warp
+ * that finish() makes of the refined quad), then binarise's checks and an
+ * exact codeword. A miss costs nothing but the skip: the quad stays a
  * candidate either way. */
 class TracedMarkerProbe final : public detail::MarkerProbe
 {
@@ -112,52 +116,25 @@ public:
 	}
 	bool isMarker(const detail::Quad &quad) override
 	{
-		std::array<Point2f, 4> corners = quad.corners;
-		for (Point2f &p : corners) {
-			p.x = (p.x + 0.5f) / scale_ - 0.5f;
-			p.y = (p.y + 0.5f) / scale_ - 0.5f;
-		}
-		const auto H = Homography::fromUnitSquare(corners);
-		if (!H)
+		std::array<Point2f, 4> corners;
+		for (int i = 0; i < 4; ++i)
+			corners[i] = toFullResolution(quad.corners[i], scale_);
+		if (!detail::warpToGrid(image_, corners, dict_.bits + 2, cellCentres_))
 			return false;
-		const int bits = dict_.bits, cells = bits + 2;
-		std::array<float, kMaxCells * kMaxCells> v;
-		float lo = 1e9f, hi = -1e9f;
-		for (int cy = 0; cy < cells; ++cy)
-			for (int cx = 0; cx < cells; ++cx) {
-				const Point2f p = H->map((cx + 0.5) / cells, (cy + 0.5) / cells);
-				const float s = detail::sampleBilinear(image_, p.x, p.y);
-				v[static_cast<std::size_t>(cy * cells + cx)] = s;
-				if (cx > 0 && cy > 0 && cx <= bits && cy <= bits) {
-					lo = std::min(lo, s);
-					hi = std::max(hi, s);
-				}
-			}
-		if (hi - lo < 10.0f)
-			return false;
-		const float thr = 0.5f * (lo + hi);
-		int borderErrors = 0;
-		std::uint64_t code = 0;
-		for (int cy = 0; cy < cells; ++cy)
-			for (int cx = 0; cx < cells; ++cx) {
-				const bool white = v[static_cast<std::size_t>(cy * cells + cx)] > thr;
-				if (cx == 0 || cy == 0 || cx == cells - 1 || cy == cells - 1)
-					borderErrors += white;
-				else
-					code = (code << 1) | (white ? 1u : 0u);
-			}
+		const detail::Binarised b = detail::binarise(cellCentres_, dict_.bits);
 		/* Only an exact codeword: a wrong "yes" would hide whatever lies
 		 * inside the quad (markers on a dark panel, say), and with a small
 		 * dictionary and a generous max_hamming a third of all bit patterns
 		 * are within reach of some codeword. */
-		return borderErrors <= allowedBorderErrors(bits) && detail::decode(dict_, code, 0).id >= 0;
+		return b.contrast >= 10.0f && b.border_errors <= allowedBorderErrors(dict_.bits) &&
+		       detail::decode(dict_, b.code, 0).id >= 0;
 	}
 
 private:
-	static constexpr int kMaxCells = 10; /* 8x8 codes and their frame */
 	const ImageView &image_;
 	float scale_;
 	const Dictionary &dict_;
+	detail::WarpedMarker cellCentres_;
 };
 
 /* Largest image side accepted: contour coordinates are ints and buffers are
@@ -310,12 +287,9 @@ void Detector::Impl::finish(const ImageView &image, Slot &slot)
 	const int borderAllowance = allowedBorderErrors(bits);
 	const int whiteFrame = 3 * bits + 3; /* three quarters of the 4(n+1) border cells */
 	double refineMs = 0, warpMs = 0, decodeMs = 0;
-	for (detail::Quad &q : slot.quads) {
-		for (Point2f &p : q.corners) {
-			p.x = (p.x + 0.5f) / scale - 0.5f;
-			p.y = (p.y + 0.5f) / scale - 0.5f;
-		}
-	}
+	for (detail::Quad &q : slot.quads)
+		for (Point2f &p : q.corners)
+			p = toFullResolution(p, scale);
 	refineMs += msSince(t);
 	const bool batched = warper != nullptr;
 	if (batched)
