@@ -169,7 +169,7 @@ private:
 } // namespace detail
 
 struct Pipeline::Impl {
-	Impl(const Config &config, Mode m) : mode(m), detector(config)
+	Impl(const Config &config, Mode mode) : detector(config)
 	{
 		if (mode == Mode::Frames)
 			frameQueue = std::make_unique<detail::FrameQueue>(config, detector, worker);
@@ -186,7 +186,6 @@ struct Pipeline::Impl {
 		bool traced = false;
 	};
 
-	Mode mode;
 	Detector detector;
 	detail::Worker worker;
 

@@ -57,7 +57,7 @@ public:
 	int latency() const;
 
 	/// The detector of the calling thread (Mode::Frames has a second one,
-	/// configured alike, for the odd frames).
+	/// configured alike, for the worker).
 	Detector &detector();
 
 private:
