@@ -385,7 +385,7 @@ void ContourTracer::sealInside(const Quad &quad, int w, int h)
 		maxY = std::max(maxY, p.y);
 	}
 	/* Extends a run of filled pixels from `from` in steps of `step` over
-	 * background until the outline; returns the new end. */
+	 * background, as far as the outline if it lies within kReach. */
 	auto reach = [&](std::ptrdiff_t from, std::ptrdiff_t step, int room) {
 		for (int k = 1; k <= std::min(kReach, room); ++k) {
 			if (L[from + k * step] != 0) {

@@ -17,18 +17,6 @@ bool warpMarker(const ImageView &image, const std::array<Point2f, 4> &corners, i
 	return warpToGrid(image, corners, (bits + 2) * kSamplesPerCell, out);
 }
 
-/* bilinear sampling where sampleBilinear's clamps do nothing */
-inline float sampleInside(const ImageView &img, float x, float y)
-{
-	const int x0 = static_cast<int>(x), y0 = static_cast<int>(y);
-	const float fx = x - static_cast<float>(x0), fy = y - static_cast<float>(y0);
-	const std::uint8_t *r0 = img.row(y0) + x0;
-	const std::uint8_t *r1 = img.row(y0 + 1) + x0;
-	const float top = static_cast<float>(r0[0]) + fx * static_cast<float>(r0[1] - r0[0]);
-	const float bot = static_cast<float>(r1[0]) + fx * static_cast<float>(r1[1] - r1[0]);
-	return top + fy * (bot - top);
-}
-
 bool warpToGrid(const ImageView &image, const std::array<Point2f, 4> &corners, int side, WarpedMarker &out)
 {
 	const auto H = Homography::fromUnitSquare(corners);

@@ -25,4 +25,17 @@ inline float sampleBilinear(const ImageView &img, float x, float y)
 	return top + fy * (bot - top);
 }
 
+/// sampleBilinear for 0 <= x <= width - 2, 0 <= y <= height - 2, where its
+/// clamps change nothing: the same result, without them.
+inline float sampleInside(const ImageView &img, float x, float y)
+{
+	const int x0 = static_cast<int>(x), y0 = static_cast<int>(y);
+	const float fx = x - static_cast<float>(x0), fy = y - static_cast<float>(y0);
+	const std::uint8_t *r0 = img.row(y0) + x0;
+	const std::uint8_t *r1 = img.row(y0 + 1) + x0;
+	const float top = static_cast<float>(r0[0]) + fx * static_cast<float>(r0[1] - r0[0]);
+	const float bot = static_cast<float>(r1[0]) + fx * static_cast<float>(r1[1] - r1[0]);
+	return top + fy * (bot - top);
+}
+
 } // namespace frappe::detail
