@@ -234,7 +234,7 @@ __attribute__((optimize("omit-frame-pointer"))) void smoothRowV6(const std::uint
 
 __attribute__((optimize("omit-frame-pointer"))) void gradientRowV6(const std::uint8_t *a, const std::uint8_t *b, const std::uint8_t *c, int w,
 		   std::int16_t *gx, std::int16_t * /* gy: the pairs hold it */, std::int32_t *mag,
-		   std::int16_t *tmp, TensorRow /* the corner test sums on demand */)
+		   std::int16_t *tmp)
 {
 	std::uint8_t *pairs = reinterpret_cast<std::uint8_t *>(gx);
 	auto storePair = [&](int x, u32 p) { store32(pairs + 4 * x, p); };

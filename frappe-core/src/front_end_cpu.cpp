@@ -137,10 +137,10 @@ void CpuFrontEnd::runBand(const ImageView &src, const FrontEndParams &params, Ed
 	auto gradient = [&](int r) {
 		const int i = r % 3;
 		if (r <= 0 || r >= h - 1)
-			detail::zeroGradientRow(w, s.gx[i].data(), s.gy[i].data(), s.mag[i].data(), s.tensor(i));
+			detail::zeroGradientRow(w, s.gx[i].data(), s.gy[i].data(), s.mag[i].data());
 		else
 			k.gradient(smoothed(r - 1), smoothed(r), smoothed(r + 1), w, s.gx[i].data(),
-				   s.gy[i].data(), s.mag[i].data(), s.separable.data(), s.tensor(i));
+				   s.gy[i].data(), s.mag[i].data(), s.separable.data());
 	};
 	/* Rows beyond the frame replicate its first and last row. */
 	auto smoothRow = [&](int r) {
@@ -161,9 +161,6 @@ void CpuFrontEnd::runBand(const ImageView &src, const FrontEndParams &params, Ed
 			{ s.gx[(y - 1) % 3].data(), s.gx[y % 3].data(), s.gx[next % 3].data() },
 			{ s.gy[(y - 1) % 3].data(), s.gy[y % 3].data(), s.gy[next % 3].data() },
 			{ s.mag[(y - 1) % 3].data(), s.mag[y % 3].data(), s.mag[next % 3].data() },
-			{ s.txx[(y - 1) % 3].data(), s.txx[y % 3].data(), s.txx[next % 3].data() },
-			{ s.tyy[(y - 1) % 3].data(), s.tyy[y % 3].data(), s.tyy[next % 3].data() },
-			{ s.txy[(y - 1) % 3].data(), s.txy[y % 3].data(), s.txy[next % 3].data() },
 		};
 		std::uint8_t *edgeRow = out.pixels.data() + static_cast<std::size_t>(y) * w;
 		const bool any = k.edge(rows, w, params, edgeRow);

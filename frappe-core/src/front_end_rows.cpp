@@ -39,8 +39,7 @@ void smoothRow(const std::uint8_t *a, const std::uint8_t *b, const std::uint8_t 
 }
 
 void gradientRow(const std::uint8_t *a, const std::uint8_t *b, const std::uint8_t *c, int w,
-		 std::int16_t *gx, std::int16_t *gy, std::int32_t *mag, std::int16_t *tmp,
-		 TensorRow /* the scalar corner test sums on demand */)
+		 std::int16_t *gx, std::int16_t *gy, std::int32_t *mag, std::int16_t *tmp)
 {
 	/* Separable Sobel: vertical smoothing and vertical difference per
 	 * column, then the horizontal difference and smoothing. */
@@ -62,14 +61,11 @@ void gradientRow(const std::uint8_t *a, const std::uint8_t *b, const std::uint8_
 	}
 }
 
-void zeroGradientRow(int w, std::int16_t *gx, std::int16_t *gy, std::int32_t *mag, TensorRow tensor)
+void zeroGradientRow(int w, std::int16_t *gx, std::int16_t *gy, std::int32_t *mag)
 {
 	std::memset(gx, 0, sizeof(*gx) * 2 * w);
 	std::memset(gy, 0, sizeof(*gy) * w);
 	std::memset(mag, 0, sizeof(*mag) * w);
-	std::memset(tensor.xx, 0, sizeof(*tensor.xx) * w);
-	std::memset(tensor.yy, 0, sizeof(*tensor.yy) * w);
-	std::memset(tensor.xy, 0, sizeof(*tensor.xy) * w);
 }
 
 bool isCorner(const GradRows &rows, int x, std::int64_t cornerThreshold)

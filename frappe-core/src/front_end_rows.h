@@ -12,19 +12,11 @@
 
 namespace frappe::detail {
 
-/// One row of the structure tensor's products summed over x-1..x+1, for the
-/// vectorised corner test (the scalar kernels leave it untouched).
-struct TensorRow {
-	std::int32_t *xx, *yy, *xy;
-	std::int32_t *scratch; ///< 3w values for the unsummed products
-};
-
 /// Three consecutive rows (y-1, y, y+1) of gradients and squared magnitudes.
 struct GradRows {
 	const std::int16_t *gx[3];
 	const std::int16_t *gy[3];
 	const std::int32_t *mag[3];
-	const std::int32_t *txx[3], *tyy[3], *txy[3]; ///< TensorRow sums, when computed
 };
 
 /// Per-thread scratch: rings of smoothed rows and of gradient rows.
@@ -35,23 +27,16 @@ struct RowScratch {
 	/// gx holds 2w values: the ARMv6 kernels store (gx, gy) pairs in it.
 	std::vector<std::int16_t> gx[3], gy[3];
 	std::vector<std::int32_t> mag[3];
-	std::vector<std::int32_t> txx[3], tyy[3], txy[3];
-	std::vector<std::int32_t> products;
-	TensorRow tensor(int i) { return { txx[i].data(), tyy[i].data(), txy[i].data(), products.data() }; }
 	void resize(int w)
 	{
 		for (int i = 0; i < 4; ++i)
 			smooth[i].resize(2 * static_cast<std::size_t>(w) + 8);
 		columns.resize(w);
 		separable.resize(2 * static_cast<std::size_t>(w) + 16);
-		products.resize(3 * static_cast<std::size_t>(w));
 		for (int i = 0; i < 3; ++i) {
 			gx[i].resize(2 * static_cast<std::size_t>(w));
 			gy[i].resize(w);
 			mag[i].resize(w);
-			txx[i].resize(w);
-			tyy[i].resize(w);
-			txy[i].resize(w);
 		}
 	}
 };
@@ -69,11 +54,10 @@ void smoothRow(const std::uint8_t *a, const std::uint8_t *b, const std::uint8_t 
 /// Sobel gradients of the middle of three smoothed rows a, b, c; zero in
 /// the first and last column. `tmp` holds 2w values.
 void gradientRow(const std::uint8_t *a, const std::uint8_t *b, const std::uint8_t *c, int w,
-		 std::int16_t *gx, std::int16_t *gy, std::int32_t *mag, std::int16_t *tmp,
-		 TensorRow tensor);
+		 std::int16_t *gx, std::int16_t *gy, std::int32_t *mag, std::int16_t *tmp);
 
 /// The gradient row of the outermost image rows: all zero (2w values of gx).
-void zeroGradientRow(int w, std::int16_t *gx, std::int16_t *gy, std::int32_t *mag, TensorRow tensor);
+void zeroGradientRow(int w, std::int16_t *gx, std::int16_t *gy, std::int32_t *mag);
 
 /// Non-maximum suppression, edge threshold and corner test of the middle
 /// row. Writes w bytes; returns whether any pixel is an edge.
@@ -92,8 +76,7 @@ struct RowKernels {
 	void (*smooth)(const std::uint8_t *a, const std::uint8_t *b, const std::uint8_t *c, int w,
 		       std::uint8_t *out, std::uint16_t *tmp);
 	void (*gradient)(const std::uint8_t *a, const std::uint8_t *b, const std::uint8_t *c, int w,
-			 std::int16_t *gx, std::int16_t *gy, std::int32_t *mag, std::int16_t *tmp,
-			 TensorRow tensor);
+			 std::int16_t *gx, std::int16_t *gy, std::int32_t *mag, std::int16_t *tmp);
 	bool (*edge)(const GradRows &rows, int w, const FrontEndParams &params, std::uint8_t *out);
 };
 

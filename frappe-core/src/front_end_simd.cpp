@@ -155,8 +155,7 @@ hn::Vec<D8> EdgeBytes(D32 d32, D8 d8, hn::Mask<D32> edge, hn::Mask<D32> corner)
 }
 
 void GradientRow(const std::uint8_t *a, const std::uint8_t *b, const std::uint8_t *c, int w,
-		 std::int16_t *gx, std::int16_t *gy, std::int32_t *mag, std::int16_t *tmp,
-		 TensorRow tensor)
+		 std::int16_t *gx, std::int16_t *gy, std::int32_t *mag, std::int16_t *tmp)
 {
 	const hn::ScalableTag<std::int16_t> d16;
 	const hn::Rebind<std::uint8_t, decltype(d16)> d8;
@@ -166,7 +165,7 @@ void GradientRow(const std::uint8_t *a, const std::uint8_t *b, const std::uint8_
 	const hn::Rebind<std::uint16_t, decltype(d32)> du16h;
 	const int N = static_cast<int>(hn::Lanes(d16));
 	if (!UsePairs(d16, w)) {
-		gradientRow(a, b, c, w, gx, gy, mag, tmp, tensor);
+		gradientRow(a, b, c, w, gx, gy, mag, tmp);
 		return;
 	}
 	auto *pairs = reinterpret_cast<std::int32_t *>(gx);
@@ -349,10 +348,9 @@ bool EdgeRow(const GradRows &rows, int w, const FrontEndParams &params, std::uin
 #else // HWY_SCALAR: one-lane vectors hold no pairs; the scalar kernels.
 
 void GradientRow(const std::uint8_t *a, const std::uint8_t *b, const std::uint8_t *c, int w,
-		 std::int16_t *gx, std::int16_t *gy, std::int32_t *mag, std::int16_t *tmp,
-		 TensorRow tensor)
+		 std::int16_t *gx, std::int16_t *gy, std::int32_t *mag, std::int16_t *tmp)
 {
-	gradientRow(a, b, c, w, gx, gy, mag, tmp, tensor);
+	gradientRow(a, b, c, w, gx, gy, mag, tmp);
 }
 
 bool EdgeRow(const GradRows &rows, int w, const FrontEndParams &params, std::uint8_t *out)
@@ -382,10 +380,9 @@ void smoothDispatch(const std::uint8_t *a, const std::uint8_t *b, const std::uin
 }
 
 void gradientDispatch(const std::uint8_t *a, const std::uint8_t *b, const std::uint8_t *c, int w,
-		      std::int16_t *gx, std::int16_t *gy, std::int32_t *mag, std::int16_t *tmp,
-		      TensorRow tensor)
+		      std::int16_t *gx, std::int16_t *gy, std::int32_t *mag, std::int16_t *tmp)
 {
-	HWY_DYNAMIC_DISPATCH(GradientRow)(a, b, c, w, gx, gy, mag, tmp, tensor);
+	HWY_DYNAMIC_DISPATCH(GradientRow)(a, b, c, w, gx, gy, mag, tmp);
 }
 
 bool edgeDispatch(const GradRows &rows, int w, const FrontEndParams &params, std::uint8_t *out)

@@ -102,10 +102,8 @@ void checkRows(const RowKernels &ref, const RowKernels &k, int w, int kind, int 
 
 	std::vector<std::int16_t> gx(2 * w + 8, 0x5555), gy(2 * w + 8, 0x5555), rgx(w), rgy(w), sep(2 * w + 16);
 	std::vector<std::int32_t> mag(w + 4, 0x55555555), rmag(w);
-	std::vector<std::int32_t> t0(w), t1(w), t2(w), prod(3 * w);
-	const TensorRow tensor{ t0.data(), t1.data(), t2.data(), prod.data() };
-	ref.gradient(a, b, c, w, rgx.data(), rgy.data(), rmag.data(), sep.data(), tensor);
-	k.gradient(la.data(), lb.data(), lc.data(), w, gx.data(), gy.data(), mag.data(), sep.data(), tensor);
+	ref.gradient(a, b, c, w, rgx.data(), rgy.data(), rmag.data(), sep.data());
+	k.gradient(la.data(), lb.data(), lc.data(), w, gx.data(), gy.data(), mag.data(), sep.data());
 	for (int x = 0; x < w; ++x) {
 		/* The ARMv6 kernel stores (gx, gy) pairs in the gx buffer. */
 		CHECK(gx[2 * x] == rgx[x] && gx[2 * x + 1] == rgy[x] && mag[x] == rmag[x],

@@ -113,11 +113,11 @@ Planes referencePlanes(const Img &img, float scale)
 		detail::smoothRow(row(y - 1), row(y), row(y + 1), w, sm.data() + static_cast<size_t>(y) * w, tmp.data());
 	std::vector<int32_t> gx(static_cast<size_t>(w) * h, 0), gy(gx.size(), 0);
 	std::vector<int16_t> gxr(w), gyr(w), sep(2 * w);
-	std::vector<int32_t> mag(w), t0(w), t1(w), t2(w), t3(3 * w);
+	std::vector<int32_t> mag(w);
 	for (int y = 1; y < h - 1; ++y) {
 		detail::gradientRow(sm.data() + static_cast<size_t>(y - 1) * w, sm.data() + static_cast<size_t>(y) * w,
 		                    sm.data() + static_cast<size_t>(y + 1) * w, w, gxr.data(), gyr.data(), mag.data(),
-		                    sep.data(), {t0.data(), t1.data(), t2.data(), t3.data()});
+		                    sep.data());
 		for (int x = 0; x < w; ++x) {
 			gx[static_cast<size_t>(y) * w + x] = gxr[x];
 			gy[static_cast<size_t>(y) * w + x] = gyr[x];
