@@ -11,6 +11,7 @@
 //   starts there.
 // Empty 16x16 tiles hold no edge pixel, so the raster scan jumps over them.
 #include "contour_trace.h"
+#include "neighbour_masks.h"
 
 #include <algorithm>
 #include <bit>
@@ -174,6 +175,41 @@ float dist2(Point2f a, Point2f b)
 
 } // namespace
 
+void ContourTracer::buildStepTables(int w)
+{
+	/* Moves as pointer offsets: 16 bits hold them up to this width. */
+	useMasks_ = sizeof(void *) >= 8 && w <= 32000;
+	if (useMasks_) {
+		maskTable_.resize(8 * 256);
+		for (int back = 0; back < 8; ++back)
+			for (int mask = 0; mask < 256; ++mask) {
+				const int e = kNextStep.entry[back][mask];
+				const int d = e & 7;
+				MaskStep &st = maskTable_[static_cast<std::size_t>(back) * 256 + mask];
+				st.offset = static_cast<std::int16_t>(kDx[d] + kDy[d] * w);
+				st.back = static_cast<std::uint8_t>((d + 4) & 7);
+				st.mark = (e & 8) ? kMarkRightBg : kMarkFollowed;
+			}
+		stepTable_.clear();
+		return;
+	}
+	/* kRowStep as (offset << 12) | back' << 9 | mark: the move's pointer
+	 * offset, the direction back from the pixel it reaches (which selects
+	 * the next row of the table), and the label mark of the pixel it
+	 * leaves. */
+	stepTable_.resize(8 * 512);
+	for (int back = 0; back < 8; ++back)
+		for (int idx = 0; idx < 512; ++idx) {
+			const int e = kRowStep.entry[back][idx];
+			const int d = e & 7;
+			const auto offset = static_cast<std::uint32_t>(kDx[d] + kDy[d] * w);
+			stepTable_[static_cast<std::size_t>(back) * 512 + idx] = static_cast<std::int32_t>(
+				offset << 12 | static_cast<std::uint32_t>((d + 4) & 7) << 9 |
+				((e & 8) ? kMarkRightBg : kMarkFollowed));
+		}
+	maskTable_.clear();
+}
+
 void ContourTracer::trace(const EdgeMap &edges, const TraceParams &params, std::vector<Quad> &out,
 			  MarkerProbe *probe)
 {
@@ -182,22 +218,8 @@ void ContourTracer::trace(const EdgeMap &edges, const TraceParams &params, std::
 	const int w = edges.width, h = edges.height;
 	if (w < 3 || h < 3)
 		return;
-	if (stride_ != w || stepTable_.empty()) {
-		/* kRowStep as (offset << 12) | back' << 9 | mark: the move's
-		 * pointer offset, the direction back from the pixel it reaches
-		 * (which selects the next row of the table), and the label mark
-		 * of the pixel it leaves. */
-		stepTable_.resize(8 * 512);
-		for (int back = 0; back < 8; ++back)
-			for (int idx = 0; idx < 512; ++idx) {
-				const int e = kRowStep.entry[back][idx];
-				const int d = e & 7;
-				const auto offset = static_cast<std::uint32_t>(kDx[d] + kDy[d] * w);
-				stepTable_[static_cast<std::size_t>(back) * 512 + idx] = static_cast<std::int32_t>(
-					offset << 12 | static_cast<std::uint32_t>((d + 4) & 7) << 9 |
-					((e & 8) ? kMarkRightBg : kMarkFollowed));
-			}
-	}
+	if (stride_ != w || (stepTable_.empty() && maskTable_.empty()))
+		buildStepTables(w);
 	stride_ = w;
 	radius2_ = params.cluster_radius * params.cluster_radius;
 	/* Four bytes of padding: follow reads neighbours a word at a time. */
@@ -252,6 +274,24 @@ void ContourTracer::trace(const EdgeMap &edges, const TraceParams &params, std::
 	};
 
 	constexpr int T = EdgeMap::kTile;
+	/* Neighbour masks wherever a border can run: the occupied tiles. */
+	if (useMasks_) {
+		masks_.resize(static_cast<std::size_t>(w) * h);
+		for (int y = 1; y < h - 1; ++y) {
+			const std::uint8_t *tileRow = edges.tiles.data() + static_cast<std::size_t>(y / T) * edges.tiles_x;
+			const std::uint8_t *e = edges.pixels.data() + static_cast<std::size_t>(y) * w;
+			std::uint8_t *m = masks_.data() + static_cast<std::size_t>(y) * w;
+			for (int tx = 0; tx < edges.tiles_x; ++tx) {
+				if (tileRow[tx] == 0)
+					continue;
+				int tEnd = tx + 1;
+				while (tEnd < edges.tiles_x && tileRow[tEnd])
+					++tEnd;
+				neighbourMasks(e, w, std::max(1, tx * T), std::min(w - 1, tEnd * T), m);
+				tx = tEnd;
+			}
+		}
+	}
 	startWords_.resize(static_cast<std::size_t>(w) / 8 + 2);
 	for (int y = 1; y < h - 1; ++y) {
 		const std::uint8_t *tileRow = edges.tiles.data() + static_cast<std::size_t>(y / T) * edges.tiles_x;
@@ -419,6 +459,16 @@ void ContourTracer::sealInside(const Quad &quad, int w, int h)
 		reach(static_cast<std::ptrdiff_t>(y0) * stride + x, -stride, y0 - 1);
 		reach(static_cast<std::ptrdiff_t>(y1) * stride + x, stride, h - 2 - y1);
 	}
+	/* Pixels beside the filled ones now have other neighbours. */
+	if (useMasks_) {
+		const int y0 = std::max(1, static_cast<int>(minY) - kReach - 1);
+		const int y1 = std::min(h - 2, static_cast<int>(maxY) + kReach + 2);
+		const int x0 = std::max(1, static_cast<int>(minX) - kReach - 1);
+		const int x1 = std::min(w - 1, static_cast<int>(maxX) + kReach + 3);
+		for (int y = y0; y <= y1; ++y)
+			neighbourMasks(L + static_cast<std::ptrdiff_t>(y) * stride, stride, x0, x1,
+				       masks_.data() + static_cast<std::ptrdiff_t>(y) * stride);
+	}
 }
 
 bool ContourTracer::spansAtLeast(float span) const
@@ -506,6 +556,38 @@ void ContourTracer::follow(int x0, int y0, int fromDir, const EdgeMap &edges)
 						      -kDx[2] - kDy[2] * 65536, -kDx[3] - kDy[3] * 65536,
 						      -kDx[4] - kDy[4] * 65536, -kDx[5] - kDy[5] * 65536,
 						      -kDx[6] - kDy[6] * 65536, -kDx[7] - kDy[7] * 65536 };
+	if (useMasks_) {
+		/* Each pixel's neighbourhood is one byte of masks_: a step is
+		 * two dependent loads, that byte and the table entry. */
+		const std::uint8_t *const M = masks_.data();
+		const MaskStep *const mt = maskTable_.data();
+		const std::ptrdiff_t i0 = p0 - L, i1 = p1 - L;
+		std::ptrdiff_t i = i0;
+		unsigned back = static_cast<unsigned>(d1);
+		for (;;) {
+			const MaskStep st = mt[back << 8 | M[i]];
+			L[i] |= st.mark;
+			*out++ = xy;
+			if (isCorner(L + i)) [[unlikely]]
+				cluster(xy);
+			if (out == outEnd) [[unlikely]] {
+				const std::size_t n = points_.size();
+				if (n > 4 * labels_.size())
+					break;
+				points_.resize(2 * n);
+				out = points_.data() + n;
+				outEnd = points_.data() + points_.size();
+			}
+			const std::ptrdiff_t next = i + st.offset;
+			if (i == i1 && next == i0) [[unlikely]]
+				break;
+			back = st.back;
+			xy += static_cast<std::uint32_t>(kDxyBack[back]);
+			i = next;
+		}
+		steps_ = static_cast<int>(out - points_.data());
+		return;
+	}
 	const std::int32_t *const table = stepTable_.data();
 	const std::size_t maxSteps = 4 * labels_.size();
 	std::uint8_t *p = p0;

@@ -56,6 +56,7 @@ private:
 		int n;
 		int fx, fy;   ///< first member, the cluster's anchor
 	};
+	void buildStepTables(int w);
 	void follow(int x, int y, int fromDir, const EdgeMap &edges);
 	bool spansAtLeast(float span) const; ///< the last border's bounding box
 	bool quadFromClusters(Quad &quad) const;
@@ -65,9 +66,22 @@ private:
 
 	std::vector<std::uint8_t> labels_;
 	std::vector<std::uint64_t> startWords_; ///< border starts of a row's stretch, 8 pixels a word
-	/// Suzuki's step 3.3 for this width: per direction back and 3x3
-	/// neighbourhood, the move's pointer offset, the next direction back
+	/// Suzuki's step 3.3 for this width, in one of two forms. On 64-bit
+	/// targets each edge pixel's eight neighbours are first gathered into
+	/// one byte of masks_ (a vectorised pass over the occupied tiles), and
+	/// the table is indexed by direction back and that byte. Elsewhere (the
+	/// ARMv6 build, where that pass would cost more than it saves) the
+	/// neighbourhood is read from three label rows at every step, and
+	/// stepTable_ holds the move's pointer offset, the next direction back
 	/// and the label bits to set.
+	struct MaskStep {
+		std::int16_t offset; ///< pointer offset of the move
+		std::uint8_t back;   ///< direction back from the pixel it reaches
+		std::uint8_t mark;   ///< label mark of the pixel it leaves
+	};
+	bool useMasks_ = false;
+	std::vector<std::uint8_t> masks_;
+	std::vector<MaskStep> maskTable_;
 	std::vector<std::int32_t> stepTable_;
 	std::vector<Cluster> clusters_;
 	/// The last border's pixels as x | y << 16; only the first steps_ are

@@ -1,9 +1,17 @@
 // SPDX-License-Identifier: MIT
 // Suzuki border following and candidate selection on hand-made edge maps.
+#include <cstdio>
+#include <random>
+
 #include <gtest/gtest.h>
+
+#ifdef FRAPPE_TEST_HWY_TARGETS
+#include <hwy/targets.h>
+#endif
 
 #include "contour_trace.h"
 #include "frappe/edge_map.h"
+#include "neighbour_masks.h"
 
 using namespace frappe;
 using namespace frappe::detail;
@@ -252,4 +260,121 @@ TEST(ContourTrace, LongBorderAndReuseGiveTheSameQuad)
 			near = near || (std::abs(c.x - ex[k]) <= 1.0f && std::abs(c.y - ey[k]) <= 1.0f);
 		EXPECT_TRUE(near) << c.x << "," << c.y;
 	}
+}
+
+/* Each bit of a neighbour mask names one direction, counter-clockwise on
+ * screen from the right; only bit 0 of a neighbour counts (labels 9 and 25
+ * and the corner bit are all "non-zero" or ignored alike). */
+TEST(NeighbourMasks, BitsNameTheDirections)
+{
+	const int w = 8;
+	const int dx[8] = { 1, 1, 0, -1, -1, -1, 0, 1 }, dy[8] = { 0, -1, -1, -1, 0, 1, 1, 1 };
+	const std::uint8_t values[8] = { 1, 9, 25, 3, 1, 9, 25, 3 };
+	for (int d = 0; d < 8; ++d) {
+		std::vector<std::uint8_t> img(w * 3, 0), out(w, 0xAA);
+		img[(1 + dy[d]) * w + 3 + dx[d]] = values[d];
+		img[1 * w + 5] = EdgeMap::kCorner; /* bit 0 clear: not a neighbour */
+		neighbourMasksScalar(img.data() + w, w, 2, 5, out.data());
+		EXPECT_EQ(out[3], 1u << d) << "direction " << d;
+		EXPECT_EQ(out[4] & 1, 0) << "the corner bit counted as an edge";
+		EXPECT_EQ(out[1], 0xAAu) << "written outside [x0, x1)";
+		EXPECT_EQ(out[5], 0xAAu) << "written outside [x0, x1)";
+		neighbourMasks(img.data() + w, w, 2, 5, out.data());
+		EXPECT_EQ(out[3], 1u << d) << "direction " << d;
+	}
+}
+
+namespace {
+
+void expectVectorMasksMatchScalar(const char *target)
+{
+	/* Rows of random labels (0, 1, 9, 25, with corner bits), spans of
+	 * every length and start up to a few vectors, so that every tail and
+	 * misalignment is met. */
+	const int w = 301;
+	std::mt19937 rng(5);
+	std::vector<std::uint8_t> img(static_cast<std::size_t>(w) * 3);
+	const std::uint8_t pick[6] = { 0, 0, 1, 9, 25, 3 };
+	for (std::uint8_t &v : img)
+		v = pick[rng() % 6];
+	std::vector<std::uint8_t> a(w), b(w);
+	int compared = 0;
+	for (int x0 = 1; x0 < 40; x0 += 3)
+		for (int x1 = x0; x1 <= w - 1; x1 += 7) {
+			std::fill(a.begin(), a.end(), 0x55);
+			std::fill(b.begin(), b.end(), 0x55);
+			neighbourMasks(img.data() + w, w, x0, x1, a.data());
+			neighbourMasksScalar(img.data() + w, w, x0, x1, b.data());
+			ASSERT_EQ(a, b) << target << ": x in [" << x0 << ", " << x1 << ")";
+			++compared;
+		}
+	EXPECT_GT(compared, 500);
+}
+
+} // namespace
+
+TEST(NeighbourMasks, VectorFormMatchesTheScalarOne)
+{
+#ifdef FRAPPE_TEST_HWY_TARGETS
+	int targets = 0;
+	for (const std::int64_t t : hwy::SupportedAndGeneratedTargets()) {
+		hwy::SetSupportedTargetsForTest(t);
+		expectVectorMasksMatchScalar(hwy::TargetName(t));
+		std::printf("compared on %s\n", hwy::TargetName(t));
+		++targets;
+	}
+	hwy::SetSupportedTargetsForTest(0);
+	EXPECT_GE(targets, 1);
+#else
+	expectVectorMasksMatchScalar("scalar build");
+#endif
+}
+
+/* Frames wider than 16-bit moves reach follow the neighbourhood from three
+ * label rows at every step (the 32-bit targets' walk) rather than from the
+ * neighbour masks. Both walks must give the same borders and quads: the same
+ * clutter, rings and probed marker placed in a narrow and a very wide frame. */
+TEST(ContourTrace, BothWalksGiveTheSameQuads)
+{
+	auto scene = [](int w) {
+		EdgeMap em = emptyMap(w, 200);
+		markerLike(em, 20, 20, 64);
+		ring(em, 87, 20, 140, 84);
+		ring(em, 150, 30, 230, 110);
+		/* Clutter: random edge pixels, some with corner bits, and a
+		 * second ring through it. */
+		std::mt19937 rng(11);
+		for (int k = 0; k < 2500; ++k) {
+			const int x = 10 + static_cast<int>(rng() % 280), y = 120 + static_cast<int>(rng() % 70);
+			set(em, x, y, (rng() % 5 == 0) ? EdgeMap::kEdge | EdgeMap::kCorner : EdgeMap::kEdge);
+		}
+		ring(em, 40, 125, 120, 185);
+		/* Clutter touching the probed marker's outline from outside
+		 * and inside: borders that run beside its sealed inside. */
+		for (int k = 0; k < 400; ++k) {
+			const int x = 14 + static_cast<int>(rng() % 70), y = 76 + static_cast<int>(rng() % 16);
+			set(em, x, y, EdgeMap::kEdge);
+		}
+		for (int k = 0; k < 200; ++k) {
+			const int x = 76 + static_cast<int>(rng() % 9), y = 14 + static_cast<int>(rng() % 70);
+			set(em, x, y, EdgeMap::kEdge);
+		}
+		return em;
+	};
+	const EdgeMap narrow = scene(320), wide = scene(33000);
+	BoxProbe p1(18, 18, 22, 22), p2(18, 18, 22, 22);
+	ContourTracer a, b;
+	std::vector<Quad> qa, qb;
+	a.trace(narrow, TraceParams{}, qa, &p1);
+	b.trace(wide, TraceParams{}, qb, &p2);
+	EXPECT_GT(a.bordersFollowed(), 100);
+	EXPECT_EQ(a.bordersFollowed(), b.bordersFollowed());
+	EXPECT_EQ(p1.calls, p2.calls);
+	ASSERT_EQ(qa.size(), qb.size());
+	EXPECT_GE(qa.size(), 4u);
+	for (std::size_t k = 0; k < qa.size(); ++k)
+		for (int i = 0; i < 4; ++i) {
+			EXPECT_EQ(qa[k].corners[i].x, qb[k].corners[i].x);
+			EXPECT_EQ(qa[k].corners[i].y, qb[k].corners[i].y);
+		}
 }
