@@ -110,18 +110,29 @@ Point2f toFullResolution(Point2f p, float scale)
 class TracedMarkerProbe final : public detail::MarkerProbe
 {
 public:
-	TracedMarkerProbe(const ImageView &image, float scale, const Dictionary &dict)
-		: image_(image), scale_(scale), dict_(dict)
+	/* What the probe read on each quad: how many border cells were white
+	 * at the traced outline (-1: the quad could not be read). */
+	struct Read {
+		std::array<Point2f, 4> corners;
+		int borderErrors;
+	};
+
+	TracedMarkerProbe(const ImageView &image, float scale, const Dictionary &dict, std::vector<Read> &reads)
+		: image_(image), scale_(scale), dict_(dict), reads_(reads)
 	{
+		reads_.clear();
 	}
 	bool isMarker(const detail::Quad &quad) override
 	{
 		std::array<Point2f, 4> corners;
 		for (int i = 0; i < 4; ++i)
 			corners[i] = toFullResolution(quad.corners[i], scale_);
-		if (!detail::warpToGrid(image_, corners, dict_.bits + 2, cellCentres_))
+		if (!detail::warpToGrid(image_, corners, dict_.bits + 2, cellCentres_)) {
+			reads_.push_back({ quad.corners, -1 });
 			return false;
+		}
 		const detail::Binarised b = detail::binarise(cellCentres_, dict_.bits);
+		reads_.push_back({ quad.corners, b.border_errors });
 		/* Only an exact codeword: a wrong "yes" would hide whatever lies
 		 * inside the quad (markers on a dark panel, say), and with a small
 		 * dictionary and a generous max_hamming a third of all bit patterns
@@ -134,6 +145,7 @@ private:
 	const ImageView &image_;
 	float scale_;
 	const Dictionary &dict_;
+	std::vector<Read> &reads_;
 	detail::WarpedMarker cellCentres_;
 };
 
@@ -174,6 +186,10 @@ struct Detector::Impl {
 		ImageView image; /* the frame, valid until its back end returns */
 		EdgeMap edges;
 		std::vector<detail::Quad> quads;
+		/* Per quad, border cells read white at its traced outline, -1 when
+		 * not read. */
+		std::vector<int> tracedFrame;
+		std::vector<TracedMarkerProbe::Read> reads;
 		Result result;
 	};
 	Slot slots[kSlots];
@@ -233,7 +249,7 @@ void Detector::Impl::trace(Slot &slot)
 	tp.cluster_radius = config.corner_cluster_radius;
 	tp.min_side = std::max(4.0f, config.min_marker_side * scale);
 	tp.border_margin = 1.0f;
-	TracedMarkerProbe probe(slot.image, scale, *dict);
+	TracedMarkerProbe probe(slot.image, scale, *dict, slot.reads);
 	tracer.trace(edges, tp, quads, &probe);
 	detail::removeDuplicateQuads(quads, 2.5f);
 	/* Smallest first: a marker's own outline decodes before the outline of
@@ -241,6 +257,14 @@ void Detector::Impl::trace(Slot &slot)
 	std::sort(quads.begin(), quads.end(), [](const detail::Quad &a, const detail::Quad &b) {
 		return quadArea(a.corners) < quadArea(b.corners);
 	});
+	slot.tracedFrame.assign(quads.size(), -1);
+	for (std::size_t k = 0; k < quads.size(); ++k)
+		for (const TracedMarkerProbe::Read &r : slot.reads)
+			if (std::equal(r.corners.begin(), r.corners.end(), quads[k].corners.begin(),
+				       [](Point2f a, Point2f b) { return a.x == b.x && a.y == b.y; })) {
+				slot.tracedFrame[k] = r.borderErrors;
+				break;
+			}
 	slot.result.times[Stage::Trace] = msSince(t);
 }
 
@@ -286,6 +310,14 @@ void Detector::Impl::finish(const ImageView &image, Slot &slot)
 	const int bits = dict->bits;
 	const int borderAllowance = allowedBorderErrors(bits);
 	const int whiteFrame = 3 * bits + 3; /* three quarters of the 4(n+1) border cells */
+	/* The probe's read at the traced outline decides two things before
+	 * refinement. A frame with more white cells than twice what decode
+	 * forgives, on a quad of at least 4 px a cell (where the traced outline
+	 * lies well within a cell of the refined one), is clutter: nothing to
+	 * refine. A white frame goes straight to the inset read below, which
+	 * starts from the traced outline anyway. */
+	const int mixedFrame = 2 * borderAllowance;
+	const float sureSide = 4.0f * static_cast<float>(bits + 2);
 	double refineMs = 0, warpMs = 0, decodeMs = 0;
 	for (detail::Quad &q : slot.quads)
 		for (Point2f &p : q.corners)
@@ -302,7 +334,13 @@ void Detector::Impl::finish(const ImageView &image, Slot &slot)
 			refineMs += msSince(t);
 			continue;
 		}
-		bool refined = batched ? batch.refined[k] != 0 : detail::refineCorners(image, q.corners, search);
+		const int traced = k < slot.tracedFrame.size() ? slot.tracedFrame[k] : -1;
+		if (traced > mixedFrame && traced < whiteFrame && sidesAtLeast(outline, sureSide)) {
+			refineMs += msSince(t);
+			continue;
+		}
+		bool refined = batched ? batch.refined[k] != 0
+			       : traced < whiteFrame && detail::refineCorners(image, q.corners, search);
 		refineMs += msSince(t);
 		detail::Binarised b;
 		if (refined && sidesAtLeast(q.corners, config.min_marker_side)) {

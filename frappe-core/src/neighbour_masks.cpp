@@ -42,8 +42,7 @@ void NeighbourMaskRow(const std::uint8_t *row, std::ptrdiff_t stride, int x0, in
 	using S5 = std::integral_constant<int, 5>;
 	using S6 = std::integral_constant<int, 6>;
 	using S7 = std::integral_constant<int, 7>;
-	int x = x0;
-	for (; x + N <= x1; x += N) {
+	auto masks = [&](int x) HWY_ATTR {
 		auto acc = hn::And(hn::LoadU(d8, row + x + 1), hn::Set(d8, 1));
 		acc = add(acc, up + x + 1, S1{});
 		acc = add(acc, up + x, S2{});
@@ -53,8 +52,19 @@ void NeighbourMaskRow(const std::uint8_t *row, std::ptrdiff_t stride, int x0, in
 		acc = add(acc, down + x, S6{});
 		acc = add(acc, down + x + 1, S7{});
 		hn::StoreU(acc, d8, out + x);
-	}
-	neighbourMasksScalar(row, stride, x, x1, out);
+	};
+	int x = x0;
+	for (; x + N <= x1; x += N)
+		masks(x);
+	if (x == x1)
+		return;
+	/* The tail as one vector ending at x1, recomputing some masks on its
+	 * left (the stretches are short: a scalar tail cost as much as the
+	 * rest), when that vector starts inside the row. */
+	if (x1 - N >= 1)
+		masks(x1 - N);
+	else
+		neighbourMasksScalar(row, stride, x, x1, out);
 #endif
 }
 
