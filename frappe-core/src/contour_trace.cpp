@@ -11,7 +11,7 @@
 //   starts there.
 // Empty 16x16 tiles hold no edge pixel, so the raster scan jumps over them.
 #include "contour_trace.h"
-#include "neighbour_masks.h"
+#include "trace_rows.h"
 
 #include <algorithm>
 #include <bit>
@@ -24,8 +24,8 @@ namespace {
 
 /* Following a pixel ORs one of the two marks into its label: 1 -> 9 or 25,
  * 9 -> 9 or 25, 25 stays. */
-constexpr std::uint8_t kUnfollowed = 1, kFollowed = 9, kFollowedRightBg = 25;
 constexpr std::uint8_t kMarkFollowed = 8, kMarkRightBg = 24;
+static_assert((kUnfollowed | kMarkFollowed) == kFollowed && (kFollowed | kMarkRightBg) == kFollowedRightBg);
 
 /* Neighbour offsets, counter-clockwise on screen starting at the right. */
 constexpr int kDx[8] = { 1, 1, 0, -1, -1, -1, 0, 1 };
@@ -106,43 +106,16 @@ inline unsigned neighbourIndex(const std::uint8_t *p, std::ptrdiff_t w)
 	}
 }
 
-/* Labels of eight pixels at p (and their neighbours at p - 1 .. p + 8, which
- * must be readable): bit 0 of byte i set where pixel i may start a border,
- * i.e. an unfollowed edge pixel with background on its left (an outer
- * border), or an unfollowed or followed one (not kFollowedRightBg) with
- * background on its right (a hole). */
-std::uint64_t borderStarts(const std::uint8_t *p)
-{
-	constexpr std::uint64_t kOnes = 0x0101010101010101ull;
-	std::uint64_t here, left, right;
-	std::memcpy(&here, p, 8);
-	std::memcpy(&left, p - 1, 8);
-	std::memcpy(&right, p + 1, 8);
-	/* labels are 0, 1, 9, 25: bit 3 marks a followed pixel, bit 4 one
-	 * whose right neighbour is background */
-	const std::uint64_t b0 = here & kOnes, b3 = (here >> 3) & kOnes, b4 = (here >> 4) & kOnes;
-	const std::uint64_t leftZero = ~left & kOnes, rightZero = ~right & kOnes;
-	return (b0 & ~b3 & leftZero) | (b0 & ~b4 & rightZero);
-}
-
-/* borderStarts for four pixels, given their labels `here`: the form for
- * 32-bit targets, where 64-bit shifts take several instructions. */
+/* Labels of four pixels at p, `here` (their neighbours at p - 1 .. p + 4
+ * must be readable): bit 0 of byte i set where pixel i may start a border
+ * (see borderStartBits), for 32-bit targets, where 64-bit shifts take
+ * several instructions. */
 inline std::uint32_t borderStarts4(const std::uint8_t *p, std::uint32_t here)
 {
-	/* bit 0 of (left | b3) & (right | b4) clear: an outer or a hole start */
+	/* labels are 0, 1, 9, 25: bit 3 marks a followed pixel, bit 4 one
+	 * whose right neighbour is background; bit 0 of (left | b3) & (right |
+	 * b4) clear: an outer or a hole start */
 	return here & ~((load32(p - 1) | here >> 3) & (load32(p + 1) | here >> 4)) & 0x01010101u;
-}
-
-/* Index of the lowest non-zero byte of a non-zero word. */
-int firstByte(std::uint64_t v)
-{
-	/* On 32-bit targets a 64-bit count is a libgcc call. */
-	if constexpr (sizeof(void *) >= 8) {
-		return std::countr_zero(v) >> 3;
-	} else {
-		const auto lo = static_cast<std::uint32_t>(v);
-		return lo ? std::countr_zero(lo) >> 3 : 4 + (std::countr_zero(static_cast<std::uint32_t>(v >> 32)) >> 3);
-	}
 }
 
 float cross(Point2f o, Point2f a, Point2f b)
@@ -222,8 +195,9 @@ void ContourTracer::trace(const EdgeMap &edges, const TraceParams &params, std::
 		buildStepTables(w);
 	stride_ = w;
 	radius2_ = params.cluster_radius * params.cluster_radius;
-	/* Four bytes of padding: follow reads neighbours a word at a time. */
-	labels_.resize(static_cast<std::size_t>(w) * h + 4);
+	/* Padding: follow reads neighbours a word at a time, and the start
+	 * scan reads a vector past the end of a stretch. */
+	labels_.resize(static_cast<std::size_t>(w) * h + 128);
 	/* Label 1 for every edge pixel; a plain loop over local pointers that
 	 * the compiler vectorises. */
 	{
@@ -292,7 +266,7 @@ void ContourTracer::trace(const EdgeMap &edges, const TraceParams &params, std::
 			}
 		}
 	}
-	startWords_.resize(static_cast<std::size_t>(w) / 8 + 2);
+	startWords_.resize(static_cast<std::size_t>(w) / 64 + 2);
 	for (int y = 1; y < h - 1; ++y) {
 		const std::uint8_t *tileRow = edges.tiles.data() + static_cast<std::size_t>(y / T) * edges.tiles_x;
 		std::uint8_t *row = labels_.data() + static_cast<std::size_t>(y) * w;
@@ -306,22 +280,16 @@ void ContourTracer::trace(const EdgeMap &edges, const TraceParams &params, std::
 			const int x0 = std::max(1, tx * T), x1 = std::min(w - 1, tEnd * T);
 			tx = tEnd;
 			if constexpr (std::endian::native == std::endian::little && sizeof(void *) >= 8) {
-				/* Where borders may start, for the whole stretch first,
-				 * without a branch per word (most words hold none, but
-				 * which ones is unpredictable); then each candidate is
+				/* Where borders may start, for the whole stretch first
+				 * (one bit a pixel, vectorised); then each candidate is
 				 * checked again, since following and sealing only ever
-				 * take starts away, never add one. Little-endian: the
-				 * lowest byte is the leftmost pixel. */
-				const int words = (x1 - x0 + 7) / 8;
+				 * take starts away, never add one. */
 				std::uint64_t *starts = startWords_.data();
-				for (int k = 0; k < words; ++k)
-					starts[k] = borderStarts(row + x0 + 8 * k);
-				const int tail = (x1 - x0) - 8 * (words - 1); /* 1..8 valid bytes */
-				if (tail < 8)
-					starts[words - 1] &= (std::uint64_t{ 1 } << (8 * tail)) - 1;
+				borderStartBits(row, x0, x1, starts);
+				const int words = (x1 - x0 + 63) / 64;
 				for (int k = 0; k < words; ++k)
 					for (std::uint64_t m = starts[k]; m != 0; m &= m - 1)
-						tryStart(row, x0 + 8 * k + firstByte(m), y);
+						tryStart(row, x0 + 64 * k + std::countr_zero(m), y);
 			} else {
 				for (int x = x0; x < x1; ++x) {
 					/* Most pixels are background or lie on a border

@@ -65,7 +65,7 @@ private:
 	void sealInside(const Quad &quad, int w, int h);
 
 	std::vector<std::uint8_t> labels_;
-	std::vector<std::uint64_t> startWords_; ///< border starts of a row's stretch, 8 pixels a word
+	std::vector<std::uint64_t> startWords_; ///< border starts of a row's stretch, a bit a pixel
 	/// Suzuki's step 3.3 for this width, in one of two forms. On 64-bit
 	/// targets each edge pixel's eight neighbours are first gathered into
 	/// one byte of masks_ (a vectorised pass over the occupied tiles), and

@@ -11,7 +11,7 @@
 
 #include "contour_trace.h"
 #include "frappe/edge_map.h"
-#include "neighbour_masks.h"
+#include "trace_rows.h"
 
 using namespace frappe;
 using namespace frappe::detail;
@@ -317,23 +317,79 @@ void expectVectorMasksMatchScalar(const char *target)
 	EXPECT_GT(compared, 500);
 }
 
-} // namespace
+void expectVectorStartsMatchScalar(const char *target)
+{
+	const int w = 301;
+	std::mt19937 rng(9);
+	std::vector<std::uint8_t> row(w + 128);
+	const std::uint8_t pick[6] = { 0, 0, 1, 9, 25, 1 };
+	for (std::uint8_t &v : row)
+		v = pick[rng() % 6];
+	std::vector<std::uint64_t> a(8), b(8);
+	int compared = 0;
+	for (int x0 = 1; x0 < 70; x0 += 3)
+		for (int x1 = x0; x1 <= w - 1; x1 += 5) {
+			std::fill(a.begin(), a.end(), ~std::uint64_t{ 0 });
+			std::fill(b.begin(), b.end(), ~std::uint64_t{ 0 });
+			borderStartBits(row.data(), x0, x1, a.data());
+			borderStartBitsScalar(row.data(), x0, x1, b.data());
+			const int words = (x1 - x0 + 63) / 64;
+			for (int k = 0; k < words; ++k)
+				ASSERT_EQ(a[k], b[k]) << target << ": x in [" << x0 << ", " << x1 << "), word " << k;
+			ASSERT_EQ(a[words], ~std::uint64_t{ 0 }) << target << ": wrote past the last word";
+			++compared;
+		}
+	EXPECT_GT(compared, 1000);
+}
 
-TEST(NeighbourMasks, VectorFormMatchesTheScalarOne)
+/* Runs `check` on every Highway target this CPU has, or once without. */
+template <class F>
+void onEveryTarget(F check)
 {
 #ifdef FRAPPE_TEST_HWY_TARGETS
 	int targets = 0;
 	for (const std::int64_t t : hwy::SupportedAndGeneratedTargets()) {
 		hwy::SetSupportedTargetsForTest(t);
-		expectVectorMasksMatchScalar(hwy::TargetName(t));
+		check(hwy::TargetName(t));
 		std::printf("compared on %s\n", hwy::TargetName(t));
 		++targets;
 	}
 	hwy::SetSupportedTargetsForTest(0);
 	EXPECT_GE(targets, 1);
 #else
-	expectVectorMasksMatchScalar("scalar build");
+	check("scalar build");
 #endif
+}
+
+} // namespace
+
+TEST(NeighbourMasks, VectorFormMatchesTheScalarOne)
+{
+	onEveryTarget(expectVectorMasksMatchScalar);
+}
+
+/* Outer borders start at an unfollowed pixel after background, hole
+ * borders at any edge pixel not marked "right is background" before
+ * background. */
+TEST(BorderStarts, BitsMarkOuterAndHoleStarts)
+{
+	/*                     x: 0  1  2  3   4  5  6  7  8   9 10 */
+	const std::uint8_t row[11 + 128] = { 0, 1, 1, 0, 9, 0, 25, 0, 1, 25, 9 };
+	std::uint64_t bits[2] = { 0, 0 };
+	borderStartBitsScalar(row, 1, 10, bits);
+	/* 1: outer (0 on its left); 2: hole (0 on its right); 4: followed,
+	 * 0 on its right: hole; 6: right-bg marked: none; 8: outer, and its
+	 * right is 25, so no hole; 9: none (marked, and 9 on its right). */
+	const std::uint64_t expect = (1u << (1 - 1)) | (1u << (2 - 1)) | (1u << (4 - 1)) | (1u << (8 - 1));
+	EXPECT_EQ(bits[0], expect);
+	std::uint64_t vbits[2] = { 0, 0 };
+	borderStartBits(row, 1, 10, vbits);
+	EXPECT_EQ(vbits[0], expect);
+}
+
+TEST(BorderStarts, VectorFormMatchesTheScalarOne)
+{
+	onEveryTarget(expectVectorStartsMatchScalar);
 }
 
 /* Frames wider than 16-bit moves reach follow the neighbourhood from three

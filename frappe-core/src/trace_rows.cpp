@@ -1,12 +1,14 @@
 // SPDX-License-Identifier: MIT
-// Eight-neighbour masks for the contour tracer (see neighbour_masks.h),
-// vectorised with Highway where it is built in, else a plain loop.
+// The contour tracer's row passes (see trace_rows.h), vectorised with
+// Highway where it is built in, else plain loops.
 
-#include "neighbour_masks.h"
+#include "trace_rows.h"
+
+#include <cstring>
 
 #ifdef FRAPPE_HAVE_HWY
 #undef HWY_TARGET_INCLUDE
-#define HWY_TARGET_INCLUDE "neighbour_masks.cpp"
+#define HWY_TARGET_INCLUDE "trace_rows.cpp"
 #include <hwy/foreach_target.h> // IWYU pragma: keep
 
 #include <hwy/highway.h>
@@ -68,6 +70,35 @@ void NeighbourMaskRow(const std::uint8_t *row, std::ptrdiff_t stride, int x0, in
 #endif
 }
 
+void BorderStartBits(const std::uint8_t *labels, int x0, int x1, std::uint64_t *bits)
+{
+#if HWY_TARGET == HWY_SCALAR
+	borderStartBitsScalar(labels, x0, x1, bits);
+#else
+	const hn::ScalableTag<std::uint8_t> d8;
+	const int N = static_cast<int>(hn::Lanes(d8)); /* a multiple of 16 */
+	const auto zero = hn::Zero(d8), unfollowed = hn::Set(d8, kUnfollowed);
+	const auto one = hn::Set(d8, 1), rightBg = hn::Set(d8, kFollowedRightBg ^ kFollowed);
+	auto *out = reinterpret_cast<std::uint8_t *>(bits);
+	int x = x0;
+	for (; x < x1; x += N) {
+		const auto here = hn::LoadU(d8, labels + x);
+		const auto left = hn::LoadU(d8, labels + x - 1), right = hn::LoadU(d8, labels + x + 1);
+		const auto outer = hn::And(hn::Eq(here, unfollowed), hn::Eq(left, zero));
+		const auto hole = hn::And(hn::And(hn::TestBit(here, one), hn::Not(hn::TestBit(here, rightBg))),
+					  hn::Eq(right, zero));
+		auto starts = hn::Or(outer, hole);
+		if (x + N > x1)
+			starts = hn::And(starts, hn::FirstN(d8, static_cast<std::size_t>(x1 - x)));
+		hn::StoreMaskBits(d8, starts, out + (x - x0) / 8);
+	}
+	/* Clear the rest of the last word. */
+	const int done = (x - x0) / 8, end = ((x1 - x0 + 63) / 64) * 8;
+	if (done < end)
+		std::memset(out + done, 0, static_cast<std::size_t>(end - done));
+#endif
+}
+
 } // namespace HWY_NAMESPACE
 } // namespace frappe::detail
 HWY_AFTER_NAMESPACE();
@@ -85,17 +116,42 @@ void neighbourMasksScalar(const std::uint8_t *row, std::ptrdiff_t stride, int x0
 			(row[x - 1] & 1) << 4 | (down[x - 1] & 1) << 5 | (down[x] & 1) << 6 | (down[x + 1] & 1) << 7);
 }
 
+void borderStartBitsScalar(const std::uint8_t *labels, int x0, int x1, std::uint64_t *bits)
+{
+	const int words = (x1 - x0 + 63) / 64;
+	for (int k = 0; k < words; ++k)
+		bits[k] = 0;
+	for (int x = x0; x < x1; ++x) {
+		const std::uint8_t f = labels[x];
+		const bool outer = f == kUnfollowed && labels[x - 1] == 0;
+		const bool hole = (f & 1) && !(f & (kFollowedRightBg ^ kFollowed)) && labels[x + 1] == 0;
+		if (outer || hole)
+			bits[(x - x0) / 64] |= std::uint64_t{ 1 } << ((x - x0) % 64);
+	}
+}
+
 #ifdef FRAPPE_HAVE_HWY
 HWY_EXPORT(NeighbourMaskRow);
+HWY_EXPORT(BorderStartBits);
 
 void neighbourMasks(const std::uint8_t *row, std::ptrdiff_t stride, int x0, int x1, std::uint8_t *out)
 {
 	HWY_DYNAMIC_DISPATCH(NeighbourMaskRow)(row, stride, x0, x1, out);
 }
+
+void borderStartBits(const std::uint8_t *labels, int x0, int x1, std::uint64_t *bits)
+{
+	HWY_DYNAMIC_DISPATCH(BorderStartBits)(labels, x0, x1, bits);
+}
 #else
 void neighbourMasks(const std::uint8_t *row, std::ptrdiff_t stride, int x0, int x1, std::uint8_t *out)
 {
 	neighbourMasksScalar(row, stride, x0, x1, out);
+}
+
+void borderStartBits(const std::uint8_t *labels, int x0, int x1, std::uint64_t *bits)
+{
+	borderStartBitsScalar(labels, x0, x1, bits);
 }
 #endif
 
