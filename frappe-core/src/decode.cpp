@@ -129,6 +129,15 @@ inline int bitCount(std::uint64_t v)
 }
 #endif
 
+/* rotations[r]: the code as read with quad corner r as the top-left. Reading
+ * from corner 1 sees the grid turned a quarter anticlockwise, i.e. three
+ * quarter turns clockwise; from corner 3, one. */
+std::array<std::uint64_t, 4> rotationsOf(std::uint64_t code, int bits)
+{
+	const std::uint64_t one = rotateCode(code, bits), two = rotateCode(one, bits);
+	return { code, rotateCode(two, bits), two, one };
+}
+
 } // namespace
 
 /* The nearest codeword is a popcount per codeword and rotation; without
@@ -139,17 +148,7 @@ __attribute__((target_clones("popcnt", "default")))
 #endif
 Decoded decode(const Dictionary &dict, std::uint64_t code, int maxHamming)
 {
-	/* rotations[r]: the code as read with quad corner r as the top-left.
-	 * Reading from corner 1 sees the grid turned a quarter anticlockwise,
-	 * i.e. three quarter turns clockwise. */
-	std::uint64_t rotations[4];
-	rotations[0] = code;
-	for (int r = 1; r < 4; ++r) {
-		std::uint64_t c = rotations[r - 1];
-		for (int t = 0; t < 3; ++t)
-			c = rotateCode(c, dict.bits);
-		rotations[r] = c;
-	}
+	const std::array<std::uint64_t, 4> rotations = rotationsOf(code, dict.bits);
 	Decoded best;
 	int bestDist = maxHamming + 1;
 	bool ambiguous = false;
@@ -180,6 +179,36 @@ Decoded decode(const Dictionary &dict, std::uint64_t code, int maxHamming)
 	if (best.id < 0 || ambiguous)
 		return {};
 	return best;
+}
+
+CodeBook::CodeBook(const Dictionary &dict) : dict_(&dict)
+{
+	sorted_.reserve(dict.codes.size());
+	for (int id = 0; id < dict.size(); ++id)
+		sorted_.emplace_back(dict.codes[id], id);
+	std::sort(sorted_.begin(), sorted_.end());
+}
+
+Decoded CodeBook::decode(std::uint64_t code, int maxHamming) const
+{
+	if (maxHamming < 0)
+		return {};
+	/* decode() takes the lowest id at distance 0 and the lowest rotation
+	 * for it, and calls two ids at distance 0 ambiguous. */
+	const std::array<std::uint64_t, 4> rotations = rotationsOf(code, dict_->bits);
+	Decoded exact;
+	for (int r = 0; r < 4; ++r) {
+		auto it = std::lower_bound(sorted_.begin(), sorted_.end(), std::make_pair(rotations[r], -1));
+		for (; it != sorted_.end() && it->first == rotations[r]; ++it) {
+			if (exact.id < 0)
+				exact = { it->second, 0, r };
+			else if (it->second != exact.id)
+				return {};
+		}
+	}
+	if (exact.id >= 0)
+		return exact;
+	return maxHamming > 0 ? frappe::detail::decode(*dict_, code, maxHamming) : Decoded{};
 }
 
 } // namespace frappe::detail

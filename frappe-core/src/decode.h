@@ -59,4 +59,19 @@ struct Decoded {
 /// within maxHamming or the nearest is ambiguous.
 Decoded decode(const Dictionary &dict, std::uint64_t code, int maxHamming);
 
+/// A dictionary's codes sorted for exact lookup. Most markers read without a
+/// wrong bit, and finding their code by binary search skips decode()'s scan
+/// of every code in four rotations; the answer is always decode()'s.
+class CodeBook
+{
+public:
+	explicit CodeBook(const Dictionary &dict);
+	const Dictionary &dictionary() const { return *dict_; }
+	Decoded decode(std::uint64_t code, int maxHamming) const;
+
+private:
+	const Dictionary *dict_;
+	std::vector<std::pair<std::uint64_t, int>> sorted_; ///< (code, id), by code
+};
+
 } // namespace frappe::detail

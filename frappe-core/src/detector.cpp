@@ -117,8 +117,8 @@ public:
 		int borderErrors;
 	};
 
-	TracedMarkerProbe(const ImageView &image, float scale, const Dictionary &dict, std::vector<Read> &reads)
-		: image_(image), scale_(scale), dict_(dict), reads_(reads)
+	TracedMarkerProbe(const ImageView &image, float scale, const detail::CodeBook &codes, std::vector<Read> &reads)
+		: image_(image), scale_(scale), codes_(codes), dict_(codes.dictionary()), reads_(reads)
 	{
 		reads_.clear();
 	}
@@ -138,12 +138,13 @@ public:
 		 * dictionary and a generous max_hamming a third of all bit patterns
 		 * are within reach of some codeword. */
 		return b.contrast >= 10.0f && b.border_errors <= allowedBorderErrors(dict_.bits) &&
-		       detail::decode(dict_, b.code, 0).id >= 0;
+		       codes_.decode(b.code, 0).id >= 0;
 	}
 
 private:
 	const ImageView &image_;
 	float scale_;
+	const detail::CodeBook &codes_;
 	const Dictionary &dict_;
 	std::vector<Read> &reads_;
 	detail::WarpedMarker cellCentres_;
@@ -172,6 +173,7 @@ std::string_view stageName(Stage stage)
 struct Detector::Impl {
 	Config config;
 	const Dictionary *dict = nullptr;
+	std::unique_ptr<detail::CodeBook> codes;
 	int maxHamming = 0;
 	FrontEndParams params;
 	std::unique_ptr<FrontEnd> frontEnd;
@@ -249,7 +251,7 @@ void Detector::Impl::trace(Slot &slot)
 	tp.cluster_radius = config.corner_cluster_radius;
 	tp.min_side = std::max(4.0f, config.min_marker_side * scale);
 	tp.border_margin = 1.0f;
-	TracedMarkerProbe probe(slot.image, scale, *dict, slot.reads);
+	TracedMarkerProbe probe(slot.image, scale, *codes, slot.reads);
 	tracer.trace(edges, tp, quads, &probe);
 	detail::removeDuplicateQuads(quads, 2.5f);
 	/* Smallest first: a marker's own outline decodes before the outline of
@@ -379,7 +381,7 @@ void Detector::Impl::finish(const ImageView &image, Slot &slot)
 		t = Clock::now();
 		detail::Decoded d;
 		if (b.contrast >= 10.0f && b.border_errors <= borderAllowance)
-			d = detail::decode(*dict, b.code, maxHamming);
+			d = codes->decode(b.code, maxHamming);
 		decodeMs += msSince(t);
 		if (d.id < 0 && refined && b.border_errors < whiteFrame) {
 			/* Refinement can pull a small, blurred marker's sides onto its
@@ -388,7 +390,7 @@ void Detector::Impl::finish(const ImageView &image, Slot &slot)
 			if (detail::warpMarker(image, outline, bits, warped)) {
 				const detail::Binarised bt = detail::binarise(warped, bits);
 				if (bt.contrast >= 10.0f && bt.border_errors <= borderAllowance) {
-					d = detail::decode(*dict, bt.code, maxHamming);
+					d = codes->decode(bt.code, maxHamming);
 					if (d.id >= 0)
 						q.corners = outline;
 				}
@@ -437,6 +439,7 @@ Detector::Detector(const Config &config) : impl_(std::make_unique<Impl>())
 	validate(config, *d);
 	impl_->config = config;
 	impl_->dict = d;
+	impl_->codes = std::make_unique<detail::CodeBook>(*d);
 	impl_->maxHamming = config.max_hamming >= 0 ? config.max_hamming : d->defaultMaxHamming();
 	const double e = static_cast<double>(config.edge_threshold) * 255.0;
 	impl_->params.edge_threshold_sq = static_cast<std::int64_t>(std::floor(e * e));

@@ -131,6 +131,41 @@ TEST_P(DictionaryDecode, OneMoreFlipThanMaxHammingIsRejected)
 	}
 }
 
+/* The code book's exact lookup gives decode()'s answer, field by field:
+ * exact reads in every rotation, reads within and beyond max_hamming, random
+ * words, and the duplicate and rotation-symmetric codes of aruco_original
+ * (two ids at distance 0: ambiguous). */
+TEST_P(DictionaryDecode, CodeBookAnswersAsTheScan)
+{
+	const Dictionary &d = dictionaries()[GetParam()];
+	const detail::CodeBook book(d);
+	const int h = d.defaultMaxHamming();
+	std::mt19937 rng(77 + GetParam());
+	auto expectSame = [&](std::uint64_t seen, int maxHamming) {
+		const detail::Decoded a = detail::decode(d, seen, maxHamming);
+		const detail::Decoded b = book.decode(seen, maxHamming);
+		ASSERT_EQ(b.id, a.id) << d.name << " code " << seen << " h " << maxHamming;
+		ASSERT_EQ(b.hamming, a.hamming) << d.name << " code " << seen;
+		ASSERT_EQ(b.rotation, a.rotation) << d.name << " code " << seen;
+	};
+	const int step = d.size() > 600 ? 7 : 1;
+	int exact = 0;
+	for (int id = 0; id < d.size(); id += step) {
+		std::uint64_t grid = d.codes[id];
+		for (int r = 0; r < 4; ++r, grid = rotateCode(grid, d.bits)) {
+			expectSame(grid, h);
+			expectSame(grid, 0);
+			exact += detail::decode(d, grid, 0).id >= 0;
+			expectSame(flipBits(grid, d.bits, 1 + (id + r) % (h + 1), rng), h);
+		}
+	}
+	EXPECT_GT(exact, d.size() / step);
+	const std::uint64_t all = d.bits * d.bits == 64 ? ~std::uint64_t{ 0 } : (std::uint64_t{ 1 } << (d.bits * d.bits)) - 1;
+	for (int k = 0; k < 200; ++k)
+		expectSame((static_cast<std::uint64_t>(rng()) << 32 | rng()) & all, h);
+	expectSame(d.codes[0], -1);
+}
+
 INSTANTIATE_TEST_SUITE_P(All, DictionaryDecode,
 			 ::testing::Range(0, static_cast<int>(dictionaries().size())),
 			 [](const auto &info) {
