@@ -11,7 +11,7 @@
 //   starts there.
 // Empty 16x16 tiles hold no edge pixel, so the raster scan jumps over them.
 #include "contour_trace.h"
-#include "trace_rows.h"
+#include "trace_kernels.h"
 
 #include <algorithm>
 #include <bit>
@@ -497,7 +497,9 @@ void ContourTracer::follow(int x0, int y0, int fromDir, const EdgeMap &edges)
 	 * make the compiler reload members on every step. */
 	if (points_.size() < 1024)
 		points_.resize(1024);
-	std::uint32_t *out = points_.data(), *outEnd = out + points_.size();
+	/* The last kPointsPadding points stay free: sideCoverage reads a vector
+	 * at a time. */
+	std::uint32_t *out = points_.data(), *outEnd = out + points_.size() - kPointsPadding;
 	std::uint32_t xy = static_cast<std::uint32_t>(x0) | static_cast<std::uint32_t>(y0) << 16;
 
 	/* Pointer offsets of the eight neighbours, in kDx/kDy order. */
@@ -543,8 +545,8 @@ void ContourTracer::follow(int x0, int y0, int fromDir, const EdgeMap &edges)
 				if (n > 4 * labels_.size())
 					break;
 				points_.resize(2 * n);
-				out = points_.data() + n;
-				outEnd = points_.data() + points_.size();
+				out = points_.data() + (n - kPointsPadding);
+				outEnd = points_.data() + points_.size() - kPointsPadding;
 			}
 			const std::ptrdiff_t next = i + st.offset;
 			if (i == i1 && next == i0) [[unlikely]]
@@ -576,8 +578,8 @@ void ContourTracer::follow(int x0, int y0, int fromDir, const EdgeMap &edges)
 			if (n > maxSteps) /* only on a corrupt label image */
 				break;
 			points_.resize(2 * n);
-			out = points_.data() + n;
-			outEnd = points_.data() + points_.size();
+			out = points_.data() + (n - kPointsPadding);
+			outEnd = points_.data() + points_.size() - kPointsPadding;
 		}
 		std::uint8_t *const next = p + (step >> 12);
 		/* 3.5: back at the start, about to repeat the first move. */
@@ -693,7 +695,7 @@ bool ContourTracer::quadFromOutline(Quad &quad) const
 	return true;
 }
 
-bool ContourTracer::acceptQuad(const TraceParams &params, int w, int h, Quad &quad) const
+bool ContourTracer::acceptQuad(const TraceParams &params, int w, int h, Quad &quad)
 {
 	auto &q = quad.corners;
 	/* Convex, and oriented clockwise on screen (positive cross in y-down). */
@@ -729,38 +731,34 @@ bool ContourTracer::acceptQuad(const TraceParams &params, int w, int h, Quad &qu
 	 * still covers the four sides, and is kept. */
 	/* Per side: unit normal n and offset c (n . p = c on the side), and the
 	 * bin of a point along it, t = (u . p - t0) * kBins / len. */
-	constexpr int kBins = 16;
-	float nx[4], ny[4], nc[4], ux[4], uy[4], t0[4];
-	for (int i = 0; i < 4; ++i) {
-		const Point2f a = q[i], b = q[(i + 1) & 3];
-		const float len = std::sqrt(dist2(a, b));
-		nx[i] = -(b.y - a.y) / len;
-		ny[i] = (b.x - a.x) / len;
-		nc[i] = nx[i] * a.x + ny[i] * a.y;
-		ux[i] = (b.x - a.x) / (len * len) * kBins;
-		uy[i] = (b.y - a.y) / (len * len) * kBins;
-		t0[i] = ux[i] * a.x + uy[i] * a.y;
-	}
+	constexpr int kBins = kSideBins;
 	const float shortSide = std::sqrt(shortest);
 	const float tol = std::max(1.5f, 0.06f * shortSide);
 	/* A bin is 1/16 of a side: on long sides every point is not needed to
 	 * cover one. A border step is at most sqrt(2) px, so every L/24-th point
 	 * is at most L/17 apart: still one in every bin the border runs along. */
 	const std::size_t stride = std::max(1, static_cast<int>(shortSide / (1.5f * kBins)));
-	std::uint32_t covered[4] = {};
-	const std::size_t n = static_cast<std::size_t>(steps_);
-	for (std::size_t k = 0; k < n; k += stride) {
-		const float px = static_cast<float>(points_[k] & 0xFFFFu), py = static_cast<float>(points_[k] >> 16);
-		for (int i = 0; i < 4; ++i) {
-			if (std::abs(nx[i] * px + ny[i] * py - nc[i]) > tol)
-				continue;
-			const float t = ux[i] * px + uy[i] * py - t0[i];
-			if (t >= 0.0f && t < static_cast<float>(kBins))
-				covered[i] |= 1u << static_cast<int>(t);
-		}
+	const std::uint32_t *pts = points_.data();
+	std::size_t n = static_cast<std::size_t>(steps_);
+	if (stride > 1) {
+		sampled_.resize(n / stride + 1 + kPointsPadding);
+		std::size_t m = 0;
+		for (std::size_t k = 0; k < n; k += stride)
+			sampled_[m++] = pts[k];
+		pts = sampled_.data();
+		n = m;
 	}
 	for (int i = 0; i < 4; ++i) {
-		if (std::popcount(covered[i]) < kBins * 7 / 16)
+		const Point2f a = q[i], b = q[(i + 1) & 3];
+		const float len = std::sqrt(dist2(a, b));
+		SideLine side;
+		side.nx = -(b.y - a.y) / len;
+		side.ny = (b.x - a.x) / len;
+		side.nc = side.nx * a.x + side.ny * a.y;
+		side.ux = (b.x - a.x) / (len * len) * kBins;
+		side.uy = (b.y - a.y) / (len * len) * kBins;
+		side.t0 = side.ux * a.x + side.uy * a.y;
+		if (std::popcount(sideCoverage(pts, n, side, tol)) < kBins * 7 / 16)
 			return false;
 	}
 	return true;

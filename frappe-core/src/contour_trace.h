@@ -61,7 +61,7 @@ private:
 	bool spansAtLeast(float span) const; ///< the last border's bounding box
 	bool quadFromClusters(Quad &quad) const;
 	bool quadFromOutline(Quad &quad) const;
-	bool acceptQuad(const TraceParams &params, int w, int h, Quad &quad) const;
+	bool acceptQuad(const TraceParams &params, int w, int h, Quad &quad);
 	void sealInside(const Quad &quad, int w, int h);
 
 	std::vector<std::uint8_t> labels_;
@@ -87,6 +87,7 @@ private:
 	/// The last border's pixels as x | y << 16; only the first steps_ are
 	/// valid (follow writes through a local pointer and grows it itself).
 	std::vector<std::uint32_t> points_;
+	std::vector<std::uint32_t> sampled_; ///< acceptQuad's every stride-th point
 	int steps_ = 0;
 	bool tooManyClusters_ = false;
 	int borders_ = 0;

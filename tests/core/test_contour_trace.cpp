@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: MIT
 // Suzuki border following and candidate selection on hand-made edge maps.
+#include <cmath>
 #include <cstdio>
 #include <random>
 
@@ -11,7 +12,7 @@
 
 #include "contour_trace.h"
 #include "frappe/edge_map.h"
-#include "trace_rows.h"
+#include "trace_kernels.h"
 
 using namespace frappe;
 using namespace frappe::detail;
@@ -342,6 +343,46 @@ void expectVectorStartsMatchScalar(const char *target)
 	EXPECT_GT(compared, 1000);
 }
 
+void expectVectorCoverageMatchesScalar(const char *target)
+{
+	/* Points scattered about a side of a random quad, many within the
+	 * tolerance and on bin edges (whole-pixel corners), counts covering
+	 * every tail length. */
+	std::mt19937 rng(21);
+	std::uniform_real_distribution<float> coord(20.0f, 200.0f);
+	int compared = 0, nonzero = 0;
+	for (int trial = 0; trial < 300; ++trial) {
+		const Point2f a{ std::floor(coord(rng)), std::floor(coord(rng)) };
+		const Point2f b{ std::floor(coord(rng)), std::floor(coord(rng)) };
+		const float len = std::hypot(b.x - a.x, b.y - a.y);
+		if (len < 8.0f)
+			continue;
+		SideLine side;
+		side.nx = -(b.y - a.y) / len;
+		side.ny = (b.x - a.x) / len;
+		side.nc = side.nx * a.x + side.ny * a.y;
+		side.ux = (b.x - a.x) / (len * len) * kSideBins;
+		side.uy = (b.y - a.y) / (len * len) * kSideBins;
+		side.t0 = side.ux * a.x + side.uy * a.y;
+		const int n = trial % 70;
+		std::vector<std::uint32_t> pts(n + kPointsPadding, 0xFFFFFFFFu);
+		for (int k = 0; k < n; ++k) {
+			const float s = std::uniform_real_distribution<float>(-0.1f, 1.1f)(rng);
+			const float off = std::uniform_real_distribution<float>(-3.0f, 3.0f)(rng);
+			const int x = static_cast<int>(std::lround(a.x + s * (b.x - a.x) + off * side.nx));
+			const int y = static_cast<int>(std::lround(a.y + s * (b.y - a.y) + off * side.ny));
+			pts[k] = static_cast<std::uint32_t>(x) | static_cast<std::uint32_t>(y) << 16;
+		}
+		const float tol = 1.5f + static_cast<float>(trial % 3);
+		const std::uint32_t want = sideCoverageScalar(pts.data(), n, side, tol);
+		ASSERT_EQ(sideCoverage(pts.data(), n, side, tol), want) << target << ": trial " << trial << " n " << n;
+		++compared;
+		nonzero += want != 0;
+	}
+	EXPECT_GT(compared, 250);
+	EXPECT_GT(nonzero, 200);
+}
+
 /* Runs `check` on every Highway target this CPU has, or once without. */
 template <class F>
 void onEveryTarget(F check)
@@ -390,6 +431,31 @@ TEST(BorderStarts, BitsMarkOuterAndHoleStarts)
 TEST(BorderStarts, VectorFormMatchesTheScalarOne)
 {
 	onEveryTarget(expectVectorStartsMatchScalar);
+}
+
+/* A side's sixteen bins: a point on the line in each bin sets that bit,
+ * one beyond the tolerance or past either end sets none. */
+TEST(SideCoverage, BinsAlongTheSide)
+{
+	/* The side from (10, 20) to (42, 20): 2 px a bin. */
+	SideLine side{ 0.0f, 1.0f, 20.0f, 0.5f, 0.0f, 5.0f };
+	std::vector<std::uint32_t> pts(kPointsPadding + 8, 0);
+	auto at = [](int x, int y) { return static_cast<std::uint32_t>(x) | static_cast<std::uint32_t>(y) << 16; };
+	pts[0] = at(10, 20);   /* bin 0 */
+	pts[1] = at(13, 21);   /* bin 1, 1 px off the line */
+	pts[2] = at(41, 19);   /* bin 15 */
+	pts[3] = at(20, 23);   /* 3 px off: outside a tolerance of 1.5 */
+	pts[4] = at(9, 20);    /* before the start */
+	pts[5] = at(42, 20);   /* at the end: t = 16, outside */
+	EXPECT_EQ(sideCoverageScalar(pts.data(), 6, side, 1.5f), (1u << 0) | (1u << 1) | (1u << 15));
+	EXPECT_EQ(sideCoverage(pts.data(), 6, side, 1.5f), (1u << 0) | (1u << 1) | (1u << 15));
+	EXPECT_EQ(sideCoverage(pts.data(), 6, side, 3.0f), (1u << 0) | (1u << 1) | (1u << 5) | (1u << 15));
+	EXPECT_EQ(sideCoverage(pts.data(), 0, side, 3.0f), 0u);
+}
+
+TEST(SideCoverage, VectorFormMatchesTheScalarOne)
+{
+	onEveryTarget(expectVectorCoverageMatchesScalar);
 }
 
 /* Frames wider than 16-bit moves reach follow the neighbourhood from three

@@ -1,14 +1,17 @@
 // SPDX-License-Identifier: MIT
-// The contour tracer's row passes (see trace_rows.h), vectorised with
-// Highway where it is built in, else plain loops.
+// The contour tracer's data-parallel kernels (see trace_kernels.h),
+// vectorised with Highway where it is built in, else plain loops. The
+// library is built with -ffp-contract=off, so that the float kernels give
+// the scalar ones' results exactly.
 
-#include "trace_rows.h"
+#include "trace_kernels.h"
 
+#include <cmath>
 #include <cstring>
 
 #ifdef FRAPPE_HAVE_HWY
 #undef HWY_TARGET_INCLUDE
-#define HWY_TARGET_INCLUDE "trace_rows.cpp"
+#define HWY_TARGET_INCLUDE "trace_kernels.cpp"
 #include <hwy/foreach_target.h> // IWYU pragma: keep
 
 #include <hwy/highway.h>
@@ -99,6 +102,42 @@ void BorderStartBits(const std::uint8_t *labels, int x0, int x1, std::uint64_t *
 #endif
 }
 
+std::uint32_t SideCoverage(const std::uint32_t *pts, std::size_t n, const SideLine &side, float tol)
+{
+#if HWY_TARGET == HWY_SCALAR
+	return sideCoverageScalar(pts, n, side, tol);
+#else
+	const hn::ScalableTag<std::uint32_t> du;
+	const hn::Rebind<std::int32_t, decltype(du)> di;
+	const hn::Rebind<float, decltype(du)> df;
+	const std::size_t N = hn::Lanes(du);
+	const auto nx = hn::Set(df, side.nx), ny = hn::Set(df, side.ny), nc = hn::Set(df, side.nc);
+	const auto ux = hn::Set(df, side.ux), uy = hn::Set(df, side.uy), t0 = hn::Set(df, side.t0);
+	const auto vTol = hn::Set(df, tol), zero = hn::Zero(df), bins = hn::Set(df, static_cast<float>(kSideBins));
+	const auto low16 = hn::Set(du, 0xFFFFu), one = hn::Set(du, 1u);
+	auto covered = hn::Zero(du);
+	for (std::size_t k = 0; k < n; k += N) {
+		const auto v = hn::LoadU(du, pts + k);
+		const auto x = hn::ConvertTo(df, hn::BitCast(di, hn::And(v, low16)));
+		const auto y = hn::ConvertTo(df, hn::BitCast(di, hn::ShiftRight<16>(v)));
+		const auto d = hn::Abs(hn::Sub(hn::Add(hn::Mul(nx, x), hn::Mul(ny, y)), nc));
+		const auto t = hn::Sub(hn::Add(hn::Mul(ux, x), hn::Mul(uy, y)), t0);
+		auto hit = hn::And(hn::Not(hn::Gt(d, vTol)), hn::And(hn::Ge(t, zero), hn::Lt(t, bins)));
+		if (k + N > n)
+			hit = hn::And(hit, hn::FirstN(df, n - k));
+		/* t is in [0, 16) where it counts: the shift never exceeds 15. */
+		const auto bin = hn::BitCast(du, hn::ConvertTo(di, hn::IfThenElseZero(hit, t)));
+		covered = hn::Or(covered, hn::IfThenElseZero(hn::RebindMask(du, hit), hn::operator<<(one, bin)));
+	}
+	HWY_ALIGN std::uint32_t lanes[HWY_MAX_BYTES / 4];
+	hn::Store(covered, du, lanes);
+	std::uint32_t all = 0;
+	for (std::size_t i = 0; i < N; ++i)
+		all |= lanes[i];
+	return all;
+#endif
+}
+
 } // namespace HWY_NAMESPACE
 } // namespace frappe::detail
 HWY_AFTER_NAMESPACE();
@@ -130,9 +169,29 @@ void borderStartBitsScalar(const std::uint8_t *labels, int x0, int x1, std::uint
 	}
 }
 
+std::uint32_t sideCoverageScalar(const std::uint32_t *pts, std::size_t n, const SideLine &side, float tol)
+{
+	std::uint32_t covered = 0;
+	for (std::size_t k = 0; k < n; ++k) {
+		const float px = static_cast<float>(pts[k] & 0xFFFFu), py = static_cast<float>(pts[k] >> 16);
+		if (std::abs(side.nx * px + side.ny * py - side.nc) > tol)
+			continue;
+		const float t = side.ux * px + side.uy * py - side.t0;
+		if (t >= 0.0f && t < static_cast<float>(kSideBins))
+			covered |= 1u << static_cast<int>(t);
+	}
+	return covered;
+}
+
 #ifdef FRAPPE_HAVE_HWY
 HWY_EXPORT(NeighbourMaskRow);
 HWY_EXPORT(BorderStartBits);
+HWY_EXPORT(SideCoverage);
+
+std::uint32_t sideCoverage(const std::uint32_t *pts, std::size_t n, const SideLine &side, float tol)
+{
+	return HWY_DYNAMIC_DISPATCH(SideCoverage)(pts, n, side, tol);
+}
 
 void neighbourMasks(const std::uint8_t *row, std::ptrdiff_t stride, int x0, int x1, std::uint8_t *out)
 {
@@ -152,6 +211,11 @@ void neighbourMasks(const std::uint8_t *row, std::ptrdiff_t stride, int x0, int 
 void borderStartBits(const std::uint8_t *labels, int x0, int x1, std::uint64_t *bits)
 {
 	borderStartBitsScalar(labels, x0, x1, bits);
+}
+
+std::uint32_t sideCoverage(const std::uint32_t *pts, std::size_t n, const SideLine &side, float tol)
+{
+	return sideCoverageScalar(pts, n, side, tol);
 }
 #endif
 

@@ -1,8 +1,9 @@
 // SPDX-License-Identifier: MIT
-// The contour tracer's passes over whole rows, vectorised where Highway is
-// built in: which pixels may start a border, and each pixel's neighbours as
-// one byte, so that a step of a border reads its neighbourhood with one
-// load instead of assembling it from three rows.
+// The contour tracer's data-parallel kernels, vectorised where Highway is
+// built in: which pixels may start a border, each pixel's neighbours as one
+// byte (so that a step of a border reads its neighbourhood with one load
+// instead of assembling it from three rows), and how much of a quad's side
+// a border covers.
 #pragma once
 
 #include <cstddef>
@@ -30,9 +31,24 @@ void neighbourMasks(const std::uint8_t *row, std::ptrdiff_t stride, int x0, int 
 /// x0 + 64 * words + 1; bits from x1 on are clear.
 void borderStartBits(const std::uint8_t *labels, int x0, int x1, std::uint64_t *bits);
 
+/// A side of a candidate quad: points p on it have nx x + ny y = nc, and
+/// ux x + uy y - t0 runs from 0 to kSideBins along it.
+struct SideLine {
+	float nx, ny, nc, ux, uy, t0;
+};
+constexpr int kSideBins = 16;
+
+/// Bit b set when some point (x | y << 16) of pts[0, n) lies within `tol`
+/// of the side's line, in its b-th sixteenth: |nx x + ny y - nc| <= tol and
+/// b <= ux x + uy y - t0 < b + 1, in float arithmetic without fused
+/// multiply-adds. pts must be readable to n + kPointsPadding.
+std::uint32_t sideCoverage(const std::uint32_t *pts, std::size_t n, const SideLine &side, float tol);
+constexpr std::size_t kPointsPadding = 16;
+
 /// The same without SIMD, the references the vectorised forms are tested
 /// against.
 void neighbourMasksScalar(const std::uint8_t *row, std::ptrdiff_t stride, int x0, int x1, std::uint8_t *out);
 void borderStartBitsScalar(const std::uint8_t *labels, int x0, int x1, std::uint64_t *bits);
+std::uint32_t sideCoverageScalar(const std::uint32_t *pts, std::size_t n, const SideLine &side, float tol);
 
 } // namespace frappe::detail
