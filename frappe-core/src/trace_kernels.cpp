@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: MIT
 // The contour tracer's data-parallel kernels (see trace_kernels.h),
-// vectorised with Highway where it is built in, else plain loops. The
-// library is built with -ffp-contract=off, so that the float kernels give
-// the scalar ones' results exactly.
+// vectorised with Highway where it is built in, else plain loops. With
+// Highway the library is built with -ffp-contract=off, so that the float
+// kernels give the scalar ones' results exactly.
 
 #include "trace_kernels.h"
 
