@@ -17,6 +17,7 @@
 #include <bit>
 #include <cmath>
 #include <cstring>
+#include <span>
 
 namespace frappe::detail {
 
@@ -247,76 +248,87 @@ void ContourTracer::trace(const EdgeMap &edges, const TraceParams &params, std::
 		}
 	};
 
+	/* The runs of occupied tiles in each row of tiles, as column ranges:
+	 * borders run only there. */
 	constexpr int T = EdgeMap::kTile;
-	/* Neighbour masks wherever a border can run: the occupied tiles. */
+	stretches_.clear();
+	stretchRows_.assign(static_cast<std::size_t>(edges.tiles_y) + 1, 0);
+	for (int ty = 0; ty < edges.tiles_y; ++ty) {
+		const std::uint8_t *tileRow = edges.tiles.data() + static_cast<std::size_t>(ty) * edges.tiles_x;
+		for (int tx = 0; tx < edges.tiles_x; ++tx) {
+			if (tileRow[tx] == 0)
+				continue;
+			int tEnd = tx + 1;
+			while (tEnd < edges.tiles_x && tileRow[tEnd])
+				++tEnd;
+			stretches_.push_back({ std::max(1, tx * T), std::min(w - 1, tEnd * T) });
+			tx = tEnd;
+		}
+		stretchRows_[static_cast<std::size_t>(ty) + 1] = static_cast<int>(stretches_.size());
+	}
+	auto stretchesOf = [&](int y) {
+		const std::size_t ty = static_cast<std::size_t>(y / T);
+		return std::span<const std::pair<int, int>>(stretches_.data() + stretchRows_[ty],
+							    stretches_.data() + stretchRows_[ty + 1]);
+	};
+
+	/* Neighbour masks wherever a border can run. */
 	if (useMasks_) {
 		masks_.resize(static_cast<std::size_t>(w) * h);
 		for (int y = 1; y < h - 1; ++y) {
-			const std::uint8_t *tileRow = edges.tiles.data() + static_cast<std::size_t>(y / T) * edges.tiles_x;
 			const std::uint8_t *e = edges.pixels.data() + static_cast<std::size_t>(y) * w;
 			std::uint8_t *m = masks_.data() + static_cast<std::size_t>(y) * w;
-			for (int tx = 0; tx < edges.tiles_x; ++tx) {
-				if (tileRow[tx] == 0)
-					continue;
-				int tEnd = tx + 1;
-				while (tEnd < edges.tiles_x && tileRow[tEnd])
-					++tEnd;
-				neighbourMasks(e, w, std::max(1, tx * T), std::min(w - 1, tEnd * T), m);
-				tx = tEnd;
-			}
+			for (const auto &[x0, x1] : stretchesOf(y))
+				neighbourMasks(e, w, x0, x1, m);
 		}
 	}
 	startWords_.resize(static_cast<std::size_t>(w) / 64 + 2);
 	for (int y = 1; y < h - 1; ++y) {
-		const std::uint8_t *tileRow = edges.tiles.data() + static_cast<std::size_t>(y / T) * edges.tiles_x;
+		const auto stretches = stretchesOf(y);
+		if (stretches.empty())
+			continue;
 		std::uint8_t *row = labels_.data() + static_cast<std::size_t>(y) * w;
-		for (int tx = 0; tx < edges.tiles_x; ++tx) {
-			if (tileRow[tx] == 0)
-				continue;
-			/* Runs of occupied tiles are scanned as one stretch. */
-			int tEnd = tx + 1;
-			while (tEnd < edges.tiles_x && tileRow[tEnd])
-				++tEnd;
-			const int x0 = std::max(1, tx * T), x1 = std::min(w - 1, tEnd * T);
-			tx = tEnd;
-			if constexpr (std::endian::native == std::endian::little && sizeof(void *) >= 8) {
-				/* Where borders may start, for the whole stretch first
-				 * (one bit a pixel, vectorised); then each candidate is
-				 * checked again, since following and sealing only ever
-				 * take starts away, never add one. */
-				std::uint64_t *starts = startWords_.data();
-				borderStartBits(row, x0, x1, starts);
-				const int words = (x1 - x0 + 63) / 64;
-				for (int k = 0; k < words; ++k)
-					for (std::uint64_t m = starts[k]; m != 0; m &= m - 1)
-						tryStart(row, x0 + 64 * k + std::countr_zero(m), y);
-			} else {
-				for (int x = x0; x < x1; ++x) {
-					/* Most pixels are background or lie on a border
-					 * already followed: find the next pixel where a
-					 * border can start, eight at a time, as two words
-					 * (64-bit shifts are library calls here). */
-					if constexpr (std::endian::native == std::endian::little) {
-						if (x + 8 <= x1) {
-							const std::uint32_t h0 = load32(row + x), h1 = load32(row + x + 4);
-							if ((h0 | h1) == 0) {
+		if constexpr (std::endian::native == std::endian::little && sizeof(void *) >= 8) {
+			/* Where borders may start, one bit a pixel, vectorised, from
+			 * the first stretch to the end of the last in one call (the
+			 * empty tiles between hold no label, so no start); then each
+			 * candidate is checked again, since following and sealing
+			 * only ever take starts away, never add one. */
+			const int x0 = stretches.front().first, x1 = stretches.back().second;
+			std::uint64_t *starts = startWords_.data();
+			borderStartBits(row, x0, x1, starts);
+			const int words = (x1 - x0 + 63) / 64;
+			for (int k = 0; k < words; ++k)
+				for (std::uint64_t m = starts[k]; m != 0; m &= m - 1)
+					tryStart(row, x0 + 64 * k + std::countr_zero(m), y);
+			continue;
+		}
+		for (const auto &[x0, x1] : stretches) {
+			for (int x = x0; x < x1; ++x) {
+				/* Most pixels are background or lie on a border
+				 * already followed: find the next pixel where a border
+				 * can start, eight at a time, as two words (64-bit
+				 * shifts are library calls here). */
+				if constexpr (std::endian::native == std::endian::little) {
+					if (x + 8 <= x1) {
+						const std::uint32_t h0 = load32(row + x), h1 = load32(row + x + 4);
+						if ((h0 | h1) == 0) {
+							x += 7;
+							continue;
+						}
+						std::uint32_t s4 = borderStarts4(row + x, h0);
+						if (s4 == 0) {
+							s4 = borderStarts4(row + x + 4, h1);
+							if (s4 == 0) {
 								x += 7;
 								continue;
 							}
-							std::uint32_t s4 = borderStarts4(row + x, h0);
-							if (s4 == 0) {
-								s4 = borderStarts4(row + x + 4, h1);
-								if (s4 == 0) {
-									x += 7;
-									continue;
-								}
-								x += 4;
-							}
-							x += std::countr_zero(s4) >> 3;
+							x += 4;
 						}
+						x += std::countr_zero(s4) >> 3;
 					}
-					tryStart(row, x, y);
 				}
+				tryStart(row, x, y);
 			}
 		}
 	}

@@ -65,7 +65,11 @@ private:
 	void sealInside(const Quad &quad, int w, int h);
 
 	std::vector<std::uint8_t> labels_;
-	std::vector<std::uint64_t> startWords_; ///< border starts of a row's stretch, a bit a pixel
+	std::vector<std::uint64_t> startWords_; ///< border starts of a row, a bit a pixel
+	/// Column ranges of the runs of occupied tiles, row of tiles after row
+	/// of tiles; stretchRows_[ty] is the first of row ty's.
+	std::vector<std::pair<int, int>> stretches_;
+	std::vector<int> stretchRows_;
 	/// Suzuki's step 3.3 for this width, in one of two forms. On 64-bit
 	/// targets each edge pixel's eight neighbours are first gathered into
 	/// one byte of masks_ (a vectorised pass over the occupied tiles), and
