@@ -652,58 +652,13 @@ bool ContourTracer::quadFromOutline(Quad &quad) const
 	const std::size_t n = static_cast<std::size_t>(steps_);
 	if (n < 8)
 		return false;
-	const std::uint32_t *pts = points_.data();
-	auto X = [pts](std::size_t i) { return static_cast<std::int32_t>(pts[i] & 0xFFFFu); };
-	auto Y = [pts](std::size_t i) { return static_cast<std::int32_t>(pts[i] >> 16); };
-	std::int64_t sx = 0, sy = 0;
-	for (std::size_t i = 0; i < n; ++i) {
-		sx += X(i);
-		sy += Y(i);
-	}
-	const double mx = static_cast<double>(sx) / static_cast<double>(n);
-	const double my = static_cast<double>(sy) / static_cast<double>(n);
-	std::size_t i0 = 0;
-	double bd = -1;
-	for (std::size_t i = 0; i < n; ++i) {
-		const double dx = X(i) - mx, dy = Y(i) - my;
-		if (dx * dx + dy * dy > bd) {
-			bd = dx * dx + dy * dy;
-			i0 = i;
-		}
-	}
-	/* The rest in integers (coordinates below 2^15, so squares and cross
-	 * products fit an int32; in float they were exact too). */
-	const int x0 = X(i0), y0 = Y(i0);
-	std::size_t i2 = 0;
-	std::int32_t bd2 = -1;
-	for (std::size_t i = 0; i < n; ++i) {
-		const std::int32_t dx = X(i) - x0, dy = Y(i) - y0;
-		if (dx * dx + dy * dy > bd2) {
-			bd2 = dx * dx + dy * dy;
-			i2 = i;
-		}
-	}
-	const int ex = X(i2) - x0, ey = Y(i2) - y0;
-	std::int32_t most = 0, least = 0;
-	std::size_t i1 = 0, i3 = 0;
-	for (std::size_t i = 0; i < n; ++i) {
-		/* cross(p0, p2, p) */
-		const std::int32_t c = ex * (Y(i) - y0) - ey * (X(i) - x0);
-		if (c > most) {
-			most = c;
-			i1 = i;
-		} else if (c < least) {
-			least = c;
-			i3 = i;
-		}
-	}
-	auto pt = [&](std::size_t i) {
-		return Point2f{ static_cast<float>(X(i)), static_cast<float>(Y(i)) };
-	};
-	const Point2f p0 = pt(i0), p1 = pt(i1), p2 = pt(i2), p3 = pt(i3);
-	if (most <= 0 || least >= 0)
+	const OutlineExtremes e = outlineExtremes(points_.data(), n);
+	if (e.most <= 0 || e.least >= 0)
 		return false;
-	quad.corners = { p0, p1, p2, p3 };
+	auto pt = [this](std::size_t i) {
+		return Point2f{ static_cast<float>(points_[i] & 0xFFFFu), static_cast<float>(points_[i] >> 16) };
+	};
+	quad.corners = { pt(e.i0), pt(e.i1), pt(e.i2), pt(e.i3) };
 	return true;
 }
 

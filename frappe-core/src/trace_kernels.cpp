@@ -6,6 +6,7 @@
 
 #include "trace_kernels.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 
@@ -138,6 +139,123 @@ std::uint32_t SideCoverage(const std::uint32_t *pts, std::size_t n, const SideLi
 #endif
 }
 
+OutlineExtremes OutlineExtremesV(const std::uint32_t *pts, std::size_t n)
+{
+#if HWY_TARGET == HWY_SCALAR
+	return outlineExtremesScalar(pts, n);
+#else
+	const hn::ScalableTag<std::uint32_t> du;
+	const hn::Rebind<std::int32_t, decltype(du)> di;
+	const std::size_t N = hn::Lanes(du);
+	const auto low16 = hn::Set(du, 0xFFFFu);
+	auto X = [&](hn::Vec<decltype(du)> v) HWY_ATTR { return hn::BitCast(di, hn::And(v, low16)); };
+	auto Y = [&](hn::Vec<decltype(du)> v) HWY_ATTR { return hn::BitCast(di, hn::ShiftRight<16>(v)); };
+
+	/* The centroid: sums in 32-bit lanes, emptied before they could
+	 * overflow (2^15 vectors of 16-bit values). */
+	std::uint64_t sx = 0, sy = 0;
+	for (std::size_t k = 0; k < n;) {
+		const std::size_t end = std::min(n, k + N * 32768);
+		auto ax = hn::Zero(du), ay = hn::Zero(du);
+		for (; k < end; k += N) {
+			auto v = hn::LoadU(du, pts + k);
+			if (k + N > n)
+				v = hn::IfThenElseZero(hn::FirstN(du, n - k), v);
+			ax = hn::Add(ax, hn::And(v, low16));
+			ay = hn::Add(ay, hn::ShiftRight<16>(v));
+		}
+		sx += hn::GetLane(hn::SumOfLanes(du, ax));
+		sy += hn::GetLane(hn::SumOfLanes(du, ay));
+	}
+	OutlineExtremes e;
+
+	/* i0 in double, as the scalar form: the largest distance, then the
+	 * first point at it. */
+	{
+		const hn::ScalableTag<double> dd;
+		const hn::Rebind<std::uint32_t, decltype(dd)> duh;
+		const hn::Rebind<std::int32_t, decltype(dd)> dih;
+		const std::size_t M = hn::Lanes(dd);
+		const auto mx = hn::Set(dd, static_cast<double>(sx) / static_cast<double>(n));
+		const auto my = hn::Set(dd, static_cast<double>(sy) / static_cast<double>(n));
+		const auto low16h = hn::Set(duh, 0xFFFFu);
+		const auto none = hn::Set(dd, -1.0);
+		auto dist = [&](std::size_t k) HWY_ATTR {
+			const auto v = hn::LoadU(duh, pts + k);
+			const auto dx = hn::Sub(hn::PromoteTo(dd, hn::BitCast(dih, hn::And(v, low16h))), mx);
+			const auto dy = hn::Sub(hn::PromoteTo(dd, hn::BitCast(dih, hn::ShiftRight<16>(v))), my);
+			const auto d = hn::Add(hn::Mul(dx, dx), hn::Mul(dy, dy));
+			return k + M > n ? hn::IfThenElse(hn::FirstN(dd, n - k), d, none) : d;
+		};
+		auto best = none;
+		for (std::size_t k = 0; k < n; k += M)
+			best = hn::Max(best, dist(k));
+		const auto top = hn::MaxOfLanes(dd, best);
+		for (std::size_t k = 0; k < n; k += M) {
+			const intptr_t at = hn::FindFirstTrue(dd, hn::Eq(dist(k), top));
+			if (at >= 0) {
+				e.i0 = k + static_cast<std::size_t>(at);
+				break;
+			}
+		}
+	}
+
+	/* The rest in int32, like the scalar form. */
+	const auto x0 = hn::Set(di, static_cast<std::int32_t>(pts[e.i0] & 0xFFFFu));
+	const auto y0 = hn::Set(di, static_cast<std::int32_t>(pts[e.i0] >> 16));
+	auto firstWhere = [&](auto value, hn::Vec<decltype(di)> target) HWY_ATTR {
+		for (std::size_t k = 0; k < n; k += N) {
+			auto m = hn::Eq(value(k), target);
+			if (k + N > n)
+				m = hn::And(m, hn::FirstN(di, n - k));
+			const intptr_t at = hn::FindFirstTrue(di, m);
+			if (at >= 0)
+				return k + static_cast<std::size_t>(at);
+		}
+		return std::size_t{ 0 };
+	};
+	{
+		auto dist = [&](std::size_t k) HWY_ATTR {
+			const auto v = hn::LoadU(du, pts + k);
+			const auto dx = hn::Sub(X(v), x0), dy = hn::Sub(Y(v), y0);
+			return hn::Add(hn::Mul(dx, dx), hn::Mul(dy, dy));
+		};
+		auto best = hn::Set(di, -1);
+		for (std::size_t k = 0; k < n; k += N) {
+			auto d = dist(k);
+			if (k + N > n)
+				d = hn::IfThenElse(hn::FirstN(di, n - k), d, hn::Set(di, -1));
+			best = hn::Max(best, d);
+		}
+		e.i2 = firstWhere(dist, hn::MaxOfLanes(di, best));
+	}
+	{
+		const auto ex = hn::Sub(hn::Set(di, static_cast<std::int32_t>(pts[e.i2] & 0xFFFFu)), x0);
+		const auto ey = hn::Sub(hn::Set(di, static_cast<std::int32_t>(pts[e.i2] >> 16)), y0);
+		auto cross = [&](std::size_t k) HWY_ATTR {
+			const auto v = hn::LoadU(du, pts + k);
+			return hn::Sub(hn::Mul(ex, hn::Sub(Y(v), y0)), hn::Mul(ey, hn::Sub(X(v), x0)));
+		};
+		auto most = hn::Zero(di), least = hn::Zero(di);
+		for (std::size_t k = 0; k < n; k += N) {
+			auto c = cross(k);
+			if (k + N > n)
+				c = hn::IfThenElseZero(hn::FirstN(di, n - k), c);
+			most = hn::Max(most, c);
+			least = hn::Min(least, c);
+		}
+		const auto mostV = hn::MaxOfLanes(di, most), leastV = hn::MinOfLanes(di, least);
+		e.most = hn::GetLane(mostV);
+		e.least = hn::GetLane(leastV);
+		if (e.most > 0)
+			e.i1 = firstWhere(cross, mostV);
+		if (e.least < 0)
+			e.i3 = firstWhere(cross, leastV);
+	}
+	return e;
+#endif
+}
+
 } // namespace HWY_NAMESPACE
 } // namespace frappe::detail
 HWY_AFTER_NAMESPACE();
@@ -183,10 +301,62 @@ std::uint32_t sideCoverageScalar(const std::uint32_t *pts, std::size_t n, const 
 	return covered;
 }
 
+OutlineExtremes outlineExtremesScalar(const std::uint32_t *pts, std::size_t n)
+{
+	auto X = [pts](std::size_t i) { return static_cast<std::int32_t>(pts[i] & 0xFFFFu); };
+	auto Y = [pts](std::size_t i) { return static_cast<std::int32_t>(pts[i] >> 16); };
+	std::int64_t sx = 0, sy = 0;
+	for (std::size_t i = 0; i < n; ++i) {
+		sx += X(i);
+		sy += Y(i);
+	}
+	const double mx = static_cast<double>(sx) / static_cast<double>(n);
+	const double my = static_cast<double>(sy) / static_cast<double>(n);
+	OutlineExtremes e;
+	double bd = -1;
+	for (std::size_t i = 0; i < n; ++i) {
+		const double dx = X(i) - mx, dy = Y(i) - my;
+		if (dx * dx + dy * dy > bd) {
+			bd = dx * dx + dy * dy;
+			e.i0 = i;
+		}
+	}
+	/* The rest in integers (coordinates below 2^15, so squares and cross
+	 * products fit an int32). */
+	const std::int32_t x0 = X(e.i0), y0 = Y(e.i0);
+	std::int32_t bd2 = -1;
+	for (std::size_t i = 0; i < n; ++i) {
+		const std::int32_t dx = X(i) - x0, dy = Y(i) - y0;
+		if (dx * dx + dy * dy > bd2) {
+			bd2 = dx * dx + dy * dy;
+			e.i2 = i;
+		}
+	}
+	const std::int32_t ex = X(e.i2) - x0, ey = Y(e.i2) - y0;
+	for (std::size_t i = 0; i < n; ++i) {
+		/* cross(p0, p2, p) */
+		const std::int32_t c = ex * (Y(i) - y0) - ey * (X(i) - x0);
+		if (c > e.most) {
+			e.most = c;
+			e.i1 = i;
+		} else if (c < e.least) {
+			e.least = c;
+			e.i3 = i;
+		}
+	}
+	return e;
+}
+
 #ifdef FRAPPE_HAVE_HWY
 HWY_EXPORT(NeighbourMaskRow);
 HWY_EXPORT(BorderStartBits);
 HWY_EXPORT(SideCoverage);
+HWY_EXPORT(OutlineExtremesV);
+
+OutlineExtremes outlineExtremes(const std::uint32_t *pts, std::size_t n)
+{
+	return HWY_DYNAMIC_DISPATCH(OutlineExtremesV)(pts, n);
+}
 
 std::uint32_t sideCoverage(const std::uint32_t *pts, std::size_t n, const SideLine &side, float tol)
 {
@@ -216,6 +386,11 @@ void borderStartBits(const std::uint8_t *labels, int x0, int x1, std::uint64_t *
 std::uint32_t sideCoverage(const std::uint32_t *pts, std::size_t n, const SideLine &side, float tol)
 {
 	return sideCoverageScalar(pts, n, side, tol);
+}
+
+OutlineExtremes outlineExtremes(const std::uint32_t *pts, std::size_t n)
+{
+	return outlineExtremesScalar(pts, n);
 }
 #endif
 

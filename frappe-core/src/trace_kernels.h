@@ -45,10 +45,23 @@ constexpr int kSideBins = 16;
 std::uint32_t sideCoverage(const std::uint32_t *pts, std::size_t n, const SideLine &side, float tol);
 constexpr std::size_t kPointsPadding = 16;
 
+/// A border's extreme points, from which a quad is made when its corner
+/// pixels do not give four corners: i0 the point farthest from the
+/// centroid, i2 the point farthest from i0, i1 and i3 the points farthest
+/// on either side of the diagonal i0-i2 (most > 0 and least < 0 the cross
+/// products there, 0 when that side is empty). Every "farthest" is the first
+/// such point. pts as for sideCoverage, n >= 1.
+struct OutlineExtremes {
+	std::size_t i0 = 0, i1 = 0, i2 = 0, i3 = 0;
+	std::int32_t most = 0, least = 0;
+};
+OutlineExtremes outlineExtremes(const std::uint32_t *pts, std::size_t n);
+
 /// The same without SIMD, the references the vectorised forms are tested
 /// against.
 void neighbourMasksScalar(const std::uint8_t *row, std::ptrdiff_t stride, int x0, int x1, std::uint8_t *out);
 void borderStartBitsScalar(const std::uint8_t *labels, int x0, int x1, std::uint64_t *bits);
 std::uint32_t sideCoverageScalar(const std::uint32_t *pts, std::size_t n, const SideLine &side, float tol);
+OutlineExtremes outlineExtremesScalar(const std::uint32_t *pts, std::size_t n);
 
 } // namespace frappe::detail

@@ -383,6 +383,47 @@ void expectVectorCoverageMatchesScalar(const char *target)
 	EXPECT_GT(nonzero, 200);
 }
 
+void expectVectorExtremesMatchScalar(const char *target)
+{
+	/* Borders of small integer shapes, so that distances tie often: rings
+	 * of a square (four farthest corners), random walks, and collinear
+	 * points (an empty side). */
+	std::mt19937 rng(31);
+	int compared = 0;
+	for (int trial = 0; trial < 400; ++trial) {
+		const int n = 1 + trial % 90;
+		std::vector<std::uint32_t> pts(n + kPointsPadding, 0x00010001u);
+		int x = 100, y = 100;
+		for (int k = 0; k < n; ++k) {
+			switch (trial % 3) {
+			case 0: { /* around a square of side 10 */
+				const int s = k % 40, side = s / 10, t = s % 10;
+				x = 100 + (side == 0 ? t : side == 1 ? 10 : side == 2 ? 10 - t : 0);
+				y = 100 + (side == 0 ? 0 : side == 1 ? t : side == 2 ? 10 : 10 - t);
+				break;
+			}
+			case 1: /* a random walk */
+				x += static_cast<int>(rng() % 3) - 1;
+				y += static_cast<int>(rng() % 3) - 1;
+				break;
+			default: /* a line */
+				x = 50 + k;
+				y = 60 + k / 2;
+			}
+			pts[k] = static_cast<std::uint32_t>(x) | static_cast<std::uint32_t>(y) << 16;
+		}
+		const OutlineExtremes a = outlineExtremes(pts.data(), n), b = outlineExtremesScalar(pts.data(), n);
+		ASSERT_EQ(a.i0, b.i0) << target << ": trial " << trial;
+		ASSERT_EQ(a.i1, b.i1) << target << ": trial " << trial;
+		ASSERT_EQ(a.i2, b.i2) << target << ": trial " << trial;
+		ASSERT_EQ(a.i3, b.i3) << target << ": trial " << trial;
+		ASSERT_EQ(a.most, b.most) << target << ": trial " << trial;
+		ASSERT_EQ(a.least, b.least) << target << ": trial " << trial;
+		++compared;
+	}
+	EXPECT_EQ(compared, 400);
+}
+
 /* Runs `check` on every Highway target this CPU has, or once without. */
 template <class F>
 void onEveryTarget(F check)
@@ -456,6 +497,36 @@ TEST(SideCoverage, BinsAlongTheSide)
 TEST(SideCoverage, VectorFormMatchesTheScalarOne)
 {
 	onEveryTarget(expectVectorCoverageMatchesScalar);
+}
+
+/* The extremes of a square's outline: its corners, the first of each tie. */
+TEST(OutlineExtremes, SquareGivesItsCorners)
+{
+	std::vector<std::uint32_t> pts;
+	auto at = [](int x, int y) { return static_cast<std::uint32_t>(x) | static_cast<std::uint32_t>(y) << 16; };
+	for (int t = 0; t < 20; ++t)
+		pts.push_back(at(10 + t, 10)); /* top, left to right */
+	for (int t = 0; t < 20; ++t)
+		pts.push_back(at(30, 10 + t)); /* right, downwards */
+	for (int t = 0; t < 20; ++t)
+		pts.push_back(at(30 - t, 30)); /* bottom */
+	for (int t = 0; t < 20; ++t)
+		pts.push_back(at(10, 30 - t)); /* left */
+	const std::size_t n = pts.size();
+	pts.resize(n + kPointsPadding, 0);
+	for (const OutlineExtremes e : { outlineExtremes(pts.data(), n), outlineExtremesScalar(pts.data(), n) }) {
+		EXPECT_EQ(pts[e.i0], at(10, 10)); /* first of the four at the same distance */
+		EXPECT_EQ(pts[e.i2], at(30, 30));
+		EXPECT_EQ(pts[e.i1], at(10, 30)); /* most > 0: left of i0 -> i2 on screen */
+		EXPECT_EQ(pts[e.i3], at(30, 10));
+		EXPECT_EQ(e.most, 400);
+		EXPECT_EQ(e.least, -400);
+	}
+}
+
+TEST(OutlineExtremes, VectorFormMatchesTheScalarOne)
+{
+	onEveryTarget(expectVectorExtremesMatchScalar);
 }
 
 /* Frames wider than 16-bit moves reach follow the neighbourhood from three
