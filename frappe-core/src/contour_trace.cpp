@@ -229,6 +229,7 @@ void ContourTracer::trace(const EdgeMap &edges, const TraceParams &params, std::
 		 * and spans at least min_side / sqrt(2) each way. */
 		if (static_cast<float>(steps_) < 2.8f * params.min_side)
 			return;
+		clusterCorners();
 		/* Both ways of making a quad below need two clusters. */
 		if (clusters_.size() < 2)
 			return;
@@ -467,51 +468,72 @@ bool ContourTracer::spansAtLeast(float span) const
 	return static_cast<float>(maxX - minX) >= span && static_cast<float>((hi >> 16) - (lo >> 16)) >= span;
 }
 
-/* Follows one border from (x, y); (x, y) + kD[fromDir] is the background
- * pixel the scan came from. Collects the corner clusters on the way. */
-void ContourTracer::follow(int x0, int y0, int fromDir, const EdgeMap &edges)
+/* Groups the last border's corner pixels, in the order it met them: a
+ * pixel within the cluster radius of a cluster's first member joins it. */
+void ContourTracer::clusterCorners()
 {
 	clusters_.clear();
 	tooManyClusters_ = false;
-	std::uint8_t *const L = labels_.data();
-	const std::ptrdiff_t w = stride_;
-	/* The edge map's byte of a label pointer (same layout). */
-	const std::uintptr_t toEdge =
-		reinterpret_cast<std::uintptr_t>(edges.pixels.data()) - reinterpret_cast<std::uintptr_t>(L);
-	auto isCorner = [toEdge](const std::uint8_t *label) {
-		return (*reinterpret_cast<const std::uint8_t *>(reinterpret_cast<std::uintptr_t>(label) + toEdge) &
-			EdgeMap::kCorner) != 0;
-	};
-	/* Not inlined into the loop: one in ten border pixels or fewer is a corner. */
-	auto cluster = [this](std::uint32_t xy) __attribute__((noinline)) {
-		if (tooManyClusters_)
-			return;
+	for (int k = 0; k < cornerCount_; ++k) {
+		const std::uint32_t xy = corners_[static_cast<std::size_t>(k)];
 		const int x = static_cast<int>(xy & 0xFFFFu), y = static_cast<int>(xy >> 16);
 		const float fx = static_cast<float>(x), fy = static_cast<float>(y);
+		bool joined = false;
 		for (Cluster &c : clusters_) {
 			const float dx = fx - static_cast<float>(c.fx), dy = fy - static_cast<float>(c.fy);
 			if (dx * dx + dy * dy <= radius2_) {
 				c.sx += fx;
 				c.sy += fy;
 				++c.n;
-				return;
+				joined = true;
+				break;
 			}
 		}
+		if (joined)
+			continue;
 		if (clusters_.size() >= kMaxClusters) {
 			tooManyClusters_ = true;
 			return;
 		}
 		clusters_.push_back({ fx, fy, 1, x, y });
+	}
+}
+
+/* Follows one border from (x, y); (x, y) + kD[fromDir] is the background
+ * pixel the scan came from. Keeps its pixels and, apart, its corner pixels. */
+void ContourTracer::follow(int x0, int y0, int fromDir, const EdgeMap &edges)
+{
+	std::uint8_t *const L = labels_.data();
+	const std::ptrdiff_t w = stride_;
+	/* The edge map's corner bit of a label pointer (same layout), 0 or 1. */
+	const std::uintptr_t toEdge =
+		reinterpret_cast<std::uintptr_t>(edges.pixels.data()) - reinterpret_cast<std::uintptr_t>(L);
+	auto isCorner = [toEdge](const std::uint8_t *label) {
+		return (*reinterpret_cast<const std::uint8_t *>(reinterpret_cast<std::uintptr_t>(label) + toEdge) >>
+			1) & 1;
 	};
+	static_assert(EdgeMap::kCorner == 2);
 
 	/* The points are written through local pointers, and the loop reads
 	 * no member: the label stores (bytes, which may alias anything) would
 	 * make the compiler reload members on every step. */
-	if (points_.size() < 1024)
+	if (points_.size() < 1024) {
 		points_.resize(1024);
+		corners_.resize(1024);
+	}
 	/* The last kPointsPadding points stay free: sideCoverage reads a vector
-	 * at a time. */
+	 * at a time. Every point is written to the corner list too, which
+	 * advances only past corners: no branch on them. */
 	std::uint32_t *out = points_.data(), *outEnd = out + points_.size() - kPointsPadding;
+	std::uint32_t *cornerOut = corners_.data();
+	auto grow = [&]() {
+		const std::size_t n = points_.size(), nc = static_cast<std::size_t>(cornerOut - corners_.data());
+		points_.resize(2 * n);
+		corners_.resize(2 * n);
+		out = points_.data() + (n - kPointsPadding);
+		outEnd = points_.data() + points_.size() - kPointsPadding;
+		cornerOut = corners_.data() + nc;
+	};
 	std::uint32_t xy = static_cast<std::uint32_t>(x0) | static_cast<std::uint32_t>(y0) << 16;
 
 	/* Pointer offsets of the eight neighbours, in kDx/kDy order. */
@@ -524,9 +546,10 @@ void ContourTracer::follow(int x0, int y0, int fromDir, const EdgeMap &edges)
 	if (mask0 == 0) {
 		*p0 = kFollowedRightBg; /* isolated pixel */
 		*out++ = xy;
-		if (isCorner(p0))
-			cluster(xy);
+		*cornerOut = xy;
+		cornerOut += isCorner(p0);
 		steps_ = 1;
+		cornerCount_ = static_cast<int>(cornerOut - corners_.data());
 		return;
 	}
 	int d1 = fromDir;
@@ -550,15 +573,12 @@ void ContourTracer::follow(int x0, int y0, int fromDir, const EdgeMap &edges)
 			const MaskStep st = mt[back << 8 | M[i]];
 			L[i] |= st.mark;
 			*out++ = xy;
-			if (isCorner(L + i)) [[unlikely]]
-				cluster(xy);
+			*cornerOut = xy;
+			cornerOut += isCorner(L + i);
 			if (out == outEnd) [[unlikely]] {
-				const std::size_t n = points_.size();
-				if (n > 4 * labels_.size())
+				if (points_.size() > 4 * labels_.size())
 					break;
-				points_.resize(2 * n);
-				out = points_.data() + (n - kPointsPadding);
-				outEnd = points_.data() + points_.size() - kPointsPadding;
+				grow();
 			}
 			const std::ptrdiff_t next = i + st.offset;
 			if (i == i1 && next == i0) [[unlikely]]
@@ -568,6 +588,7 @@ void ContourTracer::follow(int x0, int y0, int fromDir, const EdgeMap &edges)
 			i = next;
 		}
 		steps_ = static_cast<int>(out - points_.data());
+		cornerCount_ = static_cast<int>(cornerOut - corners_.data());
 		return;
 	}
 	const std::int32_t *const table = stepTable_.data();
@@ -583,15 +604,12 @@ void ContourTracer::follow(int x0, int y0, int fromDir, const EdgeMap &edges)
 		/* 3.4: mark the current pixel. */
 		*p |= static_cast<std::uint8_t>(step & kMarkRightBg);
 		*out++ = xy;
-		if (isCorner(p)) [[unlikely]]
-			cluster(xy);
+		*cornerOut = xy;
+		cornerOut += isCorner(p);
 		if (out == outEnd) [[unlikely]] {
-			const std::size_t n = points_.size();
-			if (n > maxSteps) /* only on a corrupt label image */
+			if (points_.size() > maxSteps) /* only on a corrupt label image */
 				break;
-			points_.resize(2 * n);
-			out = points_.data() + (n - kPointsPadding);
-			outEnd = points_.data() + points_.size() - kPointsPadding;
+			grow();
 		}
 		std::uint8_t *const next = p + (step >> 12);
 		/* 3.5: back at the start, about to repeat the first move. */
@@ -602,6 +620,7 @@ void ContourTracer::follow(int x0, int y0, int fromDir, const EdgeMap &edges)
 		p = next;
 	}
 	steps_ = static_cast<int>(out - points_.data());
+	cornerCount_ = static_cast<int>(cornerOut - corners_.data());
 }
 
 /* The paper's rule is "exactly four corner clusters". Noise adds clusters

@@ -58,6 +58,7 @@ private:
 	};
 	void buildStepTables(int w);
 	void follow(int x, int y, int fromDir, const EdgeMap &edges);
+	void clusterCorners();
 	bool spansAtLeast(float span) const; ///< the last border's bounding box
 	bool quadFromClusters(Quad &quad) const;
 	bool quadFromOutline(Quad &quad) const;
@@ -92,6 +93,11 @@ private:
 	/// valid (follow writes through a local pointer and grows it itself).
 	std::vector<std::uint32_t> points_;
 	std::vector<std::uint32_t> sampled_; ///< acceptQuad's every stride-th point
+	/// The last border's corner pixels, as points_; only the first
+	/// cornerCount_ are valid. Clustered only for borders long enough to
+	/// be a candidate.
+	std::vector<std::uint32_t> corners_;
+	int cornerCount_ = 0;
 	int steps_ = 0;
 	bool tooManyClusters_ = false;
 	int borders_ = 0;
