@@ -273,14 +273,17 @@ void ContourTracer::trace(const EdgeMap &edges, const TraceParams &params, std::
 							    stretches_.data() + stretchRows_[ty + 1]);
 	};
 
-	/* Neighbour masks wherever a border can run. */
+	/* Neighbour masks wherever a border can run: from a row's first
+	 * stretch to the end of its last, in one call (the masks of empty
+	 * tiles between are computed too, and never read). */
 	if (useMasks_) {
 		masks_.resize(static_cast<std::size_t>(w) * h);
 		for (int y = 1; y < h - 1; ++y) {
-			const std::uint8_t *e = edges.pixels.data() + static_cast<std::size_t>(y) * w;
-			std::uint8_t *m = masks_.data() + static_cast<std::size_t>(y) * w;
-			for (const auto &[x0, x1] : stretchesOf(y))
-				neighbourMasks(e, w, x0, x1, m);
+			const auto stretches = stretchesOf(y);
+			if (stretches.empty())
+				continue;
+			neighbourMasks(edges.pixels.data() + static_cast<std::size_t>(y) * w, w, stretches.front().first,
+				       stretches.back().second, masks_.data() + static_cast<std::size_t>(y) * w);
 		}
 	}
 	startWords_.resize(static_cast<std::size_t>(w) / 64 + 2);
