@@ -544,8 +544,12 @@ void ContourTracer::follow(int x0, int y0, int fromDir, const EdgeMap &edges)
 	/* 3.1: clockwise from fromDir, find the first non-zero neighbour. */
 	std::uint8_t *const p0 = L + y0 * w + x0;
 	unsigned mask0 = 0;
-	for (int d = 0; d < 8; ++d)
-		mask0 |= static_cast<unsigned>(p0[off[d]] != 0) << d;
+	if (useMasks_) {
+		mask0 = masks_[static_cast<std::size_t>(p0 - L)];
+	} else {
+		for (int d = 0; d < 8; ++d)
+			mask0 |= static_cast<unsigned>(p0[off[d]] != 0) << d;
+	}
 	if (mask0 == 0) {
 		*p0 = kFollowedRightBg; /* isolated pixel */
 		*out++ = xy;
@@ -555,9 +559,10 @@ void ContourTracer::follow(int x0, int y0, int fromDir, const EdgeMap &edges)
 		cornerCount_ = static_cast<int>(cornerOut - corners_.data());
 		return;
 	}
-	int d1 = fromDir;
-	while (!(mask0 & (1u << d1)))
-		d1 = (d1 + 7) & 7;
+	/* Turned so that direction fromDir is bit 7, the first non-zero
+	 * neighbour clockwise is the highest set bit. */
+	const auto turned = static_cast<std::uint8_t>(mask0 << (7 - fromDir) | mask0 >> (fromDir + 1));
+	const int d1 = (fromDir - std::countl_zero(turned)) & 7;
 	const std::uint8_t *const p1 = p0 + off[d1];
 	/* xy steps per direction back (the move is the opposite direction). */
 	static constexpr std::int32_t kDxyBack[8] = { -kDx[0] - kDy[0] * 65536, -kDx[1] - kDy[1] * 65536,
