@@ -31,6 +31,8 @@ static_assert((kUnfollowed | kMarkFollowed) == kFollowed && (kFollowed | kMarkRi
 /* Neighbour offsets, counter-clockwise on screen starting at the right. */
 constexpr int kDx[8] = { 1, 1, 0, -1, -1, -1, 0, 1 };
 constexpr int kDy[8] = { 0, -1, -1, -1, 0, 1, 1, 1 };
+/* Where the walk's window of neighbour masks holds direction d's. */
+constexpr int kWindowByte[8] = { 4, 2, 1, 0, 3, 5, 6, 7 };
 
 /* Step 3.3 of Suzuki's algorithm as a table: for the direction `back` to the
  * previous border pixel and the mask of non-zero neighbours (bit d for
@@ -163,6 +165,7 @@ void ContourTracer::buildStepTables(int w)
 				st.offset = static_cast<std::int16_t>(kDx[d] + kDy[d] * w);
 				st.back = static_cast<std::uint8_t>((d + 4) & 7);
 				st.mark = (e & 8) ? kMarkRightBg : kMarkFollowed;
+				st.shift = static_cast<std::uint8_t>(8 * kWindowByte[d]);
 			}
 		stepTable_.clear();
 		return;
@@ -277,7 +280,8 @@ void ContourTracer::trace(const EdgeMap &edges, const TraceParams &params, std::
 	 * stretch to the end of its last, in one call (the masks of empty
 	 * tiles between are computed too, and never read). */
 	if (useMasks_) {
-		masks_.resize(static_cast<std::size_t>(w) * h);
+		/* Padding: the walk reads a word at a time. */
+		masks_.resize(static_cast<std::size_t>(w) * h + 4);
 		for (int y = 1; y < h - 1; ++y) {
 			const auto stretches = stretchesOf(y);
 			if (stretches.empty())
@@ -570,15 +574,27 @@ void ContourTracer::follow(int x0, int y0, int fromDir, const EdgeMap &edges)
 						      -kDx[4] - kDy[4] * 65536, -kDx[5] - kDy[5] * 65536,
 						      -kDx[6] - kDy[6] * 65536, -kDx[7] - kDy[7] * 65536 };
 	if (useMasks_) {
-		/* Each pixel's neighbourhood is one byte of masks_: a step is
-		 * two dependent loads, that byte and the table entry. */
+		/* Each pixel's neighbourhood is one byte of masks_. The masks of
+		 * the current pixel's eight neighbours are loaded (three words)
+		 * while its step is looked up, so the next pixel's mask is a
+		 * shift of a register away when the table entry arrives: one
+		 * dependent load per step. */
 		const std::uint8_t *const M = masks_.data();
 		const MaskStep *const mt = maskTable_.data();
 		const std::ptrdiff_t i0 = p0 - L, i1 = p1 - L;
+		/* Bytes: up-left, up, up-right, left, right, down-left, down,
+		 * down-right (kWindowByte). */
+		auto window = [M, w](std::ptrdiff_t at) {
+			const std::uint32_t r0 = load32(M + at - w - 1), r1 = load32(M + at - 1), r2 = load32(M + at + w - 1);
+			return static_cast<std::uint64_t>(r0 & 0xFFFFFFu) | static_cast<std::uint64_t>(r1 & 0xFFu) << 24 |
+			       static_cast<std::uint64_t>(r1 & 0xFF0000u) << 16 | static_cast<std::uint64_t>(r2 & 0xFFFFFFu) << 40;
+		};
 		std::ptrdiff_t i = i0;
 		unsigned back = static_cast<unsigned>(d1);
+		unsigned mask = M[i0];
+		std::uint64_t around = window(i0);
 		for (;;) {
-			const MaskStep st = mt[back << 8 | M[i]];
+			const MaskStep st = mt[back << 8 | mask];
 			L[i] |= st.mark;
 			*out++ = xy;
 			*cornerOut = xy;
@@ -591,6 +607,8 @@ void ContourTracer::follow(int x0, int y0, int fromDir, const EdgeMap &edges)
 			const std::ptrdiff_t next = i + st.offset;
 			if (i == i1 && next == i0) [[unlikely]]
 				break;
+			mask = static_cast<unsigned>(around >> st.shift) & 0xFFu;
+			around = window(next);
 			back = st.back;
 			xy += static_cast<std::uint32_t>(kDxyBack[back]);
 			i = next;

@@ -79,10 +79,11 @@ private:
 	/// neighbourhood is read from three label rows at every step, and
 	/// stepTable_ holds the move's pointer offset, the next direction back
 	/// and the label bits to set.
-	struct MaskStep {
+	struct alignas(8) MaskStep { /* 8 bytes: a scaled index addresses it */
 		std::int16_t offset; ///< pointer offset of the move
 		std::uint8_t back;   ///< direction back from the pixel it reaches
 		std::uint8_t mark;   ///< label mark of the pixel it leaves
+		std::uint8_t shift;  ///< where the move's pixel is in the walk's window
 	};
 	bool useMasks_ = false;
 	std::vector<std::uint8_t> masks_;
