@@ -102,7 +102,7 @@ def stage_of(obj, name):
         return "front_end"
     if base == "adaptive_scale":
         return "adaptive_scale"
-    if base == "contour_trace":
+    if base in ("contour_trace", "trace_kernels"):
         return "trace"
     if base == "corner_refine":
         return "refine"
