@@ -461,18 +461,8 @@ void ContourTracer::sealInside(const Quad &quad, int w, int h)
 
 bool ContourTracer::spansAtLeast(float span) const
 {
-	/* y is the high half of a point: the extreme words give its extremes. */
-	const std::uint32_t *pt = points_.data();
-	const int n = steps_;
-	std::uint32_t lo = pt[0], hi = lo, minX = lo & 0xFFFFu, maxX = minX;
-	for (int i = 0; i < n; ++i) {
-		const std::uint32_t v = pt[i], x = v & 0xFFFFu;
-		lo = std::min(lo, v);
-		hi = std::max(hi, v);
-		minX = std::min(minX, x);
-		maxX = std::max(maxX, x);
-	}
-	return static_cast<float>(maxX - minX) >= span && static_cast<float>((hi >> 16) - (lo >> 16)) >= span;
+	const PointsBox box = pointsBox(points_.data(), static_cast<std::size_t>(steps_));
+	return static_cast<float>(box.maxX - box.minX) >= span && static_cast<float>(box.maxY - box.minY) >= span;
 }
 
 /* Groups the last border's corner pixels, in the order it met them: a

@@ -256,6 +256,33 @@ OutlineExtremes OutlineExtremesV(const std::uint32_t *pts, std::size_t n)
 #endif
 }
 
+PointsBox PointsBoxV(const std::uint32_t *pts, std::size_t n)
+{
+#if HWY_TARGET == HWY_SCALAR
+	return pointsBoxScalar(pts, n);
+#else
+	const hn::ScalableTag<std::uint32_t> du;
+	const std::size_t N = hn::Lanes(du);
+	const auto low16 = hn::Set(du, 0xFFFFu);
+	/* The tail repeats the first point, which changes no extreme. */
+	const auto first = hn::Set(du, pts[0]);
+	auto lo = first, hi = first, loX = hn::And(first, low16), hiX = loX;
+	for (std::size_t k = 0; k < n; k += N) {
+		auto v = hn::LoadU(du, pts + k);
+		if (k + N > n)
+			v = hn::IfThenElse(hn::FirstN(du, n - k), v, first);
+		/* y is the high half: the extreme words give its extremes. */
+		lo = hn::Min(lo, v);
+		hi = hn::Max(hi, v);
+		const auto x = hn::And(v, low16);
+		loX = hn::Min(loX, x);
+		hiX = hn::Max(hiX, x);
+	}
+	return { hn::GetLane(hn::MinOfLanes(du, loX)), hn::GetLane(hn::MaxOfLanes(du, hiX)),
+		 hn::GetLane(hn::MinOfLanes(du, lo)) >> 16, hn::GetLane(hn::MaxOfLanes(du, hi)) >> 16 };
+#endif
+}
+
 } // namespace HWY_NAMESPACE
 } // namespace frappe::detail
 HWY_AFTER_NAMESPACE();
@@ -347,11 +374,30 @@ OutlineExtremes outlineExtremesScalar(const std::uint32_t *pts, std::size_t n)
 	return e;
 }
 
+PointsBox pointsBoxScalar(const std::uint32_t *pts, std::size_t n)
+{
+	std::uint32_t lo = pts[0], hi = lo, minX = lo & 0xFFFFu, maxX = minX;
+	for (std::size_t i = 0; i < n; ++i) {
+		const std::uint32_t v = pts[i], x = v & 0xFFFFu;
+		lo = std::min(lo, v);
+		hi = std::max(hi, v);
+		minX = std::min(minX, x);
+		maxX = std::max(maxX, x);
+	}
+	return { minX, maxX, lo >> 16, hi >> 16 };
+}
+
 #ifdef FRAPPE_HAVE_HWY
 HWY_EXPORT(NeighbourMaskRow);
 HWY_EXPORT(BorderStartBits);
 HWY_EXPORT(SideCoverage);
 HWY_EXPORT(OutlineExtremesV);
+HWY_EXPORT(PointsBoxV);
+
+PointsBox pointsBox(const std::uint32_t *pts, std::size_t n)
+{
+	return HWY_DYNAMIC_DISPATCH(PointsBoxV)(pts, n);
+}
 
 OutlineExtremes outlineExtremes(const std::uint32_t *pts, std::size_t n)
 {
@@ -391,6 +437,11 @@ std::uint32_t sideCoverage(const std::uint32_t *pts, std::size_t n, const SideLi
 OutlineExtremes outlineExtremes(const std::uint32_t *pts, std::size_t n)
 {
 	return outlineExtremesScalar(pts, n);
+}
+
+PointsBox pointsBox(const std::uint32_t *pts, std::size_t n)
+{
+	return pointsBoxScalar(pts, n);
 }
 #endif
 

@@ -57,11 +57,19 @@ struct OutlineExtremes {
 };
 OutlineExtremes outlineExtremes(const std::uint32_t *pts, std::size_t n);
 
+/// The bounding box of points (x | y << 16) pts[0, n), n >= 1; pts as for
+/// sideCoverage.
+struct PointsBox {
+	std::uint32_t minX, maxX, minY, maxY;
+};
+PointsBox pointsBox(const std::uint32_t *pts, std::size_t n);
+
 /// The same without SIMD, the references the vectorised forms are tested
 /// against.
 void neighbourMasksScalar(const std::uint8_t *row, std::ptrdiff_t stride, int x0, int x1, std::uint8_t *out);
 void borderStartBitsScalar(const std::uint8_t *labels, int x0, int x1, std::uint64_t *bits);
 std::uint32_t sideCoverageScalar(const std::uint32_t *pts, std::size_t n, const SideLine &side, float tol);
 OutlineExtremes outlineExtremesScalar(const std::uint32_t *pts, std::size_t n);
+PointsBox pointsBoxScalar(const std::uint32_t *pts, std::size_t n);
 
 } // namespace frappe::detail

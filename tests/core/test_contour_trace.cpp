@@ -529,6 +529,31 @@ TEST(OutlineExtremes, VectorFormMatchesTheScalarOne)
 	onEveryTarget(expectVectorExtremesMatchScalar);
 }
 
+/* The bounding box of points, every count and tail, extremes anywhere (the
+ * packed word's order is y's, not x's: x needs its own pass). */
+TEST(PointsBox, VectorFormMatchesTheScalarOne)
+{
+	onEveryTarget([](const char *target) {
+		std::mt19937 rng(41);
+		for (int n = 1; n < 80; ++n) {
+			std::vector<std::uint32_t> pts(n + kPointsPadding, 0xFFFFFFFFu);
+			for (int k = 0; k < n; ++k)
+				pts[k] = (rng() % 600) | (rng() % 400) << 16;
+			const PointsBox a = pointsBox(pts.data(), n), b = pointsBoxScalar(pts.data(), n);
+			ASSERT_EQ(a.minX, b.minX) << target << " n " << n;
+			ASSERT_EQ(a.maxX, b.maxX) << target << " n " << n;
+			ASSERT_EQ(a.minY, b.minY) << target << " n " << n;
+			ASSERT_EQ(a.maxY, b.maxY) << target << " n " << n;
+		}
+		const std::uint32_t two[2 + kPointsPadding] = { 5u | 9u << 16, 7u | 3u << 16 };
+		const PointsBox box = pointsBox(two, 2);
+		EXPECT_EQ(box.minX, 5u);
+		EXPECT_EQ(box.maxX, 7u);
+		EXPECT_EQ(box.minY, 3u);
+		EXPECT_EQ(box.maxY, 9u);
+	});
+}
+
 /* Frames wider than 16-bit moves reach follow the neighbourhood from three
  * label rows at every step (the 32-bit targets' walk) rather than from the
  * neighbour masks. Both walks must give the same borders and quads: the same
