@@ -10,6 +10,9 @@
 //   same place. Sealed marker insides are kFollowedRightBg too: nothing
 //   starts there.
 // Empty 16x16 tiles hold no edge pixel, so the raster scan jumps over them.
+// The data-parallel parts (where borders start, each pixel's neighbour mask,
+// a candidate's extreme points, box and side coverage) are trace_kernels.cpp,
+// vectorised where Highway is built in; the walk itself is follow().
 #include "contour_trace.h"
 #include "trace_kernels.h"
 
