@@ -152,6 +152,9 @@ void CpuFrontEnd::runBand(const ImageView &src, const FrontEndParams &params, Ed
 	gradient(y0 - 1);
 	gradient(y0);
 
+	std::uint8_t *acc = s.tileAcc.data();
+	bool accAny = false;
+	std::fill_n(acc, w, 0);
 	for (int y = y0; y < y1; ++y) {
 		const int next = y + 1;
 		if (next + 1 <= h - 1)
@@ -164,10 +167,22 @@ void CpuFrontEnd::runBand(const ImageView &src, const FrontEndParams &params, Ed
 		};
 		std::uint8_t *edgeRow = out.pixels.data() + static_cast<std::size_t>(y) * w;
 		const bool any = k.edge(rows, w, params, edgeRow);
+		std::uint8_t *tileRow = out.tiles.data() +
+					static_cast<std::size_t>(y / EdgeMap::kTile) * out.tiles_x;
+		if (!k.orRow) {
+			if (any)
+				detail::markTiles(edgeRow, w, tileRow);
+			continue;
+		}
+		/* A vector OR per edge row, the tile test once per tile row. */
 		if (any) {
-			std::uint8_t *tileRow = out.tiles.data() +
-						static_cast<std::size_t>(y / EdgeMap::kTile) * out.tiles_x;
-			detail::markTiles(edgeRow, w, tileRow);
+			k.orRow(edgeRow, w, acc);
+			accAny = true;
+		}
+		if (accAny && ((y + 1) % EdgeMap::kTile == 0 || y + 1 == y1)) {
+			detail::markTiles(acc, w, tileRow);
+			std::fill_n(acc, w, 0);
+			accAny = false;
 		}
 	}
 }

@@ -27,8 +27,10 @@ struct RowScratch {
 	/// gx holds 2w values: the ARMv6 kernels store (gx, gy) pairs in it.
 	std::vector<std::int16_t> gx[3], gy[3];
 	std::vector<std::int32_t> mag[3];
+	std::vector<std::uint8_t> tileAcc;     ///< the OR of a tile row's edge rows (orRow)
 	void resize(int w)
 	{
+		tileAcc.resize(w);
 		for (int i = 0; i < 4; ++i)
 			smooth[i].resize(2 * static_cast<std::size_t>(w) + 8);
 		columns.resize(w);
@@ -78,6 +80,9 @@ struct RowKernels {
 	void (*gradient)(const std::uint8_t *a, const std::uint8_t *b, const std::uint8_t *c, int w,
 			 std::int16_t *gx, std::int16_t *gy, std::int32_t *mag, std::int16_t *tmp);
 	bool (*edge)(const GradRows &rows, int w, const FrontEndParams &params, std::uint8_t *out);
+	/// acc[x] |= row[x] for w bytes, when a vector OR makes marking the
+	/// tiles once per tile row cheaper than once per edge row; else null.
+	void (*orRow)(const std::uint8_t *row, int w, std::uint8_t *acc) = nullptr;
 };
 
 /// The scalar kernels: the reference, and the ARMv6 path.

@@ -72,6 +72,17 @@ void SmoothRow(const std::uint8_t *a, const std::uint8_t *b, const std::uint8_t 
 	out[w - 1] = static_cast<std::uint8_t>((tmp[w - 2] + 3 * tmp[w - 1] + 8) >> 4);
 }
 
+void OrRow(const std::uint8_t *row, int w, std::uint8_t *acc)
+{
+	const hn::ScalableTag<std::uint8_t> d8;
+	const int N = static_cast<int>(hn::Lanes(d8));
+	int x = 0;
+	for (; x + N <= w; x += N)
+		hn::StoreU(hn::Or(hn::LoadU(d8, row + x), hn::LoadU(d8, acc + x)), d8, acc + x);
+	for (; x < w; ++x)
+		acc[x] |= row[x];
+}
+
 #if HWY_TARGET != HWY_SCALAR
 
 /* The gradient row layout of these kernels (like the ARMv6 ones): per pixel
@@ -370,6 +381,7 @@ namespace frappe::detail {
 HWY_EXPORT(SmoothRow);
 HWY_EXPORT(GradientRow);
 HWY_EXPORT(EdgeRow);
+HWY_EXPORT(OrRow);
 
 namespace {
 
@@ -390,11 +402,16 @@ bool edgeDispatch(const GradRows &rows, int w, const FrontEndParams &params, std
 	return HWY_DYNAMIC_DISPATCH(EdgeRow)(rows, w, params, out);
 }
 
+void orDispatch(const std::uint8_t *row, int w, std::uint8_t *acc)
+{
+	HWY_DYNAMIC_DISPATCH(OrRow)(row, w, acc);
+}
+
 } // namespace
 
 const RowKernels &bestRowKernels()
 {
-	static constexpr RowKernels kSimd{ "highway", smoothDispatch, gradientDispatch, edgeDispatch };
+	static constexpr RowKernels kSimd{ "highway", smoothDispatch, gradientDispatch, edgeDispatch, orDispatch };
 	return kSimd;
 }
 
