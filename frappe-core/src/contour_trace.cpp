@@ -205,15 +205,8 @@ void ContourTracer::trace(const EdgeMap &edges, const TraceParams &params, std::
 	/* Padding: follow reads neighbours a word at a time, and the start
 	 * scan reads a vector past the end of a stretch. */
 	labels_.resize(static_cast<std::size_t>(w) * h + 128);
-	/* Label 1 for every edge pixel; a plain loop over local pointers that
-	 * the compiler vectorises. */
-	{
-		const std::uint8_t *src = edges.pixels.data();
-		std::uint8_t *dst = labels_.data();
-		const std::size_t n = static_cast<std::size_t>(w) * h;
-		for (std::size_t i = 0; i < n; ++i)
-			dst[i] = src[i] & EdgeMap::kEdge;
-	}
+	static_assert(EdgeMap::kEdge == kUnfollowed);
+	labelsFromEdges(edges.pixels.data(), static_cast<std::size_t>(w) * h, labels_.data());
 
 	/* A border may start at x of row y: follow it and keep it if it makes a
 	 * candidate. */

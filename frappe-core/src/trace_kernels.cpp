@@ -23,6 +23,18 @@ namespace HWY_NAMESPACE {
 
 namespace hn = hwy::HWY_NAMESPACE;
 
+void LabelsFromEdges(const std::uint8_t *edges, std::size_t n, std::uint8_t *labels)
+{
+	const hn::ScalableTag<std::uint8_t> d8;
+	const std::size_t N = hn::Lanes(d8);
+	const auto one = hn::Set(d8, kUnfollowed);
+	std::size_t i = 0;
+	for (; i + N <= n; i += N)
+		hn::StoreU(hn::And(hn::LoadU(d8, edges + i), one), d8, labels + i);
+	for (; i < n; ++i)
+		labels[i] = edges[i] & kUnfollowed;
+}
+
 void NeighbourMaskRow(const std::uint8_t *row, std::ptrdiff_t stride, int x0, int x1, std::uint8_t *out)
 {
 #if HWY_TARGET == HWY_SCALAR
@@ -388,7 +400,13 @@ PointsBox pointsBoxScalar(const std::uint32_t *pts, std::size_t n)
 }
 
 #ifdef FRAPPE_HAVE_HWY
+HWY_EXPORT(LabelsFromEdges);
 HWY_EXPORT(NeighbourMaskRow);
+
+void labelsFromEdges(const std::uint8_t *edges, std::size_t n, std::uint8_t *labels)
+{
+	HWY_DYNAMIC_DISPATCH(LabelsFromEdges)(edges, n, labels);
+}
 HWY_EXPORT(BorderStartBits);
 HWY_EXPORT(SideCoverage);
 HWY_EXPORT(OutlineExtremesV);
@@ -419,6 +437,14 @@ void borderStartBits(const std::uint8_t *labels, int x0, int x1, std::uint64_t *
 	HWY_DYNAMIC_DISPATCH(BorderStartBits)(labels, x0, x1, bits);
 }
 #else
+/* A plain loop over local pointers, which the compiler vectorises where it
+ * can. */
+void labelsFromEdges(const std::uint8_t *edges, std::size_t n, std::uint8_t *labels)
+{
+	for (std::size_t i = 0; i < n; ++i)
+		labels[i] = edges[i] & kUnfollowed;
+}
+
 void neighbourMasks(const std::uint8_t *row, std::ptrdiff_t stride, int x0, int x1, std::uint8_t *out)
 {
 	neighbourMasksScalar(row, stride, x0, x1, out);

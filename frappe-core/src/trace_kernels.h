@@ -17,6 +17,10 @@ namespace frappe::detail {
 /// while following it.
 constexpr std::uint8_t kUnfollowed = 1, kFollowed = 9, kFollowedRightBg = 25;
 
+/// labels[i] = edges[i] & kUnfollowed for i in [0, n): an edge pixel not yet
+/// on a followed border, or background.
+void labelsFromEdges(const std::uint8_t *edges, std::size_t n, std::uint8_t *labels);
+
 /// Bit d of out[x], for x in [x0, x1), is bit 0 of the neighbour of row[x]
 /// in direction d: right, up-right, up, up-left, left, down-left, down,
 /// down-right (counter-clockwise on screen). The rows above and below and
