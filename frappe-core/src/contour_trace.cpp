@@ -747,15 +747,7 @@ bool ContourTracer::acceptQuad(const TraceParams &params, int w, int h, Quad &qu
 		n = m;
 	}
 	for (int i = 0; i < 4; ++i) {
-		const Point2f a = q[i], b = q[(i + 1) & 3];
-		const float len = std::sqrt(dist2(a, b));
-		SideLine side;
-		side.nx = -(b.y - a.y) / len;
-		side.ny = (b.x - a.x) / len;
-		side.nc = side.nx * a.x + side.ny * a.y;
-		side.ux = (b.x - a.x) / (len * len) * kBins;
-		side.uy = (b.y - a.y) / (len * len) * kBins;
-		side.t0 = side.ux * a.x + side.uy * a.y;
+		const SideLine side = SideLine::between(q[i], q[(i + 1) & 3]);
 		if (std::popcount(sideCoverage(pts, n, side, tol)) < kBins * 7 / 16)
 			return false;
 	}

@@ -6,8 +6,11 @@
 // a border covers.
 #pragma once
 
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
+
+#include "frappe/image.h"
 
 namespace frappe::detail {
 
@@ -37,10 +40,24 @@ void borderStartBits(const std::uint8_t *labels, int x0, int x1, std::uint64_t *
 
 /// A side of a candidate quad: points p on it have nx x + ny y = nc, and
 /// ux x + uy y - t0 runs from 0 to kSideBins along it.
+constexpr int kSideBins = 16;
 struct SideLine {
 	float nx, ny, nc, ux, uy, t0;
+
+	/// The side from a to b (a != b).
+	static SideLine between(Point2f a, Point2f b)
+	{
+		const float len = std::sqrt((b.x - a.x) * (b.x - a.x) + (b.y - a.y) * (b.y - a.y));
+		SideLine side;
+		side.nx = -(b.y - a.y) / len;
+		side.ny = (b.x - a.x) / len;
+		side.nc = side.nx * a.x + side.ny * a.y;
+		side.ux = (b.x - a.x) / (len * len) * kSideBins;
+		side.uy = (b.y - a.y) / (len * len) * kSideBins;
+		side.t0 = side.ux * a.x + side.uy * a.y;
+		return side;
+	}
 };
-constexpr int kSideBins = 16;
 
 /// Bit b set when some point (x | y << 16) of pts[0, n) lies within `tol`
 /// of the side's line, in its b-th sixteenth: |nx x + ny y - nc| <= tol and

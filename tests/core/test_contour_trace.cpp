@@ -354,16 +354,9 @@ void expectVectorCoverageMatchesScalar(const char *target)
 	for (int trial = 0; trial < 300; ++trial) {
 		const Point2f a{ std::floor(coord(rng)), std::floor(coord(rng)) };
 		const Point2f b{ std::floor(coord(rng)), std::floor(coord(rng)) };
-		const float len = std::hypot(b.x - a.x, b.y - a.y);
-		if (len < 8.0f)
+		if (std::hypot(b.x - a.x, b.y - a.y) < 8.0f)
 			continue;
-		SideLine side;
-		side.nx = -(b.y - a.y) / len;
-		side.ny = (b.x - a.x) / len;
-		side.nc = side.nx * a.x + side.ny * a.y;
-		side.ux = (b.x - a.x) / (len * len) * kSideBins;
-		side.uy = (b.y - a.y) / (len * len) * kSideBins;
-		side.t0 = side.ux * a.x + side.uy * a.y;
+		const SideLine side = SideLine::between(a, b);
 		const int n = trial % 70;
 		std::vector<std::uint32_t> pts(n + kPointsPadding, 0xFFFFFFFFu);
 		for (int k = 0; k < n; ++k) {
