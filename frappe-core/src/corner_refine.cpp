@@ -23,6 +23,24 @@
 // Two passes: a wide one from the tracer's corners with few columns, then a
 // narrow one with more columns from corners that are now within a fraction of
 // a pixel, so its columns stay clear of the corners exactly.
+//
+// With Highway, the columns of a side are measured together, one per lane:
+// their pixels are gathered into rows, and measureColumn's searches become
+// masked passes over the rows. They compute the same integers, so the
+// corners are the same to the bit as the scalar code's (ARMv6 builds).
+
+#if FRAPPE_HAVE_HWY
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "corner_refine.cpp"
+#include <hwy/foreach_target.h> // IWYU pragma: keep
+
+#include <hwy/highway.h>
+#endif
+
+/* Once, not per Highway target. */
+#ifndef FRAPPE_CORNER_REFINE_COMMON
+#define FRAPPE_CORNER_REFINE_COMMON
+
 #include "corner_refine.h"
 
 #include <algorithm>
@@ -52,6 +70,145 @@ constexpr int kMaxReach = 23; /* search window, pixels either side */
 constexpr int kMaxProfile = 2 * (kMaxReach + kRun + 1) + 1;
 /* Steepest fall over two pixels below which a column is noise, not edge. */
 constexpr int kMinDrop = 6;
+
+/* A side's columns for the vector kernel: p[r][i] is column i's pixel
+ * j = kLoMin - kRun - 1 + r steps inwards, r < kHiMax - kLoMin + 2 kRun + 3;
+ * the kernel returns each column's measureColumn() in mass and moment2. */
+struct Columns {
+	/* Columns a row holds: a fine pass's, padded to whole vectors. */
+	static constexpr int kLanes = 64;
+	/* Vectors hold at most this many columns (int32 lanes of AVX-512):
+	 * columns n..roundUp(n, kPad) are filled with empty searches. */
+	static constexpr int kPad = 16;
+	int n;
+	int kLoMin, kHiMax;
+	alignas(64) std::uint8_t p[kMaxProfile][kLanes];
+	alignas(64) std::int32_t kLo[kLanes];
+	alignas(64) std::int32_t kHi[kLanes];
+	alignas(64) std::int32_t mass[kLanes];
+	alignas(64) std::int32_t moment2[kLanes];
+};
+
+static_assert(kFinePoints <= Columns::kLanes && Columns::kLanes % Columns::kPad == 0);
+
+} // namespace
+
+} // namespace frappe::detail
+
+#endif // FRAPPE_CORNER_REFINE_COMMON
+
+#if FRAPPE_HAVE_HWY
+HWY_BEFORE_NAMESPACE();
+namespace frappe::detail {
+namespace HWY_NAMESPACE {
+
+namespace hn = hwy::HWY_NAMESPACE;
+
+/* measureColumn() for every column, one per lane, over rows of the profile:
+ * at each row a lane acts only where the scalar loop would have reached. */
+void MeasureColumns(Columns &c)
+{
+	const hn::ScalableTag<std::int32_t> d;
+	const hn::Rebind<std::uint8_t, decltype(d)> d8;
+	const hn::Rebind<float, decltype(d)> df;
+	const int N = static_cast<int>(hn::Lanes(d));
+	/* The differences p(m) - p(m + 1), m = m0..m1 (as far as falls reach). */
+	const int m0 = c.kLoMin - kRun - 1, m1 = c.kHiMax + kRun;
+	HWY_ALIGN std::int32_t diff[(kMaxProfile - 1) * HWY_LANES(std::int32_t)];
+	HWY_ALIGN std::int32_t falls[(kMaxProfile - 1) * HWY_LANES(std::int32_t)];
+	const auto zero = hn::Zero(d), one = hn::Set(d, 1);
+
+	for (int i = 0; i < c.n; i += N) {
+		auto prev = hn::PromoteTo(d, hn::LoadU(d8, &c.p[0][i]));
+		for (int m = m0; m <= m1; ++m) {
+			const auto next = hn::PromoteTo(d, hn::LoadU(d8, &c.p[m - m0 + 1][i]));
+			hn::Store(hn::Sub(prev, next), d, diff + (m - m0) * N);
+			prev = next;
+		}
+		auto at = [&](int m) { return hn::Load(d, diff + (m - m0) * N); };
+
+		/* The strongest fall in kLo..kHi, the first of equals. */
+		/* (No integer >= or <= in this Highway.) */
+		const auto kLo1 = hn::Sub(hn::Load(d, c.kLo + i), one), kHi1 = hn::Add(hn::Load(d, c.kHi + i), one);
+		auto best = zero, bestDrop = zero;
+		for (int k = c.kLoMin; k <= c.kHiMax; ++k) {
+			const auto kv = hn::Set(d, k);
+			const auto drop = hn::Add(at(k - 1), at(k));
+			const auto take = hn::And(hn::And(hn::Gt(kv, kLo1), hn::Lt(kv, kHi1)), hn::Gt(drop, bestDrop));
+			bestDrop = hn::IfThenElse(take, drop, bestDrop);
+			best = hn::IfThenElse(take, kv, best);
+		}
+		const auto valid = hn::Gt(bestDrop, hn::Set(d, kMinDrop - 1));
+
+		/* The run down from best - 1 stops after the last non-fall
+		 * below best - 1, the run up from best + 1 at the first above,
+		 * each at most kRun further. */
+		const auto loStop = hn::Sub(best, one);
+		auto lo = hn::Set(d, m0);
+		for (int m = m0; m <= c.kHiMax - 2; ++m) {
+			const auto mv = hn::Set(d, m);
+			const auto stop = hn::And(hn::Lt(at(m), one), hn::Lt(mv, loStop));
+			lo = hn::IfThenElse(stop, hn::Add(mv, one), lo);
+		}
+		lo = hn::Max(lo, hn::Sub(best, hn::Set(d, kRun + 1)));
+		auto hi = hn::Set(d, m1 + 1);
+		for (int m = m1; m >= c.kLoMin + 1; --m) {
+			const auto mv = hn::Set(d, m);
+			const auto stop = hn::And(hn::Lt(at(m), one), hn::Gt(mv, best));
+			hi = hn::IfThenElse(stop, mv, hi);
+		}
+		hi = hn::Min(hi, hn::Add(best, hn::Set(d, kRun + 1)));
+
+		/* The falls from lo to hi, and their centroid in 1/16 pixel. */
+		const auto lo1 = hn::Sub(lo, one);
+		auto mass = zero, moment2 = zero;
+		for (int m = m0; m <= m1; ++m) {
+			const auto mv = hn::Set(d, m);
+			const auto in = hn::And(hn::Gt(mv, lo1), hn::Lt(mv, hi));
+			const auto fall = hn::IfThenElseZero(in, hn::Max(at(m), zero));
+			hn::Store(fall, d, falls + (m - m0) * N);
+			mass = hn::Add(mass, fall);
+			moment2 = hn::Add(moment2, hn::Mul(fall, hn::Set(d, 2 * m + 1)));
+		}
+		/* (8 moment2 +- mass / 2) / mass, truncated: the quotient of
+		 * |numerator| < 2^21 by mass in floats is off by at most one,
+		 * which the remainder corrects. */
+		const auto num = hn::Add(hn::ShiftLeft<3>(hn::Abs(moment2)), hn::ShiftRight<1>(mass));
+		const auto den = hn::IfThenElse(valid, mass, one);
+		auto q = hn::ConvertTo(d, hn::Div(hn::ConvertTo(df, num), hn::ConvertTo(df, den)));
+		const auto rem = hn::Sub(num, hn::Mul(q, den));
+		q = hn::Add(q, hn::IfThenElseZero(hn::Gt(rem, hn::Sub(den, one)), one));
+		q = hn::Sub(q, hn::IfThenElseZero(hn::Lt(rem, zero), one));
+		const auto c16 = hn::IfThenElse(hn::Lt(moment2, zero), hn::Neg(q), q);
+
+		/* The falls weighted by how much of each lies in the window. */
+		auto wMass = zero, wMoment2 = zero;
+		const auto full = hn::Set(d, 16);
+		for (int m = m0; m <= m1; ++m) {
+			const auto dist = hn::Abs(hn::Sub(hn::Set(d, 16 * m + 8), c16));
+			const auto f16 = hn::Min(hn::Max(hn::Sub(hn::Set(d, kWindow16), dist), zero), full);
+			const auto wf = hn::Mul(f16, hn::Load(d, falls + (m - m0) * N));
+			wMass = hn::Add(wMass, wf);
+			wMoment2 = hn::Add(wMoment2, hn::Mul(wf, hn::Set(d, 2 * m + 1)));
+		}
+		hn::Store(hn::IfThenElseZero(valid, wMass), d, c.mass + i);
+		hn::Store(hn::IfThenElseZero(valid, wMoment2), d, c.moment2 + i);
+	}
+}
+
+} // namespace HWY_NAMESPACE
+} // namespace frappe::detail
+HWY_AFTER_NAMESPACE();
+#endif // FRAPPE_HAVE_HWY
+
+#if !FRAPPE_HAVE_HWY || HWY_ONCE
+namespace frappe::detail {
+
+#if FRAPPE_HAVE_HWY
+HWY_EXPORT(MeasureColumns);
+#endif
+
+namespace {
 
 /* floor and ceil with conversions only (ARMv6 has no rounding instruction,
  * and these run a few times per side). */
@@ -179,6 +336,75 @@ bool fitSide(const ImageView &img, Point2f a, Point2f b, float search, int maxPo
 	 * w; with U = u - u0 and q = 2 w (v - vRef) they are all integers. */
 	std::int64_t sw = 0, su = 0, suu = 0, sq = 0, suq = 0;
 	int used = 0;
+	auto add = [&](int U, std::int32_t vFix, int vc, int wMass, int wMoment2) {
+		if (wMass <= 0)
+			return;
+		/* The crossing is at vc + dir * wMoment2 / (2 wMass); it must lie
+		 * within the search of the side. Both sides times 2 wMass 2^16. */
+		const std::int64_t m2 = 2 * static_cast<std::int64_t>(wMass);
+		const std::int64_t off = m2 * ((static_cast<std::int64_t>(vc) << 16) - vFix) +
+					 static_cast<std::int64_t>(dir * wMoment2) * 65536;
+		if ((off < 0 ? -off : off) > m2 * reachFix)
+			return;
+		const std::int64_t q = m2 * (vc - vRef) + dir * wMoment2;
+		sw += wMass;
+		su += static_cast<std::int64_t>(wMass) * U;
+		suu += static_cast<std::int64_t>(wMass) * U * U;
+		sq += q;
+		suq += q * U;
+		++used;
+	};
+#if FRAPPE_HAVE_HWY
+	/* The columns' geometry and search ranges first, for the rows of
+	 * pixels to gather; then all of them measured at once. */
+	Columns cols;
+	int Us[kFinePoints];
+	std::int32_t vFixes[kFinePoints];
+	cols.kLoMin = kMaxReach;
+	cols.kHiMax = -kMaxReach;
+	for (int i = 0; i < nPoints; ++i, accFix += stepFix) {
+		const int U = accFix >> 16;
+		const std::int32_t vFix = vFix0 + slopeFix * U;
+		const int vc = (vFix + 32768) >> 16;
+		const std::int32_t frac = dir * (vFix - (vc << 16)); /* the side at p[frac], |frac| <= 1/2 */
+		const int kLo = (frac - peakFix + 65535) >> 16, kHi = (frac + peakFix) >> 16;
+		Us[i] = U;
+		vFixes[i] = vFix;
+		cols.kLo[i] = kLo;
+		cols.kHi[i] = kHi;
+		cols.kLoMin = std::min(cols.kLoMin, kLo);
+		cols.kHiMax = std::max(cols.kHiMax, kHi);
+	}
+	/* No column has a step to look for. */
+	if (cols.kLoMin > cols.kHiMax)
+		return false;
+	const int j0 = cols.kLoMin - kRun - 1, rows = cols.kHiMax + kRun + 2 - j0;
+	for (int i = 0; i < nPoints; ++i) {
+		const int u = u0 + Us[i];
+		const int vc = (vFixes[i] + 32768) >> 16;
+		if (u >= 0 && u < uDim && vc - half >= 0 && vc + half < vDim) {
+			const std::uint8_t *px = img.data + u * uStep + vc * vStep + j0 * step;
+			for (int r = 0; r < rows; ++r, px += step)
+				cols.p[r][i] = *px;
+		} else {
+			/* Clamped to the image, as a bilinear sampler would. */
+			const int uc = std::clamp(u, 0, uDim - 1);
+			for (int r = 0; r < rows; ++r)
+				cols.p[r][i] = img.data[uc * uStep + std::clamp(vc + dir * (j0 + r), 0, vDim - 1) * vStep];
+		}
+	}
+	/* Empty searches to whole vectors. */
+	cols.n = (nPoints + Columns::kPad - 1) / Columns::kPad * Columns::kPad;
+	for (int i = nPoints; i < cols.n; ++i) {
+		cols.kLo[i] = 1;
+		cols.kHi[i] = 0;
+	}
+	for (int r = 0; r < rows; ++r)
+		std::fill(&cols.p[r][nPoints], &cols.p[r][cols.n], 0);
+	HWY_DYNAMIC_DISPATCH(MeasureColumns)(cols);
+	for (int i = 0; i < nPoints; ++i)
+		add(Us[i], vFixes[i], (vFixes[i] + 32768) >> 16, cols.mass[i], cols.moment2[i]);
+#else
 	int buf[kMaxProfile];
 	int *const p = buf + half; /* near the image border: p[j], the pixel j steps inwards of the side, clamped */
 	for (int i = 0; i < nPoints; ++i, accFix += stepFix) {
@@ -200,23 +426,9 @@ bool fitSide(const ImageView &img, Point2f a, Point2f b, float search, int maxPo
 				p[j] = img.data[uc * uStep + std::clamp(vc + dir * j, 0, vDim - 1) * vStep];
 			wMass = measureColumn([p](int j) { return p[j]; }, kLo, kHi, wMoment2);
 		}
-		if (wMass <= 0)
-			continue;
-		/* The crossing is at vc + dir * wMoment2 / (2 wMass); it must lie
-		 * within the search of the side. Both sides times 2 wMass 2^16. */
-		const std::int64_t m2 = 2 * static_cast<std::int64_t>(wMass);
-		const std::int64_t off = m2 * ((static_cast<std::int64_t>(vc) << 16) - vFix) +
-					 static_cast<std::int64_t>(dir * wMoment2) * 65536;
-		if ((off < 0 ? -off : off) > m2 * reachFix)
-			continue;
-		const std::int64_t q = m2 * (vc - vRef) + dir * wMoment2;
-		sw += wMass;
-		su += static_cast<std::int64_t>(wMass) * U;
-		suu += static_cast<std::int64_t>(wMass) * U * U;
-		sq += q;
-		suq += q * U;
-		++used;
+		add(U, vFix, vc, wMass, wMoment2);
 	}
+#endif
 	if (used < 3 || used * 2 < nPoints)
 		return false;
 	/* v = vRef + meanV + m (u - u0 - meanU), by weighted least squares. */
@@ -281,3 +493,4 @@ bool refineCorners(const ImageView &image, std::array<Point2f, 4> &corners, floa
 }
 
 } // namespace frappe::detail
+#endif // !FRAPPE_HAVE_HWY || HWY_ONCE
