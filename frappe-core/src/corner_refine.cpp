@@ -46,6 +46,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 
 namespace frappe::detail {
 
@@ -278,6 +279,46 @@ inline int measureColumn(Pixel p, int kLo, int kHi, int &moment2Out)
 	return wMass;
 }
 
+/* Weighted sums over the crossings, weight = the windowed falls' total w;
+ * with U = u - u0 and q = 2 w (v - vRef) they are all integers. */
+struct Sums {
+	std::int64_t sw = 0, su = 0, suu = 0, sq = 0, suq = 0;
+	int used = 0;
+};
+
+/* Adds column U's crossing, at vc + dir * wMoment2 / (2 wMass) when wMass > 0,
+ * if it lies within reachFix (16.16) of the side's vFix. */
+inline void addCrossing(Sums &s, int U, std::int32_t vFix, int vc, int wMass, int wMoment2, int dir, int vRef,
+			std::int64_t reachFix)
+{
+	if (wMass <= 0)
+		return;
+	/* Both sides of the test times 2 wMass 2^16. */
+	const std::int64_t m2 = 2 * static_cast<std::int64_t>(wMass);
+	const std::int64_t off = m2 * ((static_cast<std::int64_t>(vc) << 16) - vFix) +
+				 static_cast<std::int64_t>(dir * wMoment2) * 65536;
+	if ((off < 0 ? -off : off) > m2 * reachFix)
+		return;
+	const std::int64_t q = m2 * (vc - vRef) + dir * wMoment2;
+	s.sw += wMass;
+	s.su += static_cast<std::int64_t>(wMass) * U;
+	s.suu += static_cast<std::int64_t>(wMass) * U * U;
+	s.sq += q;
+	s.suq += q * U;
+	++s.used;
+}
+
+#if FRAPPE_HAVE_HWY
+/* Out of line: inside fitSide the sums stay in memory. */
+[[gnu::noinline]] void addColumns(Sums &s, const Columns &c, int n, const int *Us, const std::int32_t *vFixes, int dir,
+				  int vRef, std::int64_t reachFix)
+{
+	for (int i = 0; i < n; ++i)
+		addCrossing(s, Us[i], vFixes[i], (vFixes[i] + 32768) >> 16, c.mass[i], c.moment2[i], dir, vRef,
+			    reachFix);
+}
+#endif
+
 /* Measures one side from a to b (clockwise quad, so the marker interior is
  * on the right of a->b on screen). */
 bool fitSide(const ImageView &img, Point2f a, Point2f b, float search, int maxPoints, Line &line)
@@ -332,28 +373,7 @@ bool fitSide(const ImageView &img, Point2f a, Point2f b, float search, int maxPo
 	const std::int32_t stepFix = (count << 16) / nPoints;
 	std::int32_t accFix = stepFix >> 1;
 
-	/* Weighted sums over the crossings, weight = the windowed falls' total
-	 * w; with U = u - u0 and q = 2 w (v - vRef) they are all integers. */
-	std::int64_t sw = 0, su = 0, suu = 0, sq = 0, suq = 0;
-	int used = 0;
-	auto add = [&](int U, std::int32_t vFix, int vc, int wMass, int wMoment2) {
-		if (wMass <= 0)
-			return;
-		/* The crossing is at vc + dir * wMoment2 / (2 wMass); it must lie
-		 * within the search of the side. Both sides times 2 wMass 2^16. */
-		const std::int64_t m2 = 2 * static_cast<std::int64_t>(wMass);
-		const std::int64_t off = m2 * ((static_cast<std::int64_t>(vc) << 16) - vFix) +
-					 static_cast<std::int64_t>(dir * wMoment2) * 65536;
-		if ((off < 0 ? -off : off) > m2 * reachFix)
-			return;
-		const std::int64_t q = m2 * (vc - vRef) + dir * wMoment2;
-		sw += wMass;
-		su += static_cast<std::int64_t>(wMass) * U;
-		suu += static_cast<std::int64_t>(wMass) * U * U;
-		sq += q;
-		suq += q * U;
-		++used;
-	};
+	Sums sums;
 #if FRAPPE_HAVE_HWY
 	/* The columns' geometry and search ranges first, for the rows of
 	 * pixels to gather; then all of them measured at once. */
@@ -399,11 +419,11 @@ bool fitSide(const ImageView &img, Point2f a, Point2f b, float search, int maxPo
 		cols.kLo[i] = 1;
 		cols.kHi[i] = 0;
 	}
+	static_assert(kFinePoints + Columns::kPad <= Columns::kLanes);
 	for (int r = 0; r < rows; ++r)
-		std::fill(&cols.p[r][nPoints], &cols.p[r][cols.n], 0);
+		std::memset(&cols.p[r][nPoints], 0, Columns::kPad);
 	HWY_DYNAMIC_DISPATCH(MeasureColumns)(cols);
-	for (int i = 0; i < nPoints; ++i)
-		add(Us[i], vFixes[i], (vFixes[i] + 32768) >> 16, cols.mass[i], cols.moment2[i]);
+	addColumns(sums, cols, nPoints, Us, vFixes, dir, vRef, reachFix);
 #else
 	int buf[kMaxProfile];
 	int *const p = buf + half; /* near the image border: p[j], the pixel j steps inwards of the side, clamped */
@@ -426,10 +446,11 @@ bool fitSide(const ImageView &img, Point2f a, Point2f b, float search, int maxPo
 				p[j] = img.data[uc * uStep + std::clamp(vc + dir * j, 0, vDim - 1) * vStep];
 			wMass = measureColumn([p](int j) { return p[j]; }, kLo, kHi, wMoment2);
 		}
-		add(U, vFix, vc, wMass, wMoment2);
+		addCrossing(sums, U, vFix, vc, wMass, wMoment2, dir, vRef, reachFix);
 	}
 #endif
-	if (used < 3 || used * 2 < nPoints)
+	const std::int64_t sw = sums.sw, su = sums.su, suu = sums.suu, sq = sums.sq, suq = sums.suq;
+	if (sums.used < 3 || sums.used * 2 < nPoints)
 		return false;
 	/* v = vRef + meanV + m (u - u0 - meanU), by weighted least squares. */
 	const double w = static_cast<double>(sw);
