@@ -404,7 +404,15 @@ bool fitSide(const ImageView &img, Point2f a, Point2f b, float search, int maxPo
 		const int vc = (vFixes[i] + 32768) >> 16;
 		if (u >= 0 && u < uDim && vc - half >= 0 && vc + half < vDim) {
 			const std::uint8_t *px = img.data + u * uStep + vc * vStep + j0 * step;
-			for (int r = 0; r < rows; ++r, px += step)
+			/* Four at a time: the copy is a fifth of the time. */
+			int r = 0;
+			for (; r + 4 <= rows; r += 4, px += 4 * step) {
+				cols.p[r][i] = px[0];
+				cols.p[r + 1][i] = px[step];
+				cols.p[r + 2][i] = px[2 * step];
+				cols.p[r + 3][i] = px[3 * step];
+			}
+			for (; r < rows; ++r, px += step)
 				cols.p[r][i] = *px;
 		} else {
 			/* Clamped to the image, as a bilinear sampler would. */
