@@ -201,7 +201,10 @@ void ContourTracer::trace(const EdgeMap &edges, const TraceParams &params, std::
 	if (stride_ != w || (stepTable_.empty() && maskTable_.empty()))
 		buildStepTables(w);
 	stride_ = w;
-	radius2_ = params.cluster_radius * params.cluster_radius;
+	/* A whole squared distance d2 is within the radius when d2 <= r^2,
+	 * i.e. d2 <= floor(r^2). */
+	const float radius2 = params.cluster_radius * params.cluster_radius;
+	radius2Floor_ = radius2 < 4e18f ? static_cast<std::int64_t>(std::floor(radius2)) : INT64_MAX;
 	/* Padding: follow reads neighbours a word at a time, and the start
 	 * scan reads a vector past the end of a stretch. */
 	labels_.resize(static_cast<std::size_t>(w) * h + 128);
@@ -467,16 +470,16 @@ void ContourTracer::clusterCorners()
 {
 	clusters_.clear();
 	tooManyClusters_ = false;
+	/* In integers: pixel coordinates, exact sums and squared distances. */
 	for (int k = 0; k < cornerCount_; ++k) {
 		const std::uint32_t xy = corners_[static_cast<std::size_t>(k)];
 		const int x = static_cast<int>(xy & 0xFFFFu), y = static_cast<int>(xy >> 16);
-		const float fx = static_cast<float>(x), fy = static_cast<float>(y);
 		bool joined = false;
 		for (Cluster &c : clusters_) {
-			const float dx = fx - static_cast<float>(c.fx), dy = fy - static_cast<float>(c.fy);
-			if (dx * dx + dy * dy <= radius2_) {
-				c.sx += fx;
-				c.sy += fy;
+			const std::int64_t dx = x - c.fx, dy = y - c.fy;
+			if (dx * dx + dy * dy <= radius2Floor_) {
+				c.sx += x;
+				c.sy += y;
 				++c.n;
 				joined = true;
 				break;
@@ -488,7 +491,7 @@ void ContourTracer::clusterCorners()
 			tooManyClusters_ = true;
 			return;
 		}
-		clusters_.push_back({ fx, fy, 1, x, y });
+		clusters_.push_back({ x, y, 1, x, y });
 	}
 }
 
@@ -643,8 +646,8 @@ bool ContourTracer::quadFromClusters(Quad &quad) const
 	const int n = static_cast<int>(clusters_.size());
 	std::array<Point2f, kMaxClusters> c{};
 	for (int i = 0; i < n; ++i)
-		c[i] = { clusters_[i].sx / static_cast<float>(clusters_[i].n),
-			 clusters_[i].sy / static_cast<float>(clusters_[i].n) };
+		c[i] = { static_cast<float>(clusters_[i].sx) / static_cast<float>(clusters_[i].n),
+			 static_cast<float>(clusters_[i].sy) / static_cast<float>(clusters_[i].n) };
 	/* Order by angle about the centre: a border that wanders through a gap
 	 * can meet the corners out of turn. */
 	float mx = 0, my = 0;

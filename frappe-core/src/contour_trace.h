@@ -52,9 +52,9 @@ public:
 
 private:
 	struct Cluster {
-		float sx, sy; ///< sums of member coordinates
+		std::int64_t sx, sy; ///< sums of member coordinates
 		int n;
-		int fx, fy;   ///< first member, the cluster's anchor
+		int fx, fy;          ///< first member, the cluster's anchor
 	};
 	void buildStepTables(int w);
 	void follow(int x, int y, int fromDir, const EdgeMap &edges);
@@ -103,7 +103,7 @@ private:
 	bool tooManyClusters_ = false;
 	int borders_ = 0;
 	int stride_ = 0;
-	float radius2_ = 16.0f;
+	std::int64_t radius2Floor_ = 16; ///< floor(cluster_radius^2)
 };
 
 /// Drops quads whose corners all lie within `tolerance` of an earlier quad's
