@@ -129,62 +129,11 @@ void CpuFrontEnd::run(const ImageView &image, float scale, const FrontEndParams 
 void CpuFrontEnd::runBand(const ImageView &src, const FrontEndParams &params, EdgeMap &out,
 			  int y0, int y1, detail::RowScratch &s)
 {
-	const int w = src.width, h = src.height;
-	const detail::RowKernels &k = kernels_;
-	s.resize(w);
-	/* Gradient row r needs smoothed rows r-1..r+1; both live in rings. */
-	auto smoothed = [&](int r) { return s.smooth[r & 3].data(); };
-	auto gradient = [&](int r) {
-		const int i = r % 3;
-		if (r <= 0 || r >= h - 1)
-			detail::zeroGradientRow(w, s.gx[i].data(), s.gy[i].data(), s.mag[i].data());
-		else
-			k.gradient(smoothed(r - 1), smoothed(r), smoothed(r + 1), w, s.gx[i].data(),
-				   s.gy[i].data(), s.mag[i].data(), s.separable.data());
-	};
-	/* Rows beyond the frame replicate its first and last row. */
-	auto smoothRow = [&](int r) {
-		k.smooth(src.row(std::max(r - 1, 0)), src.row(r), src.row(std::min(r + 1, h - 1)), w,
-			 smoothed(r), s.columns.data());
-	};
-	for (int r = std::max(0, y0 - 2); r <= std::min(h - 1, y0 + 1); ++r)
-		smoothRow(r);
-	gradient(y0 - 1);
-	gradient(y0);
-
-	std::uint8_t *acc = s.tileAcc.data();
-	bool accAny = false;
-	std::fill_n(acc, w, 0);
-	for (int y = y0; y < y1; ++y) {
-		const int next = y + 1;
-		if (next + 1 <= h - 1)
-			smoothRow(next + 1);
-		gradient(next);
-		const detail::GradRows rows{
-			{ s.gx[(y - 1) % 3].data(), s.gx[y % 3].data(), s.gx[next % 3].data() },
-			{ s.gy[(y - 1) % 3].data(), s.gy[y % 3].data(), s.gy[next % 3].data() },
-			{ s.mag[(y - 1) % 3].data(), s.mag[y % 3].data(), s.mag[next % 3].data() },
-		};
-		std::uint8_t *edgeRow = out.pixels.data() + static_cast<std::size_t>(y) * w;
-		const bool any = k.edge(rows, w, params, edgeRow);
-		std::uint8_t *tileRow = out.tiles.data() +
-					static_cast<std::size_t>(y / EdgeMap::kTile) * out.tiles_x;
-		if (!k.orRow) {
-			if (any)
-				detail::markTiles(edgeRow, w, tileRow);
-			continue;
-		}
-		/* A vector OR per edge row, the tile test once per tile row. */
-		if (any) {
-			k.orRow(edgeRow, w, acc);
-			accAny = true;
-		}
-		if (accAny && ((y + 1) % EdgeMap::kTile == 0 || y + 1 == y1)) {
-			detail::markTiles(acc, w, tileRow);
-			std::fill_n(acc, w, 0);
-			accAny = false;
-		}
-	}
+	const detail::BandJob job{ src, &params, &out, y0, y1, &s };
+	if (kernels_.band)
+		kernels_.band(job);
+	else
+		detail::runBandRows(kernels_, job);
 }
 
 } // namespace

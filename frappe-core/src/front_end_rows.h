@@ -3,6 +3,7 @@
 // arithmetic they implement).
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -71,6 +72,15 @@ bool edgeSpan(const GradRows &rows, int x0, int x1, const FrontEndParams &params
 /// ORs each 16-pixel run of an edge row into its tile's occupancy byte.
 void markTiles(const std::uint8_t *edgeRow, int w, std::uint8_t *tileRow);
 
+/// One band of the front end: edge rows y0 .. y1-1 (1 <= y0, y1 <= h-1).
+struct BandJob {
+	ImageView src;
+	const FrontEndParams *params;
+	EdgeMap *out;
+	int y0, y1;
+	RowScratch *scratch;
+};
+
 /// The row kernels one front end uses: the portable scalar ones above, or
 /// their vectorised twins, which must produce the same bytes.
 struct RowKernels {
@@ -83,6 +93,9 @@ struct RowKernels {
 	/// acc[x] |= row[x] for w bytes, when a vector OR makes marking the
 	/// tiles once per tile row cheaper than once per edge row; else null.
 	void (*orRow)(const std::uint8_t *row, int w, std::uint8_t *acc) = nullptr;
+	/// runBandRows over kernels called directly, dispatched once per band
+	/// rather than three or four times per row; else null.
+	void (*band)(const BandJob &job) = nullptr;
 };
 
 /// The scalar kernels: the reference, and the ARMv6 path.
@@ -107,6 +120,74 @@ inline std::size_t armv6SmoothedOffset(int x)
 
 /// A CPU front end with the given kernels (tests compare them).
 std::unique_ptr<FrontEnd> makeCpuFrontEnd(int threads, const RowKernels &kernels);
+
+/// The streamed row loop of one band: smoothed and gradient rows in rings,
+/// an edge row per image row, the tile mask. Kernels has RowKernels'
+/// smooth, gradient, edge and orRow, as pointers or as static functions.
+template <class Kernels>
+void runBandRows(const Kernels &k, const BandJob &job)
+{
+	const ImageView &src = job.src;
+	const FrontEndParams &params = *job.params;
+	EdgeMap &out = *job.out;
+	RowScratch &s = *job.scratch;
+	const int w = src.width, h = src.height;
+	const int y0 = job.y0, y1 = job.y1;
+	s.resize(w);
+	/* Gradient row r needs smoothed rows r-1..r+1; both live in rings. */
+	auto smoothed = [&](int r) { return s.smooth[r & 3].data(); };
+	auto gradient = [&](int r) {
+		const int i = r % 3;
+		if (r <= 0 || r >= h - 1)
+			zeroGradientRow(w, s.gx[i].data(), s.gy[i].data(), s.mag[i].data());
+		else
+			k.gradient(smoothed(r - 1), smoothed(r), smoothed(r + 1), w, s.gx[i].data(),
+				   s.gy[i].data(), s.mag[i].data(), s.separable.data());
+	};
+	/* Rows beyond the frame replicate its first and last row. */
+	auto smoothRow = [&](int r) {
+		k.smooth(src.row(std::max(r - 1, 0)), src.row(r), src.row(std::min(r + 1, h - 1)), w,
+			 smoothed(r), s.columns.data());
+	};
+	for (int r = std::max(0, y0 - 2); r <= std::min(h - 1, y0 + 1); ++r)
+		smoothRow(r);
+	gradient(y0 - 1);
+	gradient(y0);
+
+	std::uint8_t *acc = s.tileAcc.data();
+	bool accAny = false;
+	std::fill_n(acc, w, 0);
+	for (int y = y0; y < y1; ++y) {
+		const int next = y + 1;
+		if (next + 1 <= h - 1)
+			smoothRow(next + 1);
+		gradient(next);
+		const GradRows rows{
+			{ s.gx[(y - 1) % 3].data(), s.gx[y % 3].data(), s.gx[next % 3].data() },
+			{ s.gy[(y - 1) % 3].data(), s.gy[y % 3].data(), s.gy[next % 3].data() },
+			{ s.mag[(y - 1) % 3].data(), s.mag[y % 3].data(), s.mag[next % 3].data() },
+		};
+		std::uint8_t *edgeRow = out.pixels.data() + static_cast<std::size_t>(y) * w;
+		const bool any = k.edge(rows, w, params, edgeRow);
+		std::uint8_t *tileRow = out.tiles.data() +
+					static_cast<std::size_t>(y / EdgeMap::kTile) * out.tiles_x;
+		if (!k.orRow) {
+			if (any)
+				markTiles(edgeRow, w, tileRow);
+			continue;
+		}
+		/* A vector OR per edge row, the tile test once per tile row. */
+		if (any) {
+			k.orRow(edgeRow, w, acc);
+			accAny = true;
+		}
+		if (accAny && ((y + 1) % EdgeMap::kTile == 0 || y + 1 == y1)) {
+			markTiles(acc, w, tileRow);
+			std::fill_n(acc, w, 0);
+			accAny = false;
+		}
+	}
+}
 
 /// The corner decision for one pixel from its 3x3 gradient neighbourhood.
 bool isCorner(const GradRows &rows, int x, std::int64_t cornerThreshold);

@@ -30,6 +30,9 @@ namespace HWY_NAMESPACE {
 
 namespace hn = hwy::HWY_NAMESPACE;
 
+/* Internal: the band loop calls its target's kernels without the PLT. */
+namespace {
+
 void SmoothRow(const std::uint8_t *a, const std::uint8_t *b, const std::uint8_t *c, int w,
 	       std::uint8_t *out, std::uint16_t *tmpU)
 {
@@ -371,6 +374,20 @@ bool EdgeRow(const GradRows &rows, int w, const FrontEndParams &params, std::uin
 
 #endif
 
+/* This target's kernels, called directly from its own band loop. */
+struct TargetKernels {
+	static constexpr auto smooth = &SmoothRow;
+	static constexpr auto gradient = &GradientRow;
+	static constexpr auto edge = &EdgeRow;
+	static constexpr auto orRow = &OrRow;
+};
+
+void RunBand(const BandJob &job)
+{
+	runBandRows(TargetKernels{}, job);
+}
+
+} // namespace
 } // namespace HWY_NAMESPACE
 } // namespace frappe::detail
 HWY_AFTER_NAMESPACE();
@@ -382,6 +399,7 @@ HWY_EXPORT(SmoothRow);
 HWY_EXPORT(GradientRow);
 HWY_EXPORT(EdgeRow);
 HWY_EXPORT(OrRow);
+HWY_EXPORT(RunBand);
 
 namespace {
 
@@ -407,11 +425,18 @@ void orDispatch(const std::uint8_t *row, int w, std::uint8_t *acc)
 	HWY_DYNAMIC_DISPATCH(OrRow)(row, w, acc);
 }
 
+/* Resolved per band, so a target chosen for a test is honoured. */
+void bandDispatch(const BandJob &job)
+{
+	HWY_DYNAMIC_DISPATCH(RunBand)(job);
+}
+
 } // namespace
 
 const RowKernels &bestRowKernels()
 {
-	static constexpr RowKernels kSimd{ "highway", smoothDispatch, gradientDispatch, edgeDispatch, orDispatch };
+	static constexpr RowKernels kSimd{ "highway", smoothDispatch, gradientDispatch, edgeDispatch, orDispatch,
+					   bandDispatch };
 	return kSimd;
 }
 
