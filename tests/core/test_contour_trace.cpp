@@ -6,16 +6,14 @@
 
 #include <gtest/gtest.h>
 
-#ifdef FRAPPE_TEST_HWY_TARGETS
-#include <hwy/targets.h>
-#endif
-
 #include "contour_trace.h"
+#include "every_target.h"
 #include "frappe/edge_map.h"
 #include "trace_kernels.h"
 
 using namespace frappe;
 using namespace frappe::detail;
+using frappe::test::onEveryTarget;
 
 namespace {
 
@@ -415,25 +413,6 @@ void expectVectorExtremesMatchScalar(const char *target)
 		++compared;
 	}
 	EXPECT_EQ(compared, 400);
-}
-
-/* Runs `check` on every Highway target this CPU has, or once without. */
-template <class F>
-void onEveryTarget(F check)
-{
-#ifdef FRAPPE_TEST_HWY_TARGETS
-	int targets = 0;
-	for (const std::int64_t t : hwy::SupportedAndGeneratedTargets()) {
-		hwy::SetSupportedTargetsForTest(t);
-		check(hwy::TargetName(t));
-		std::printf("compared on %s\n", hwy::TargetName(t));
-		++targets;
-	}
-	hwy::SetSupportedTargetsForTest(0);
-	EXPECT_GE(targets, 1);
-#else
-	check("scalar build");
-#endif
 }
 
 } // namespace

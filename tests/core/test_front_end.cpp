@@ -6,10 +6,7 @@
 
 #include <gtest/gtest.h>
 
-#ifdef FRAPPE_TEST_HWY_TARGETS
-#include <hwy/targets.h>
-#endif
-
+#include "every_target.h"
 #include "frappe/frappe.h"
 #include "front_end_rows.h"
 #include "scene.h"
@@ -240,17 +237,5 @@ TEST(FrontEnd, VectorKernelsMatchTheScalarOnesByteForByte)
 {
 	if (detail::bestRowKernels().smooth == detail::scalarRowKernels().smooth)
 		GTEST_SKIP() << "built without Highway: only the scalar kernels exist";
-#ifdef FRAPPE_TEST_HWY_TARGETS
-	int targets = 0;
-	for (const std::int64_t t : hwy::SupportedAndGeneratedTargets()) {
-		hwy::SetSupportedTargetsForTest(t);
-		expectVectorKernelsMatchScalar(hwy::TargetName(t));
-		std::printf("compared on %s\n", hwy::TargetName(t));
-		++targets;
-	}
-	hwy::SetSupportedTargetsForTest(0);
-	EXPECT_GE(targets, 1);
-#else
-	expectVectorKernelsMatchScalar("best target");
-#endif
+	test::onEveryTarget(expectVectorKernelsMatchScalar);
 }

@@ -33,6 +33,18 @@ const Pose kPoses[] = {
 	{ 300, 200, 20, 1.5f, 3.0f },
 };
 
+/* Every (id, corners) of the truth found, corners within `tolerance` px on
+ * average. */
+void expectAllFound(const Result &res, const std::vector<std::pair<int, std::array<Point2f, 4>>> &truth,
+		    float tolerance)
+{
+	for (const auto &[id, q] : truth) {
+		const Marker *m = findMarker(res.markers, id);
+		ASSERT_NE(m, nullptr) << "id " << id;
+		EXPECT_LT(meanCornerError(m->corners, q), tolerance) << "id " << id;
+	}
+}
+
 } // namespace
 
 class RenderedMarkers : public ::testing::TestWithParam<int> {};
@@ -98,11 +110,7 @@ TEST(RenderedMarkers, ManyMarkersInOneFrame)
 	}
 	const Result &res = det.detect(img.view());
 	EXPECT_EQ(res.markers.size(), 24u);
-	for (const auto &[id, q] : truth) {
-		const Marker *m = findMarker(res.markers, id);
-		ASSERT_NE(m, nullptr) << "id " << id;
-		EXPECT_LT(meanCornerError(m->corners, q), 0.3f) << "id " << id;
-	}
+	expectAllFound(res, truth, 0.3f);
 }
 
 /* Sub-pixel placement: an upright marker slid across one pixel in tenths.
@@ -193,11 +201,7 @@ TEST(RenderedMarkers, BoardWithOneCellGaps)
 	}
 	const Result &res = det.detect(img.view());
 	EXPECT_EQ(res.markers.size(), truth.size());
-	for (const auto &[id, q] : truth) {
-		const Marker *m = findMarker(res.markers, id);
-		ASSERT_NE(m, nullptr) << "id " << id;
-		EXPECT_LT(meanCornerError(m->corners, q), 0.1f) << "id " << id;
-	}
+	expectAllFound(res, truth, 0.1f);
 }
 
 /* The tracer skips the inside of a quad only when its traced outline reads
