@@ -245,9 +245,9 @@ void ContourTracer::trace(const EdgeMap &edges, const TraceParams &params, std::
 		if ((!tooManyClusters_ && clusters_.size() >= 4 && quadFromClusters(quad) &&
 		     acceptQuad(params, w, h, quad)) ||
 		    (clusters_.size() >= 2 && quadFromOutline(quad) && acceptQuad(params, w, h, quad))) {
-			out.push_back(quad);
 			if (probe && probe->isMarker(quad))
 				sealInside(quad, w, h);
+			out.push_back(quad);
 		}
 	};
 

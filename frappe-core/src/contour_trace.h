@@ -16,6 +16,10 @@ namespace frappe::detail {
 /// clockwise on screen starting anywhere.
 struct Quad {
 	std::array<Point2f, 4> corners;
+	/// What a MarkerProbe noted of the quad when it was asked (the detector:
+	/// how many border cells read white at the traced outline); -1 when
+	/// none. Travels with the quad through sorting and deduplication.
+	int probeRead = -1;
 };
 
 struct TraceParams {
@@ -33,7 +37,8 @@ class MarkerProbe
 {
 public:
 	virtual ~MarkerProbe() = default;
-	virtual bool isMarker(const Quad &quad) = 0;
+	/// May note what it read in quad.probeRead.
+	virtual bool isMarker(Quad &quad) = 0;
 };
 
 /// Follows every border of the edge image once, keeps the closed ones with

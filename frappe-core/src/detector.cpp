@@ -110,29 +110,21 @@ Point2f toFullResolution(Point2f p, float scale)
 class TracedMarkerProbe final : public detail::MarkerProbe
 {
 public:
-	/* What the probe read on each quad: how many border cells were white
-	 * at the traced outline (-1: the quad could not be read). */
-	struct Read {
-		std::array<Point2f, 4> corners;
-		int borderErrors;
-	};
-
-	TracedMarkerProbe(const ImageView &image, float scale, const detail::CodeBook &codes, std::vector<Read> &reads)
-		: image_(image), scale_(scale), codes_(codes), dict_(codes.dictionary()), reads_(reads)
+	TracedMarkerProbe(const ImageView &image, float scale, const detail::CodeBook &codes)
+		: image_(image), scale_(scale), codes_(codes), dict_(codes.dictionary())
 	{
-		reads_.clear();
 	}
-	bool isMarker(const detail::Quad &quad) override
+	/* Notes in quad.probeRead how many border cells read white at the
+	 * traced outline (finish() uses it before refining). */
+	bool isMarker(detail::Quad &quad) override
 	{
 		std::array<Point2f, 4> corners;
 		for (int i = 0; i < 4; ++i)
 			corners[i] = toFullResolution(quad.corners[i], scale_);
-		if (!detail::warpToGrid(image_, corners, dict_.bits + 2, cellCentres_)) {
-			reads_.push_back({ quad.corners, -1 });
+		if (!detail::warpToGrid(image_, corners, dict_.bits + 2, cellCentres_))
 			return false;
-		}
 		const detail::Binarised b = detail::binarise(cellCentres_, dict_.bits);
-		reads_.push_back({ quad.corners, b.border_errors });
+		quad.probeRead = b.border_errors;
 		/* Only an exact codeword: a wrong "yes" would hide whatever lies
 		 * inside the quad (markers on a dark panel, say), and with a small
 		 * dictionary and a generous max_hamming a third of all bit patterns
@@ -146,7 +138,6 @@ private:
 	float scale_;
 	const detail::CodeBook &codes_;
 	const Dictionary &dict_;
-	std::vector<Read> &reads_;
 	detail::WarpedMarker cellCentres_;
 };
 
@@ -188,10 +179,6 @@ struct Detector::Impl {
 		ImageView image; /* the frame, valid until its back end returns */
 		EdgeMap edges;
 		std::vector<detail::Quad> quads;
-		/* Per quad, border cells read white at its traced outline, -1 when
-		 * not read. */
-		std::vector<int> tracedFrame;
-		std::vector<TracedMarkerProbe::Read> reads;
 		Result result;
 	};
 	Slot slots[kSlots];
@@ -251,7 +238,7 @@ void Detector::Impl::trace(Slot &slot)
 	tp.cluster_radius = config.corner_cluster_radius;
 	tp.min_side = std::max(4.0f, config.min_marker_side * scale);
 	tp.border_margin = 1.0f;
-	TracedMarkerProbe probe(slot.image, scale, *codes, slot.reads);
+	TracedMarkerProbe probe(slot.image, scale, *codes);
 	tracer.trace(edges, tp, quads, &probe);
 	detail::removeDuplicateQuads(quads, 2.5f);
 	/* Smallest first: a marker's own outline decodes before the outline of
@@ -259,14 +246,6 @@ void Detector::Impl::trace(Slot &slot)
 	std::sort(quads.begin(), quads.end(), [](const detail::Quad &a, const detail::Quad &b) {
 		return quadArea(a.corners) < quadArea(b.corners);
 	});
-	slot.tracedFrame.assign(quads.size(), -1);
-	for (std::size_t k = 0; k < quads.size(); ++k)
-		for (const TracedMarkerProbe::Read &r : slot.reads)
-			if (std::equal(r.corners.begin(), r.corners.end(), quads[k].corners.begin(),
-				       [](Point2f a, Point2f b) { return a.x == b.x && a.y == b.y; })) {
-				slot.tracedFrame[k] = r.borderErrors;
-				break;
-			}
 	slot.result.times[Stage::Trace] = msSince(t);
 }
 
@@ -336,7 +315,7 @@ void Detector::Impl::finish(const ImageView &image, Slot &slot)
 			refineMs += msSince(t);
 			continue;
 		}
-		const int traced = k < slot.tracedFrame.size() ? slot.tracedFrame[k] : -1;
+		const int traced = q.probeRead;
 		if (traced > mixedFrame && traced < whiteFrame && sidesAtLeast(outline, sureSide)) {
 			refineMs += msSince(t);
 			continue;

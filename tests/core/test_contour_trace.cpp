@@ -163,9 +163,9 @@ struct BoxProbe final : MarkerProbe {
 	float x0, y0, x1, y1;
 	int calls = 0;
 	BoxProbe(float ax, float ay, float bx, float by) : x0(ax), y0(ay), x1(bx), y1(by) {}
-	bool isMarker(const Quad &quad) override
+	bool isMarker(Quad &quad) override
 	{
-		++calls;
+		quad.probeRead = calls++; /* the order it was asked in */
 		float minX = 1e9f, minY = 1e9f;
 		for (const Point2f &c : quad.corners) {
 			minX = std::min(minX, c.x);
@@ -213,6 +213,9 @@ TEST(ContourTrace, InsideOfAProbedMarkerIsSkipped)
 	EXPECT_EQ(tracer.bordersFollowed(), 8);
 	EXPECT_EQ(quads.size(), 8u);
 	EXPECT_EQ(no.calls, 8);
+	/* What the probe noted stays with each quad. */
+	for (std::size_t k = 0; k < quads.size(); ++k)
+		EXPECT_EQ(quads[k].probeRead, static_cast<int>(k));
 }
 
 /* The seal stays inside the probed outline: a ring two pixels beside it,
