@@ -7,7 +7,7 @@
 
 #include "frappe/homography.h"
 #include "corner_refine.h"
-#include "sampling.h"
+#include "warp_kernels.h"
 
 namespace frappe::detail {
 
@@ -17,39 +17,39 @@ bool warpMarker(const ImageView &image, const std::array<Point2f, 4> &corners, i
 	return warpToGrid(image, corners, (bits + 2) * kSamplesPerCell, out);
 }
 
-bool warpToGrid(const ImageView &image, const std::array<Point2f, 4> &corners, int side, WarpedMarker &out)
+namespace {
+
+bool warpWith(void (*sample)(const ImageView &, const Homography &, int, bool, float *), const ImageView &image,
+	      const std::array<Point2f, 4> &corners, int side, WarpedMarker &out)
 {
 	const auto H = Homography::fromUnitSquare(corners);
 	if (!H)
 		return false;
 	out.side = side;
-	/* The samples lie inside the quad (a projective map keeps the unit
-	 * square's inside inside): when its corners are at least a pixel
-	 * inside the image, no sample needs clamping. */
-	bool inside = image.width >= 2 && image.height >= 2;
+	/* The samples lie inside the quad when the homography's denominator
+	 * is positive over the unit square (it is linear there, so at its
+	 * corners; a convex quad's is): then, when the quad's corners are at
+	 * least a pixel inside the image, no sample needs clamping. */
+	const auto &h = H->h;
+	bool inside = image.width >= 2 && image.height >= 2 && h[8] + h[6] > 0.0 && h[8] + h[7] > 0.0 &&
+		      h[8] + h[6] + h[7] > 0.0;
 	for (const Point2f &c : corners)
 		inside = inside && c.x >= 0.0f && c.y >= 0.0f && c.x <= static_cast<float>(image.width - 2) &&
 			 c.y <= static_cast<float>(image.height - 2);
-	/* Along a row of the grid the homography's numerators and denominator
-	 * are linear in the column: three additions and a division a sample. */
-	const auto &h = H->h;
-	const double step = 1.0 / side;
-	for (int j = 0; j < side; ++j) {
-		const double v = (j + 0.5) * step, u0 = 0.5 * step;
-		double nx = h[0] * u0 + h[1] * v + h[2], ny = h[3] * u0 + h[4] * v + h[5];
-		double d = h[6] * u0 + h[7] * v + h[8];
-		const double dnx = h[0] * step, dny = h[3] * step, dd = h[6] * step;
-		float *row = out.samples.data() + static_cast<std::size_t>(j) * side;
-		for (int i = 0; i < side; ++i) {
-			const double r = 1.0 / d;
-			const float x = static_cast<float>(nx * r), y = static_cast<float>(ny * r);
-			row[i] = inside ? sampleInside(image, x, y) : sampleBilinear(image, x, y);
-			nx += dnx;
-			ny += dny;
-			d += dd;
-		}
-	}
+	sample(image, *H, side, inside, out.samples.data());
 	return true;
+}
+
+} // namespace
+
+bool warpToGrid(const ImageView &image, const std::array<Point2f, 4> &corners, int side, WarpedMarker &out)
+{
+	return warpWith(warpSamples, image, corners, side, out);
+}
+
+bool warpToGridScalar(const ImageView &image, const std::array<Point2f, 4> &corners, int side, WarpedMarker &out)
+{
+	return warpWith(warpSamplesScalar, image, corners, side, out);
 }
 
 bool insetQuad(const ImageView &image, std::array<Point2f, 4> &corners, int bits,

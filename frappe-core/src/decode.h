@@ -22,6 +22,9 @@ using WarpedMarker = CandidateSamples;
 /// Warps the quad into `side` x `side` samples (CandidateSamples' grid).
 /// False when the quad is degenerate.
 bool warpToGrid(const ImageView &image, const std::array<Point2f, 4> &corners, int side, WarpedMarker &out);
+/// warpToGrid without SIMD, the reference its vectorised sampling is tested
+/// against.
+bool warpToGridScalar(const ImageView &image, const std::array<Point2f, 4> &corners, int side, WarpedMarker &out);
 
 /// Warps the quad (clockwise, corners[0] mapped to the grid's top-left) into
 /// the sample grid of a marker with `bits` bits a side. False when the quad

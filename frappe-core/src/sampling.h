@@ -9,11 +9,12 @@
 
 namespace frappe::detail {
 
-/// Intensity at (x, y), bilinear, clamped to the image.
+/// Intensity at (x, y), bilinear, clamped to the image (a NaN coordinate
+/// to 0, where std::clamp would pass it on to an undefined conversion).
 inline float sampleBilinear(const ImageView &img, float x, float y)
 {
-	x = std::clamp(x, 0.0f, static_cast<float>(img.width - 1));
-	y = std::clamp(y, 0.0f, static_cast<float>(img.height - 1));
+	x = x >= 0.0f ? std::min(x, static_cast<float>(img.width - 1)) : 0.0f;
+	y = y >= 0.0f ? std::min(y, static_cast<float>(img.height - 1)) : 0.0f;
 	const int x0 = std::min(static_cast<int>(x), img.width - 2 < 0 ? 0 : img.width - 2);
 	const int y0 = std::min(static_cast<int>(y), img.height - 2 < 0 ? 0 : img.height - 2);
 	const int x1 = std::min(x0 + 1, img.width - 1), y1 = std::min(y0 + 1, img.height - 1);

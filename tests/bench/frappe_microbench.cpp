@@ -133,6 +133,22 @@ void BM_WarpDecode(benchmark::State &state)
 	state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(s.truth.size()));
 }
 
+/* The warp alone, per marker: side 16 (finish()'s 2x2 samples a cell, 6x6
+ * codes) or 8 (the trace's probe, a sample a cell). */
+void BM_Warp(benchmark::State &state)
+{
+	const Scene &s = scene(24);
+	const int side = static_cast<int>(state.range(0));
+	detail::WarpedMarker warped;
+	for (auto _ : state) {
+		for (const auto &q : s.truth) {
+			benchmark::DoNotOptimize(detail::warpToGrid(s.view(), q, side, warped));
+			benchmark::DoNotOptimize(warped.samples.data());
+		}
+	}
+	state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(s.truth.size()));
+}
+
 void BM_Detect(benchmark::State &state)
 {
 	const Scene &s = scene(static_cast<int>(state.range(0)));
@@ -151,6 +167,7 @@ BENCHMARK(BM_FrontEndBest)->Arg(1)->Arg(24)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_Trace)->Arg(1)->Arg(24)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_Refine)->Arg(1)->Arg(24)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_WarpDecode)->Arg(1)->Arg(24)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_Warp)->Arg(8)->Arg(16)->Unit(benchmark::kNanosecond);
 BENCHMARK(BM_Detect)->Arg(1)->Arg(24)->Unit(benchmark::kMicrosecond);
 
 BENCHMARK_MAIN();

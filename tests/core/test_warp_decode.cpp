@@ -1,15 +1,30 @@
 // SPDX-License-Identifier: MIT
-// Homographies, the perspective warp and binarisation on known inputs.
+// Homographies, the perspective warp and binarisation on known inputs, and
+// the vectorised warp against the scalar one on every Highway target.
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <random>
+#include <vector>
+
 #include <gtest/gtest.h>
 
+#if defined(__linux__)
+#include <sys/mman.h>
+#include <unistd.h>
+#endif
+
 #include "decode.h"
+#include "every_target.h"
 #include "frappe/frappe.h"
 #include "frappe/homography.h"
 #include "frappe/render.h"
 #include "scene.h"
+#include "warp_kernels.h"
 
 using namespace frappe;
 using frappe::test::Image;
+using frappe::test::onEveryTarget;
 
 TEST(Homography, MapsTheUnitSquareToTheQuad)
 {
@@ -91,4 +106,166 @@ TEST(Binarise, TheQuietZoneOutlineReadsAsAWhiteFrame)
 	EXPECT_NEAR(q[0].x, 15.5f, 0.2f);
 	EXPECT_NEAR(q[2].y, 79.5f, 0.2f);
 	EXPECT_EQ(detail::decode(d, detail::binarise(w, d.bits).code, 5).id, 7);
+}
+
+namespace {
+
+/* Random pixels in a buffer that ends where the image's last row does, with
+ * unreadable pages on either side where the system has them: a read past
+ * either end of the image faults. */
+class GuardedImage
+{
+public:
+	GuardedImage(int width, int height, int stride, std::mt19937 &rng)
+		: width_(width), height_(height), stride_(stride)
+	{
+		const std::size_t bytes = static_cast<std::size_t>(height - 1) * stride + width;
+#if defined(__linux__)
+		page_ = static_cast<std::size_t>(sysconf(_SC_PAGESIZE));
+		const std::size_t inner = (bytes + page_ - 1) / page_ * page_;
+		size_ = inner + 2 * page_;
+		void *m = mmap(nullptr, size_, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+		EXPECT_NE(m, MAP_FAILED);
+		map_ = static_cast<std::uint8_t *>(m);
+		mprotect(map_, page_, PROT_NONE);
+		mprotect(map_ + page_ + inner, page_, PROT_NONE);
+		data_ = map_ + page_ + inner - bytes;
+#else
+		own_.resize(bytes);
+		data_ = own_.data();
+#endif
+		std::uniform_int_distribution<int> px(0, 255);
+		for (std::size_t i = 0; i < bytes; ++i)
+			data_[i] = static_cast<std::uint8_t>(px(rng));
+	}
+	GuardedImage(const GuardedImage &) = delete;
+	GuardedImage &operator=(const GuardedImage &) = delete;
+	~GuardedImage()
+	{
+#if defined(__linux__)
+		munmap(map_, size_);
+#endif
+	}
+	ImageView view() const { return { data_, width_, height_, stride_ }; }
+
+private:
+	int width_, height_, stride_;
+	std::uint8_t *data_ = nullptr;
+#if defined(__linux__)
+	std::uint8_t *map_ = nullptr;
+	std::size_t page_ = 0, size_ = 0;
+#else
+	std::vector<std::uint8_t> own_;
+#endif
+};
+
+using Quad = std::array<Point2f, 4>;
+
+/* Quads of every kind the warp may meet: convex ones inside the image, with
+ * corners on its last sampleable row and column or on the border itself,
+ * partly and wholly outside, tiny ones, collinear (degenerate), concave and
+ * self-crossing ones (whose homography crosses infinity), and NaN corners. */
+std::vector<Quad> makeQuads(int width, int height, std::mt19937 &rng)
+{
+	const float w = static_cast<float>(width), h = static_cast<float>(height);
+	std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+	auto around = [&](float cx, float cy, float r) {
+		/* A convex quad: four corners at increasing angles, clockwise on screen. */
+		Quad q;
+		const float a0 = 6.2832f * unit(rng);
+		for (int i = 0; i < 4; ++i) {
+			const float a = a0 + 1.5708f * i + 0.6f * (unit(rng) - 0.5f);
+			const float ri = r * (0.6f + 0.4f * unit(rng));
+			q[i] = { cx + ri * std::cos(a), cy + ri * std::sin(a) };
+		}
+		return q;
+	};
+	std::vector<Quad> quads;
+	for (int k = 0; k < 60; ++k) {
+		const float r = std::max(w, h) * (0.05f + 0.5f * unit(rng));
+		quads.push_back(around(w * unit(rng), h * unit(rng), r)); /* anywhere, often across the border */
+		quads.push_back(around(w * (0.3f + 0.4f * unit(rng)), h * (0.3f + 0.4f * unit(rng)),
+				       std::min(w, h) * 0.25f * unit(rng))); /* mostly inside */
+		quads.push_back(around(w * unit(rng), h * unit(rng), 0.01f + unit(rng))); /* tiny */
+		quads.push_back(around(w * (4.0f * unit(rng) - 1.5f), h * (4.0f * unit(rng) - 1.5f), w * unit(rng)));
+	}
+	const float xs = w - 2.0f, ys = h - 2.0f; /* the last corners that need no clamps */
+	quads.push_back({ Point2f{ 0, 0 }, { xs, 0 }, { xs, ys }, { 0, ys } });
+	quads.push_back({ Point2f{ 0, 0 }, { w - 1, 0 }, { w - 1, h - 1 }, { 0, h - 1 } });
+	quads.push_back({ Point2f{ -0.5f, -0.5f }, { w - 0.5f, -0.5f }, { w - 0.5f, h - 0.5f }, { -0.5f, h - 0.5f } });
+	quads.push_back({ Point2f{ xs, ys }, { xs, 0 }, { 0, 0 }, { 0, ys } });		/* counter-clockwise */
+	quads.push_back({ Point2f{ 0, 0 }, { xs, ys }, { xs, 0 }, { 0, ys } });		/* self-crossing */
+	quads.push_back({ Point2f{ 0, 0 }, { xs, 0 }, { xs * 0.2f, ys * 0.2f }, { 0, ys } }); /* concave */
+	quads.push_back({ Point2f{ 1, 1 }, { 2, 2 }, { 3, 3 }, { 4, 4 } });		/* collinear */
+	quads.push_back({ Point2f{ 0.5f, 0.5f }, { 0.5f, 0.5f }, { 0.5f, 0.5f }, { 0.5f, 0.5f } });
+	quads.push_back({ Point2f{ -1e6f, -1e6f }, { 1e6f, -1e6f }, { 1e6f, 1e6f }, { -1e6f, 1e6f } });
+	const float nan = std::numeric_limits<float>::quiet_NaN();
+	quads.push_back({ Point2f{ 0, 0 }, { nan, 0 }, { xs, ys }, { 0, ys } });
+	return quads;
+}
+
+struct Warped {
+	bool ok;
+	detail::WarpedMarker samples;
+};
+
+bool sameBits(const Warped &a, const Warped &b)
+{
+	if (a.ok != b.ok)
+		return false;
+	if (!a.ok)
+		return true;
+	const std::size_t n = static_cast<std::size_t>(a.samples.side) * a.samples.side;
+	return a.samples.side == b.samples.side &&
+	       std::memcmp(a.samples.samples.data(), b.samples.samples.data(), n * sizeof(float)) == 0;
+}
+
+} // namespace
+
+/* Every grid side up to the largest, on images from the smallest a 2x2
+ * neighbourhood fits to odd widths with and without row padding. */
+TEST(Warp, VectorFormMatchesTheScalarOne)
+{
+	struct Size {
+		int width, height, stride;
+	};
+	const Size sizes[] = { { 2, 2, 2 }, { 3, 7, 3 }, { 2, 33, 5 }, { 17, 5, 17 }, { 64, 48, 64 },
+			       { 101, 67, 103 }, { 333, 211, 333 }, { 640, 480, 672 } };
+	std::mt19937 rng(11);
+	int compared = 0;
+	for (const Size &size : sizes) {
+		const GuardedImage image(size.width, size.height, size.stride, rng);
+		const ImageView view = image.view();
+		const std::vector<Quad> quads = makeQuads(size.width, size.height, rng);
+		std::vector<Warped> scalar;
+		for (const Quad &q : quads) {
+			for (int side = 1; side <= CandidateSamples::kMaxSide; ++side) {
+				Warped s;
+				s.ok = detail::warpToGridScalar(view, q, side, s.samples);
+				/* The no-clamp shortcut changes nothing. */
+				if (s.ok) {
+					Warped clamped{ true, {} };
+					clamped.samples.side = side;
+					detail::warpSamplesScalar(view, *Homography::fromUnitSquare(q), side, false,
+								  clamped.samples.samples.data());
+					ASSERT_TRUE(sameBits(s, clamped)) << size.width << "x" << size.height << " side " << side;
+				}
+				scalar.push_back(s);
+			}
+		}
+		onEveryTarget([&](const char *target) {
+			std::size_t n = 0;
+			for (const Quad &q : quads) {
+				for (int side = 1; side <= CandidateSamples::kMaxSide; ++side, ++n) {
+					Warped v;
+					v.ok = detail::warpToGrid(view, q, side, v.samples);
+					ASSERT_TRUE(sameBits(v, scalar[n]))
+						<< target << ", " << size.width << "x" << size.height << " stride " << size.stride
+						<< ", quad " << n / CandidateSamples::kMaxSide << ", side " << side;
+					++compared;
+				}
+			}
+		});
+	}
+	EXPECT_GT(compared, 10000);
 }

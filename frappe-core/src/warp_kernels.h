@@ -1,0 +1,24 @@
+// SPDX-License-Identifier: MIT
+// The perspective warp's sampling: a grid of points through a homography
+// and a bilinear sample at each, vectorised where Highway is built in.
+#pragma once
+
+#include "frappe/homography.h"
+#include "frappe/image.h"
+
+namespace frappe::detail {
+
+/// out[j * side + i] = sampleBilinear(image, H(u, v)) for u = (i + 0.5) / side
+/// and v = (j + 0.5) / side, i, j in [0, side). The point is evaluated in
+/// double (as h0 u + (h1 v + h2), h3 u + (h4 v + h5) over h6 u + (h7 v + h8),
+/// through the reciprocal of the denominator) and rounded to float, without
+/// fused multiply-adds. `inside` says that every point lies in
+/// [0, width - 2] x [0, height - 2], so that the scalar form may skip the
+/// clamps; the vector form clamps regardless (it costs it next to nothing).
+void warpSamples(const ImageView &image, const Homography &H, int side, bool inside, float *out);
+
+/// The same without SIMD, the reference the vectorised form is tested
+/// against.
+void warpSamplesScalar(const ImageView &image, const Homography &H, int side, bool inside, float *out);
+
+} // namespace frappe::detail
