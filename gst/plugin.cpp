@@ -11,6 +11,8 @@ static gboolean plugin_init(GstPlugin *plugin)
 	return GST_ELEMENT_REGISTER(frappedetect, plugin);
 }
 
+/* "MIT/X11" is how GStreamer names the MIT licence: with any string outside
+ * its list, every registry scan logs an "unknown license" warning. */
 GST_PLUGIN_DEFINE(GST_VERSION_MAJOR, GST_VERSION_MINOR, frappe,
 		  "Frappe square fiducial marker (ArUco, AprilTag) detection",
-		  plugin_init, FRAPPE_VERSION, "MIT", "frappe", "https://github.com/frappe-markers/frappe")
+		  plugin_init, FRAPPE_VERSION, "MIT/X11", "frappe", "https://github.com/frappe-markers/frappe")

@@ -1,13 +1,17 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: MIT
 """gst-inspect-1.0 frappedetect must exit 0, print no warnings or criticals,
-and list every property the issue asks for."""
+and list every property the issue asks for; the plugin's licence must be one
+GStreamer knows (else every registry scan warns of an unknown license)."""
 import subprocess
 import sys
 
 PROPERTIES = ["dictionary", "mode", "edge-threshold", "corner-threshold", "max-hamming",
               "scaled-size", "max-scaled-frames", "annotate", "post-messages", "pipelined",
               "backend", "marker-size", "camera-matrix", "distortion", "stats"]
+# gst_plugin_check_license()'s list (GStreamer 1.22).
+KNOWN_LICENSES = ["LGPL", "GPL", "QPL", "GPL/QPL", "MPL", "BSD", "MIT/X11", "0BSD", "Proprietary",
+                  "unknown"]
 
 
 def main():
@@ -26,6 +30,15 @@ def main():
     missing = [name for name in PROPERTIES if f"\n  {name} " not in out]
     if missing:
         print("missing properties: " + ", ".join(missing))
+        return 1
+    plugin = subprocess.run([inspect, "frappe"], capture_output=True, text=True).stdout
+    licence = [l.split(None, 1)[1].strip() for l in plugin.splitlines()
+               if l.strip().startswith("License") and len(l.split(None, 1)) == 2]
+    if licence != [] and licence[0] not in KNOWN_LICENSES:
+        print(f"licence {licence[0]!r} is not one GStreamer knows: {KNOWN_LICENSES}")
+        return 1
+    if licence == []:
+        print("no License line in gst-inspect-1.0 frappe")
         return 1
     for fmt in ("GRAY8", "I420", "YV12", "NV12", "NV21"):
         if fmt not in out:
