@@ -31,14 +31,16 @@ uint32_t Memory::alloc(uint32_t bytes, uint32_t align)
 uint32_t Memory::load(std::span<const uint64_t> code)
 {
 	const uint32_t address = alloc(static_cast<uint32_t>(code.size() * 8));
-	std::memcpy(&bytes_[address - base_], code.data(), code.size() * 8);
+	if (!code.empty()) /* an empty span's data() may be null: no memcpy */
+		std::memcpy(&bytes_[address - base_], code.data(), code.size() * 8);
 	return address;
 }
 
 uint32_t Memory::load(std::span<const uint32_t> words)
 {
 	const uint32_t address = alloc(static_cast<uint32_t>(words.size() * 4 + 4));
-	std::memcpy(&bytes_[address - base_], words.data(), words.size() * 4);
+	if (!words.empty())
+		std::memcpy(&bytes_[address - base_], words.data(), words.size() * 4);
 	return address;
 }
 
