@@ -90,9 +90,6 @@ struct RowKernels {
 	void (*gradient)(const std::uint8_t *a, const std::uint8_t *b, const std::uint8_t *c, int w,
 			 std::int16_t *gx, std::int16_t *gy, std::int32_t *mag, std::int16_t *tmp);
 	bool (*edge)(const GradRows &rows, int w, const FrontEndParams &params, std::uint8_t *out);
-	/// acc[x] |= row[x] for w bytes, when a vector OR makes marking the
-	/// tiles once per tile row cheaper than once per edge row; else null.
-	void (*orRow)(const std::uint8_t *row, int w, std::uint8_t *acc) = nullptr;
 	/// runBandRows over kernels called directly, dispatched once per band
 	/// rather than three or four times per row; else null.
 	void (*band)(const BandJob &job) = nullptr;
@@ -123,10 +120,13 @@ std::unique_ptr<FrontEnd> makeCpuFrontEnd(int threads, const RowKernels &kernels
 
 /// The streamed row loop of one band: smoothed and gradient rows in rings,
 /// an edge row per image row, the tile mask. Kernels has RowKernels'
-/// smooth, gradient, edge and orRow, as pointers or as static functions.
+/// smooth, gradient and edge, as pointers or as static functions, and may
+/// have a static orRow(row, w, acc) (acc[x] |= row[x]): where a vector OR
+/// makes marking the tiles once per tile row cheaper than once per edge row.
 template <class Kernels>
 void runBandRows(const Kernels &k, const BandJob &job)
 {
+	constexpr bool kOrRows = requires { Kernels::orRow; };
 	const ImageView &src = job.src;
 	const FrontEndParams &params = *job.params;
 	EdgeMap &out = *job.out;
@@ -154,9 +154,11 @@ void runBandRows(const Kernels &k, const BandJob &job)
 	gradient(y0 - 1);
 	gradient(y0);
 
-	std::uint8_t *acc = s.tileAcc.data();
-	bool accAny = false;
-	std::fill_n(acc, w, 0);
+	/* With orRow: the OR of the tile row's edge rows so far. */
+	[[maybe_unused]] std::uint8_t *acc = s.tileAcc.data();
+	[[maybe_unused]] bool accAny = false;
+	if constexpr (kOrRows)
+		std::fill_n(acc, w, 0);
 	for (int y = y0; y < y1; ++y) {
 		const int next = y + 1;
 		if (next + 1 <= h - 1)
@@ -171,20 +173,20 @@ void runBandRows(const Kernels &k, const BandJob &job)
 		const bool any = k.edge(rows, w, params, edgeRow);
 		std::uint8_t *tileRow = out.tiles.data() +
 					static_cast<std::size_t>(y / EdgeMap::kTile) * out.tiles_x;
-		if (!k.orRow) {
+		if constexpr (!kOrRows) {
 			if (any)
 				markTiles(edgeRow, w, tileRow);
-			continue;
-		}
-		/* A vector OR per edge row, the tile test once per tile row. */
-		if (any) {
-			k.orRow(edgeRow, w, acc);
-			accAny = true;
-		}
-		if (accAny && ((y + 1) % EdgeMap::kTile == 0 || y + 1 == y1)) {
-			markTiles(acc, w, tileRow);
-			std::fill_n(acc, w, 0);
-			accAny = false;
+		} else {
+			/* A vector OR per edge row, the tile test once per tile row. */
+			if (any) {
+				Kernels::orRow(edgeRow, w, acc);
+				accAny = true;
+			}
+			if (accAny && ((y + 1) % EdgeMap::kTile == 0 || y + 1 == y1)) {
+				markTiles(acc, w, tileRow);
+				std::fill_n(acc, w, 0);
+				accAny = false;
+			}
 		}
 	}
 }

@@ -398,7 +398,6 @@ namespace frappe::detail {
 HWY_EXPORT(SmoothRow);
 HWY_EXPORT(GradientRow);
 HWY_EXPORT(EdgeRow);
-HWY_EXPORT(OrRow);
 HWY_EXPORT(RunBand);
 
 namespace {
@@ -420,11 +419,6 @@ bool edgeDispatch(const GradRows &rows, int w, const FrontEndParams &params, std
 	return HWY_DYNAMIC_DISPATCH(EdgeRow)(rows, w, params, out);
 }
 
-void orDispatch(const std::uint8_t *row, int w, std::uint8_t *acc)
-{
-	HWY_DYNAMIC_DISPATCH(OrRow)(row, w, acc);
-}
-
 /* Resolved per band, so a target chosen for a test is honoured. */
 void bandDispatch(const BandJob &job)
 {
@@ -435,8 +429,7 @@ void bandDispatch(const BandJob &job)
 
 const RowKernels &bestRowKernels()
 {
-	static constexpr RowKernels kSimd{ "highway", smoothDispatch, gradientDispatch, edgeDispatch, orDispatch,
-					   bandDispatch };
+	static constexpr RowKernels kSimd{ "highway", smoothDispatch, gradientDispatch, edgeDispatch, bandDispatch };
 	return kSimd;
 }
 
