@@ -279,6 +279,27 @@ inline int measureColumn(Pixel p, int kLo, int kHi, int &moment2Out)
 	return wMass;
 }
 
+/* Column U of a side: where the side crosses it (vFix, 16.16, and the
+ * nearest pixel vc) and the range kLo..kHi of steps inwards from vc where
+ * the edge's fall is looked for. */
+struct ColumnAt {
+	int U;
+	std::int32_t vFix;
+	int vc, kLo, kHi;
+};
+
+inline ColumnAt columnAt(int U, std::int32_t vFix0, std::int32_t slopeFix, int dir, std::int32_t peakFix)
+{
+	ColumnAt c;
+	c.U = U;
+	c.vFix = vFix0 + slopeFix * U;
+	c.vc = (c.vFix + 32768) >> 16;
+	const std::int32_t frac = dir * (c.vFix - (c.vc << 16)); /* the side at p[frac], |frac| <= 1/2 */
+	c.kLo = (frac - peakFix + 65535) >> 16;
+	c.kHi = (frac + peakFix) >> 16;
+	return c;
+}
+
 /* Weighted sums over the crossings, weight = the windowed falls' total w;
  * with U = u - u0 and q = 2 w (v - vRef) they are all integers. */
 struct Sums {
@@ -383,17 +404,13 @@ bool fitSide(const ImageView &img, Point2f a, Point2f b, float search, int maxPo
 	cols.kLoMin = kMaxReach;
 	cols.kHiMax = -kMaxReach;
 	for (int i = 0; i < nPoints; ++i, accFix += stepFix) {
-		const int U = accFix >> 16;
-		const std::int32_t vFix = vFix0 + slopeFix * U;
-		const int vc = (vFix + 32768) >> 16;
-		const std::int32_t frac = dir * (vFix - (vc << 16)); /* the side at p[frac], |frac| <= 1/2 */
-		const int kLo = (frac - peakFix + 65535) >> 16, kHi = (frac + peakFix) >> 16;
-		Us[i] = U;
-		vFixes[i] = vFix;
-		cols.kLo[i] = kLo;
-		cols.kHi[i] = kHi;
-		cols.kLoMin = std::min(cols.kLoMin, kLo);
-		cols.kHiMax = std::max(cols.kHiMax, kHi);
+		const ColumnAt c = columnAt(accFix >> 16, vFix0, slopeFix, dir, peakFix);
+		Us[i] = c.U;
+		vFixes[i] = c.vFix;
+		cols.kLo[i] = c.kLo;
+		cols.kHi[i] = c.kHi;
+		cols.kLoMin = std::min(cols.kLoMin, c.kLo);
+		cols.kHiMax = std::max(cols.kHiMax, c.kHi);
 	}
 	/* No column has a step to look for. */
 	if (cols.kLoMin > cols.kHiMax)
@@ -436,12 +453,8 @@ bool fitSide(const ImageView &img, Point2f a, Point2f b, float search, int maxPo
 	int buf[kMaxProfile];
 	int *const p = buf + half; /* near the image border: p[j], the pixel j steps inwards of the side, clamped */
 	for (int i = 0; i < nPoints; ++i, accFix += stepFix) {
-		const int U = accFix >> 16;
+		const auto [U, vFix, vc, kLo, kHi] = columnAt(accFix >> 16, vFix0, slopeFix, dir, peakFix);
 		const int u = u0 + U;
-		const std::int32_t vFix = vFix0 + slopeFix * U;
-		const int vc = (vFix + 32768) >> 16;
-		const std::int32_t frac = dir * (vFix - (vc << 16)); /* the side at p[frac], |frac| <= 1/2 */
-		const int kLo = (frac - peakFix + 65535) >> 16, kHi = (frac + peakFix) >> 16;
 		int wMass, wMoment2 = 0;
 		if (u >= 0 && u < uDim && vc - half >= 0 && vc + half < vDim) {
 			const std::uint8_t *px = img.data + u * uStep + vc * vStep;
