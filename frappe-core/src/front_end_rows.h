@@ -81,8 +81,9 @@ struct BandJob {
 	RowScratch *scratch;
 };
 
-/// The row kernels one front end uses: the portable scalar ones above, or
-/// their vectorised twins, which must produce the same bytes.
+/// The row kernels one front end uses: the portable scalar ones above (or
+/// the ARMv6 ones), run by runBandRows; or a band loop of vectorised twins,
+/// which must produce the same bytes, with the row kernels null.
 struct RowKernels {
 	const char *name;
 	void (*smooth)(const std::uint8_t *a, const std::uint8_t *b, const std::uint8_t *c, int w,
@@ -91,7 +92,7 @@ struct RowKernels {
 			 std::int16_t *gx, std::int16_t *gy, std::int32_t *mag, std::int16_t *tmp);
 	bool (*edge)(const GradRows &rows, int w, const FrontEndParams &params, std::uint8_t *out);
 	/// runBandRows over kernels called directly, dispatched once per band
-	/// rather than three or four times per row; else null.
+	/// rather than three or four times per row; null for the row kernels.
 	void (*band)(const BandJob &job) = nullptr;
 };
 

@@ -395,29 +395,9 @@ HWY_AFTER_NAMESPACE();
 #if HWY_ONCE
 namespace frappe::detail {
 
-HWY_EXPORT(SmoothRow);
-HWY_EXPORT(GradientRow);
-HWY_EXPORT(EdgeRow);
 HWY_EXPORT(RunBand);
 
 namespace {
-
-void smoothDispatch(const std::uint8_t *a, const std::uint8_t *b, const std::uint8_t *c, int w,
-		    std::uint8_t *out, std::uint16_t *tmp)
-{
-	HWY_DYNAMIC_DISPATCH(SmoothRow)(a, b, c, w, out, tmp);
-}
-
-void gradientDispatch(const std::uint8_t *a, const std::uint8_t *b, const std::uint8_t *c, int w,
-		      std::int16_t *gx, std::int16_t *gy, std::int32_t *mag, std::int16_t *tmp)
-{
-	HWY_DYNAMIC_DISPATCH(GradientRow)(a, b, c, w, gx, gy, mag, tmp);
-}
-
-bool edgeDispatch(const GradRows &rows, int w, const FrontEndParams &params, std::uint8_t *out)
-{
-	return HWY_DYNAMIC_DISPATCH(EdgeRow)(rows, w, params, out);
-}
 
 /* Resolved per band, so a target chosen for a test is honoured. */
 void bandDispatch(const BandJob &job)
@@ -429,7 +409,8 @@ void bandDispatch(const BandJob &job)
 
 const RowKernels &bestRowKernels()
 {
-	static constexpr RowKernels kSimd{ "highway", smoothDispatch, gradientDispatch, edgeDispatch, bandDispatch };
+	/* Only the band loop: each target's loop calls its own row kernels. */
+	static constexpr RowKernels kSimd{ "highway", nullptr, nullptr, nullptr, bandDispatch };
 	return kSimd;
 }
 

@@ -235,7 +235,7 @@ void expectVectorKernelsMatchScalar(const char *target)
 
 TEST(FrontEnd, VectorKernelsMatchTheScalarOnesByteForByte)
 {
-	if (detail::bestRowKernels().smooth == detail::scalarRowKernels().smooth)
+	if (&detail::bestRowKernels() == &detail::scalarRowKernels())
 		GTEST_SKIP() << "built without Highway: only the scalar kernels exist";
 	test::onEveryTarget(expectVectorKernelsMatchScalar);
 }
