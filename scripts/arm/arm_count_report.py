@@ -113,7 +113,7 @@ def stage_of(obj, name):
         if "warpMarker" in name:
             return "warp"
         return "decode"
-    if base == "homography":
+    if base in ("homography", "warp_kernels"):
         return "warp"
     if base in ("dictionary", "dictionaries"):
         return "decode"
