@@ -119,6 +119,7 @@ enum {
 	PROP_MODE,
 	PROP_EDGE_THRESHOLD,
 	PROP_CORNER_THRESHOLD,
+	PROP_REGION_CONTRAST,
 	PROP_MAX_HAMMING,
 	PROP_SCALED_SIZE,
 	PROP_MAX_SCALED_FRAMES,
@@ -148,6 +149,7 @@ typedef enum {
 #define DEFAULT_MODE GST_FRAPPE_MODE_NORMAL
 #define DEFAULT_EDGE_THRESHOLD 0.27f
 #define DEFAULT_CORNER_THRESHOLD 0.19f
+#define DEFAULT_REGION_CONTRAST (frappe::Config{}.region_contrast)
 #define DEFAULT_MAX_HAMMING -1
 #define DEFAULT_SCALED_SIZE 28.0f
 #define DEFAULT_MAX_SCALED_FRAMES 5
@@ -244,6 +246,7 @@ struct Settings {
 	GstFrappeMode mode = DEFAULT_MODE;
 	gfloat edgeThreshold = DEFAULT_EDGE_THRESHOLD;
 	gfloat cornerThreshold = DEFAULT_CORNER_THRESHOLD;
+	gfloat regionContrast = DEFAULT_REGION_CONTRAST;
 	gint maxHamming = DEFAULT_MAX_HAMMING;
 	gfloat scaledSize = DEFAULT_SCALED_SIZE;
 	gint maxScaledFrames = DEFAULT_MAX_SCALED_FRAMES;
@@ -258,7 +261,8 @@ struct Settings {
 	bool sameDetector(const Settings &o) const
 	{
 		return dictionary == o.dictionary && mode == o.mode && edgeThreshold == o.edgeThreshold &&
-		       cornerThreshold == o.cornerThreshold && maxHamming == o.maxHamming &&
+		       cornerThreshold == o.cornerThreshold && regionContrast == o.regionContrast &&
+		       maxHamming == o.maxHamming &&
 		       scaledSize == o.scaledSize && maxScaledFrames == o.maxScaledFrames &&
 		       backend == o.backend;
 	}
@@ -390,6 +394,7 @@ static frappe::Config make_config(const Settings &s)
 	config.mode = s.mode == GST_FRAPPE_MODE_ASCALE ? frappe::Mode::AScale : frappe::Mode::Normal;
 	config.edge_threshold = s.edgeThreshold;
 	config.corner_threshold = s.cornerThreshold;
+	config.region_contrast = s.regionContrast;
 	config.max_hamming = std::min(s.maxHamming, dict.bits * dict.bits / 2);
 	config.scaled_size = s.scaledSize;
 	config.max_scaled_frames = s.maxScaledFrames;
@@ -1073,6 +1078,9 @@ static void gst_frappe_detect_set_property(GObject *object, guint prop_id, const
 	case PROP_CORNER_THRESHOLD:
 		p.cornerThreshold = g_value_get_float(value);
 		break;
+	case PROP_REGION_CONTRAST:
+		p.regionContrast = g_value_get_float(value);
+		break;
 	case PROP_MAX_HAMMING:
 		p.maxHamming = g_value_get_int(value);
 		break;
@@ -1146,6 +1154,9 @@ static void gst_frappe_detect_get_property(GObject *object, guint prop_id, GValu
 		break;
 	case PROP_CORNER_THRESHOLD:
 		g_value_set_float(value, p.cornerThreshold);
+		break;
+	case PROP_REGION_CONTRAST:
+		g_value_set_float(value, p.regionContrast);
 		break;
 	case PROP_MAX_HAMMING:
 		g_value_set_int(value, p.maxHamming);
@@ -1253,6 +1264,13 @@ static void gst_frappe_detect_class_init(GstFrappeDetectClass *klass)
 				   "Shi-Tomasi minimum eigenvalue that marks an edge pixel as a corner; too high "
 				   "loses low-contrast markers, too low splits corners",
 				   0.0f, 100.0f, DEFAULT_CORNER_THRESHOLD, live));
+	g_object_class_install_property(
+		gobject_class, PROP_REGION_CONTRAST,
+		g_param_spec_float("region-contrast", "Region contrast",
+				   "Contrast (intensities in [0, 1]) around a pixel for the dark-region candidates "
+				   "that find blurred markers; lower finds fainter blurred markers but traces more "
+				   "clutter; 0 turns them off (edge candidates only, faster)",
+				   0.0f, 1.0f, DEFAULT_REGION_CONTRAST, live));
 	g_object_class_install_property(
 		gobject_class, PROP_MAX_HAMMING,
 		g_param_spec_int("max-hamming", "Max Hamming",

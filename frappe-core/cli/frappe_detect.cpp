@@ -40,6 +40,8 @@ const char kUsage[] =
 	"      --threads T         1 = single thread (default), 0 = one per core\n"
 	"      --edge-threshold E  Sobel magnitude for an edge, intensities in [0,1] (default 0.27)\n"
 	"      --corner-threshold C  Shi-Tomasi threshold for a corner (default 0.19)\n"
+	"      --region-contrast R  contrast for the dark-region candidates that find blurred\n"
+	"                          markers, intensities in [0,1]; 0 = off (default 0.16)\n"
 	"      --max-hamming H     bits corrected (default: the dictionary's safe maximum)\n"
 	"      --backend B         front end: auto, cpu, vc4 (the Pi's QPUs), vc4-emu (the QPU\n"
 	"                          kernels on an emulator: slow, bit-exact) (default auto)\n"
@@ -116,6 +118,8 @@ Options parse(int argc, char **argv)
 			o.config.edge_threshold = parseNumber<float>(a, value());
 		} else if (a == "--corner-threshold") {
 			o.config.corner_threshold = parseNumber<float>(a, value());
+		} else if (a == "--region-contrast") {
+			o.config.region_contrast = parseNumber<float>(a, value());
 		} else if (a == "--max-hamming") {
 			o.config.max_hamming = parseNumber<int>(a, value());
 		} else if (a == "--backend") {

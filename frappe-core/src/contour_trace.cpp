@@ -190,7 +190,7 @@ void ContourTracer::buildStepTables(int w)
 	maskTable_.clear();
 }
 
-void ContourTracer::trace(const EdgeMap &edges, const TraceParams &params, std::vector<Quad> &out,
+void ContourTracer::trace(const TraceMap &edges, const TraceParams &params, std::vector<Quad> &out,
 			  MarkerProbe *probe)
 {
 	out.clear();
@@ -233,9 +233,9 @@ void ContourTracer::trace(const EdgeMap &edges, const TraceParams &params, std::
 			return;
 		clusterCorners();
 		/* Both ways of making a quad below need two clusters. */
-		if (clusters_.size() < 2)
+		if (clusters_.size() < static_cast<std::size_t>(params.min_clusters))
 			return;
-		if (!spansAtLeast(0.7f * params.min_side))
+		if (!spansAtLeast(0.7f * params.min_side, params.max_winding))
 			return;
 		/* The paper's rule first: the corner clusters; failing that, the
 		 * outline's extreme points, for a border with at least two corner
@@ -244,7 +244,7 @@ void ContourTracer::trace(const EdgeMap &edges, const TraceParams &params, std::
 		Quad quad;
 		if ((!tooManyClusters_ && clusters_.size() >= 4 && quadFromClusters(quad) &&
 		     acceptQuad(params, w, h, quad)) ||
-		    (clusters_.size() >= 2 && quadFromOutline(quad) && acceptQuad(params, w, h, quad))) {
+		    (clusters_.size() >= static_cast<std::size_t>(params.min_clusters) && quadFromOutline(quad) && acceptQuad(params, w, h, quad))) {
 			if (probe && probe->isMarker(quad))
 				sealInside(quad, w, h);
 			out.push_back(quad);
@@ -458,10 +458,12 @@ void ContourTracer::sealInside(const Quad &quad, int w, int h)
 	}
 }
 
-bool ContourTracer::spansAtLeast(float span) const
+bool ContourTracer::spansAtLeast(float span, float maxWinding) const
 {
 	const PointsBox box = pointsBox(points_.data(), static_cast<std::size_t>(steps_));
-	return static_cast<float>(box.maxX - box.minX) >= span && static_cast<float>(box.maxY - box.minY) >= span;
+	const float bw = static_cast<float>(box.maxX - box.minX), bh = static_cast<float>(box.maxY - box.minY);
+	/* A convex outline takes at most 2 (bw + bh) steps around its box. */
+	return bw >= span && bh >= span && static_cast<float>(steps_) <= maxWinding * 2.0f * (bw + bh + 2.0f);
 }
 
 /* Groups the last border's corner pixels, in the order it met them: a
@@ -497,7 +499,7 @@ void ContourTracer::clusterCorners()
 
 /* Follows one border from (x, y); (x, y) + kD[fromDir] is the background
  * pixel the scan came from. Keeps its pixels and, apart, its corner pixels. */
-void ContourTracer::follow(int x0, int y0, int fromDir, const EdgeMap &edges)
+void ContourTracer::follow(int x0, int y0, int fromDir, const TraceMap &edges)
 {
 	std::uint8_t *const L = labels_.data();
 	const std::ptrdiff_t w = stride_;

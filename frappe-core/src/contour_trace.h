@@ -20,12 +20,23 @@ struct Quad {
 	/// how many border cells read white at the traced outline); -1 when
 	/// none. Travels with the quad through sorting and deduplication.
 	int probeRead = -1;
+	/// Where the quad came from: the edge map, or the region map (whose
+	/// outline lies up to a region pixel inside the marker's).
+	bool fromRegion = false;
 };
 
 struct TraceParams {
 	float cluster_radius = 4.0f; ///< corner pixels closer than this form one corner
 	float min_side = 8.0f;       ///< shortest acceptable side, traced pixels
 	float border_margin = 1.0f;  ///< corners must lie this far inside the frame
+	/// Corner clusters a border needs before its outline is fitted: edge
+	/// borders without them are mostly clutter; region borders have none.
+	int min_clusters = 2;
+	/// Longest border kept, as a multiple of its bounding box's perimeter:
+	/// a marker's outline goes round its box once; a border that winds
+	/// through texture goes many times. Edge borders also double back
+	/// along open curves (twice the box), which the later checks reject.
+	float max_winding = 1e9f;
 };
 
 /// Asked during the scan whether an accepted quad is a marker. Nothing else
@@ -49,7 +60,7 @@ class ContourTracer
 public:
 	/// Appends the accepted quads to `out` (cleared first). With a probe,
 	/// the inside of each quad it calls a marker is skipped.
-	void trace(const EdgeMap &edges, const TraceParams &params, std::vector<Quad> &out,
+	void trace(const TraceMap &edges, const TraceParams &params, std::vector<Quad> &out,
 		   MarkerProbe *probe = nullptr);
 
 	/// Borders followed in the last call, for statistics.
@@ -62,9 +73,11 @@ private:
 		int fx, fy;          ///< first member, the cluster's anchor
 	};
 	void buildStepTables(int w);
-	void follow(int x, int y, int fromDir, const EdgeMap &edges);
+	void follow(int x, int y, int fromDir, const TraceMap &edges);
 	void clusterCorners();
-	bool spansAtLeast(float span) const; ///< the last border's bounding box
+	/// The last border's bounding box spans `span` both ways, and its
+	/// length is at most maxWinding times the perimeter of the box.
+	bool spansAtLeast(float span, float maxWinding) const;
 	bool quadFromClusters(Quad &quad) const;
 	bool quadFromOutline(Quad &quad) const;
 	bool acceptQuad(const TraceParams &params, int w, int h, Quad &quad);

@@ -14,6 +14,7 @@
 #include "contour_trace.h"
 #include "corner_refine.h"
 #include "decode.h"
+#include "region_map.h"
 
 namespace frappe {
 
@@ -44,6 +45,8 @@ void validate(const Config &c, const Dictionary &d)
 		fail("corner_cluster_radius must be in [1, 32], got " + std::to_string(c.corner_cluster_radius));
 	if (!(c.min_marker_side >= 4.0f))
 		fail("min_marker_side must be at least 4 pixels, got " + std::to_string(c.min_marker_side));
+	if (!(c.region_contrast >= 0.0f && c.region_contrast <= 1.0f))
+		fail("region_contrast must be in [0, 1], got " + std::to_string(c.region_contrast));
 	if (c.threads < 0 || c.threads > 256)
 		fail("threads must be in [0, 256], got " + std::to_string(c.threads));
 }
@@ -186,6 +189,9 @@ struct Detector::Impl {
 	/* Used by one stage each, so that stages of different slots can run
 	 * at once: the tracer by runTrace(), the warp buffer by runFinish(). */
 	detail::ContourTracer tracer;
+	detail::ContourTracer regionTracer;
+	std::vector<detail::Quad> regionQuads;
+	detail::RegionScratch regionScratch; /* for a front end without a region map */
 	detail::WarpedMarker warped;
 	/* With a batch warper (runFinish() only): per candidate its traced
 	 * outline, whether it refined, and its place in the warped batch (-1
@@ -240,6 +246,25 @@ void Detector::Impl::trace(Slot &slot)
 	tp.border_margin = 1.0f;
 	TracedMarkerProbe probe(slot.image, scale, *codes);
 	tracer.trace(edges, tp, quads, &probe);
+	const TraceMap &regions = edges.regions;
+	if (regions.width > 0) {
+		/* Region borders have no corner pixels: every closed one is
+		 * fitted from its outline. Their quads join the edge ones in the
+		 * edge map's coordinates. */
+		detail::TraceParams rtp = tp;
+		rtp.min_clusters = 0;
+		rtp.max_winding = 2.0f;
+		rtp.min_side = std::max(4.0f, config.min_marker_side * regions.scale);
+		TracedMarkerProbe regionProbe(slot.image, regions.scale, *codes);
+		regionTracer.trace(regions, rtp, regionQuads, &regionProbe);
+		const float toEdges = scale / regions.scale;
+		for (detail::Quad q : regionQuads) {
+			for (Point2f &p : q.corners)
+				p = { (p.x + 0.5f) * toEdges - 0.5f, (p.y + 0.5f) * toEdges - 0.5f };
+			q.fromRegion = true;
+			quads.push_back(q);
+		}
+	}
 	detail::removeDuplicateQuads(quads, 2.5f);
 	/* Smallest first: a marker's own outline decodes before the outline of
 	 * its quiet zone, which can then be skipped. */
@@ -320,8 +345,10 @@ void Detector::Impl::finish(const ImageView &image, Slot &slot)
 			refineMs += msSince(t);
 			continue;
 		}
+		/* A region outline lies up to a region pixel inside the marker's. */
+		const float qsearch = q.fromRegion ? std::max(search, 2.0f / slot.edges.regions.scale) : search;
 		bool refined = batched ? batch.refined[k] != 0
-			       : traced < whiteFrame && detail::refineCorners(image, q.corners, search);
+			       : traced < whiteFrame && detail::refineCorners(image, q.corners, qsearch);
 		refineMs += msSince(t);
 		detail::Binarised b;
 		if (refined && sidesAtLeast(q.corners, config.min_marker_side)) {
@@ -424,6 +451,9 @@ Detector::Detector(const Config &config) : impl_(std::make_unique<Impl>())
 	impl_->params.edge_threshold_sq = static_cast<std::int64_t>(std::floor(e * e));
 	impl_->params.corner_threshold =
 		static_cast<std::int64_t>(std::floor(static_cast<double>(config.corner_threshold) * 255.0 * 255.0));
+	impl_->params.region_contrast = static_cast<int>(std::lround(config.region_contrast * 255.0f));
+	if (config.region_contrast > 0.0f)
+		impl_->params.region_contrast = std::max(1, impl_->params.region_contrast);
 	impl_->frontEnd = makeCpuFrontEnd(config.threads);
 }
 
@@ -455,7 +485,14 @@ void Detector::runFrontEnd(const ImageView &image, int slot)
 	s.result.times = {};
 	s.result.times[Stage::AdaptiveScale] = msSince(t0);
 	const auto t1 = Clock::now();
+	s.edges.regions.resize(0, 0);
 	d.frontEnd->run(image, scale, d.params, s.edges);
+	if (s.edges.regions.width == 0 && d.params.region_contrast > 0) {
+		/* A front end without a region map (the QPUs, for now): the
+		 * CPU's, from the full-resolution frame (the edge map's scale
+		 * is taken into account when its quads are mapped). */
+		detail::regionMap(image, 1.0f, d.params.region_contrast, s.edges.regions, d.regionScratch);
+	}
 	s.result.times[Stage::FrontEnd] = msSince(t1);
 	s.result.scale = s.edges.scale;
 }

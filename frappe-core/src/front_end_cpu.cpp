@@ -22,6 +22,15 @@
 //   and in 32-bit integers (the QPU multiplies 24 x 24 bits):
 //   c = (Sxx + Syy - 2T) >> 9, a = |Sxx - Syy| >> 9, b = |Sxy| >> 8
 //   (arithmetic shifts), corner when c > 0 and c*c > a*a + b*b.
+// The region map (EdgeMap::regions, region_map.cpp), from the same frame s
+// (scaled when the edge map is), W x H, at w = W/2, h = H/2 (rounded down;
+// none when either is below 3 or region_contrast is 0):
+//   r  = (s[2y][2x] + s[2y][2x+1] + s[2y+1][2x] + s[2y+1][2x+1] + 2) >> 2
+//   tiles of 4 x 4 r pixels (the last row and column of tiles may be
+//   partial): lo and hi, the least and greatest r over the 3 x 3 tiles
+//   around a pixel's tile (those that exist)
+//   dark: hi - lo >= region_contrast and r < (lo + hi + 1) >> 1, never on
+//   the outermost row and column of the map.
 #include <algorithm>
 #include <cstdlib>
 #include <thread>
@@ -29,6 +38,7 @@
 
 #include "frappe/edge_map.h"
 #include "front_end_rows.h"
+#include "region_map.h"
 #include "worker.h"
 
 namespace frappe {
@@ -40,7 +50,7 @@ int scaledLength(int full, float scale)
 	return std::max(1, static_cast<int>(static_cast<float>(full) * scale + 0.5f));
 }
 
-void EdgeMap::resize(int w, int h)
+void TraceMap::resize(int w, int h)
 {
 	width = w;
 	height = h;
@@ -71,6 +81,7 @@ private:
 	const detail::RowKernels &kernels_;
 	std::vector<std::uint8_t> scaled_;
 	std::vector<detail::RowScratch> scratch_;
+	detail::RegionScratch regionScratch_;
 	detail::WorkerPool pool_;
 };
 
@@ -97,6 +108,7 @@ void CpuFrontEnd::run(const ImageView &image, float scale, const FrontEndParams 
 	}
 	if (w < 3 || h < 3) {
 		std::fill(out.pixels.begin(), out.pixels.end(), 0);
+		out.regions.resize(0, 0);
 		return;
 	}
 
@@ -115,14 +127,15 @@ void CpuFrontEnd::run(const ImageView &image, float scale, const FrontEndParams 
 	};
 	if (bands == 1) {
 		runBand(src, params, out, 1, h - 1, scratch_[0]);
-		return;
+	} else {
+		auto band = [&](int b) {
+			int y0, y1;
+			bandRows(b, y0, y1);
+			runBand(src, params, out, y0, y1, scratch_[b]);
+		};
+		pool_.run(bands, band);
 	}
-	auto band = [&](int b) {
-		int y0, y1;
-		bandRows(b, y0, y1);
-		runBand(src, params, out, y0, y1, scratch_[b]);
-	};
-	pool_.run(bands, band);
+	detail::regionMap(src, out.scale, params.region_contrast, out.regions, regionScratch_);
 }
 
 /* Edge rows y0 .. y1-1 (1 <= y0, y1 <= h-1). */

@@ -6,7 +6,7 @@ GStreamer knows (else every registry scan warns of an unknown license)."""
 import subprocess
 import sys
 
-PROPERTIES = ["dictionary", "mode", "edge-threshold", "corner-threshold", "max-hamming",
+PROPERTIES = ["dictionary", "mode", "edge-threshold", "corner-threshold", "region-contrast", "max-hamming",
               "scaled-size", "max-scaled-frames", "annotate", "post-messages", "pipelined",
               "backend", "marker-size", "camera-matrix", "distortion", "stats"]
 # gst_plugin_check_license()'s list (GStreamer 1.22).

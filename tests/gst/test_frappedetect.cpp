@@ -319,12 +319,13 @@ TEST(Properties, ChangeWhilePlaying)
 	expectMarkers(out, markers, "6x6_250");
 	gst_buffer_unref(out);
 
-	/* A threshold nothing passes: no markers; back to the default: found. */
-	g_object_set(detector(h), "edge-threshold", 4.0f, nullptr);
+	/* Thresholds nothing passes (no edges, no dark regions): no markers;
+	 * back to the defaults: found. */
+	g_object_set(detector(h), "edge-threshold", 4.0f, "region-contrast", 0.0f, nullptr);
 	out = gst_harness_push_and_pull(h, gst_buffer_ref(frame6x6));
 	EXPECT_EQ(gst_buffer_get_n_frappe_marker_metas(out), 0u);
 	gst_buffer_unref(out);
-	g_object_set(detector(h), "edge-threshold", 0.27f, "mode", 1, "max-hamming", 2, "scaled-size", 20.0f,
+	g_object_set(detector(h), "edge-threshold", 0.27f, "region-contrast", 0.16f, "mode", 1, "max-hamming", 2, "scaled-size", 20.0f,
 		     "max-scaled-frames", 3, "backend", 1, nullptr);
 	for (int i = 0; i < 6; ++i) {
 		out = gst_harness_push_and_pull(h, gst_buffer_ref(frame6x6));

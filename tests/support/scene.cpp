@@ -40,6 +40,32 @@ void blur(Image &img, float sigma)
 		}
 }
 
+void motionBlur(Image &img, float length, float angle)
+{
+	if (length <= 0.0f)
+		return;
+	const Image src = img;
+	const int n = std::max(1, static_cast<int>(std::ceil(4.0f * length)));
+	const float dx = std::cos(angle), dy = std::sin(angle);
+	auto at = [&](float x, float y) {
+		x = std::clamp(x, 0.0f, static_cast<float>(src.width - 1));
+		y = std::clamp(y, 0.0f, static_cast<float>(src.height - 1));
+		const int x0 = std::min(static_cast<int>(x), src.width - 2), y0 = std::min(static_cast<int>(y), src.height - 2);
+		const float fx = x - x0, fy = y - y0;
+		const auto p = [&](int xx, int yy) { return static_cast<float>(src.pixels[static_cast<std::size_t>(yy) * src.stride + xx]); };
+		return (1 - fy) * ((1 - fx) * p(x0, y0) + fx * p(x0 + 1, y0)) + fy * ((1 - fx) * p(x0, y0 + 1) + fx * p(x0 + 1, y0 + 1));
+	};
+	for (int y = 0; y < img.height; ++y)
+		for (int x = 0; x < img.width; ++x) {
+			float acc = 0;
+			for (int i = 0; i < n; ++i) {
+				const float t = length * ((i + 0.5f) / n - 0.5f);
+				acc += at(x + t * dx, y + t * dy);
+			}
+			img.at(x, y) = static_cast<std::uint8_t>(std::clamp(std::lround(acc / n), 0L, 255L));
+		}
+}
+
 void addNoise(Image &img, float sigma, std::mt19937 &rng)
 {
 	std::normal_distribution<float> n(0.0f, sigma);

@@ -34,6 +34,11 @@ std::array<Point2f, 4> squarePose(float cx, float cy, float side, float roll, fl
 /// Gaussian blur with standard deviation `sigma` pixels (no-op when 0).
 void blur(Image &img, float sigma);
 
+/// Motion blur: each pixel the mean of the image along a segment of
+/// `length` pixels through it at `angle` radians from the x axis (bilinear
+/// samples a quarter pixel apart), as a camera moving during the exposure.
+void motionBlur(Image &img, float length, float angle);
+
 /// Adds Gaussian noise of standard deviation `sigma` grey levels.
 void addNoise(Image &img, float sigma, std::mt19937 &rng);
 

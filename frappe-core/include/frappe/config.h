@@ -53,6 +53,16 @@ struct Config {
 	/// before one at full resolution, so small new markers are seen.
 	int max_scaled_frames = 5;
 
+	/// The second source of candidates, for blurred markers: dark regions
+	/// of the frame at half resolution, whose borders stay closed where blur
+	/// opens the edge ring. A pixel is dark when it lies below the midpoint
+	/// of the darkest and brightest pixels within about 12 px and those
+	/// differ by at least this much (intensities in [0, 1]). Lower finds
+	/// fainter blurred markers but traces more clutter; 0 turns the region
+	/// candidates off (the paper's edge candidates only: faster, and blind
+	/// to strongly blurred markers). Range [0, 1].
+	float region_contrast = 0.16f;
+
 	/// Corner pixels closer than this (pixels, at the traced resolution)
 	/// belong to one corner cluster.
 	float corner_cluster_radius = 4.0f;

@@ -20,24 +20,29 @@ struct FrontEndParams {
 	/// An edge pixel is a corner when the minimum eigenvalue of its 3x3
 	/// summed structure tensor (8-bit intensity units squared) exceeds this.
 	std::int64_t corner_threshold = 0;
+	/// A region-map pixel is dark when the brightest and darkest pixels
+	/// around it differ by at least this much (8-bit grey levels) and it
+	/// lies below their midpoint; 0: no region map.
+	int region_contrast = 0;
 };
 
-/// The output of the front end for one frame, at the traced resolution.
-struct EdgeMap {
+/// A byte map the contour tracer follows: foreground pixels have bit 0
+/// (kEdge) set, and a 16x16 tile mask says where any are.
+struct TraceMap {
 	static constexpr std::uint8_t kEdge = 1;
 	static constexpr std::uint8_t kCorner = 2;
 	static constexpr int kTile = 16; ///< side of an empty-tile mask block
 
 	int width = 0;
 	int height = 0;
-	/// Traced resolution / full resolution; 1 when the frame was not scaled.
+	/// This map's resolution / full resolution; 1 when the frame was not scaled.
 	float scale = 1.0f;
-	/// width * height bytes, row-major, kEdge | kCorner bits. The outermost
-	/// row and column on every side are always zero.
+	/// width * height bytes, row-major. The outermost row and column on
+	/// every side are always zero.
 	std::vector<std::uint8_t> pixels;
 	int tiles_x = 0;
 	int tiles_y = 0;
-	/// tiles_x * tiles_y bytes: 1 when the 16x16 block holds an edge pixel.
+	/// tiles_x * tiles_y bytes: 1 when the 16x16 block holds a foreground pixel.
 	std::vector<std::uint8_t> tiles;
 
 	/// Sizes the buffers; reuses their storage when the size is unchanged.
@@ -46,13 +51,27 @@ struct EdgeMap {
 	bool tileEmpty(int tx, int ty) const { return tiles[static_cast<std::size_t>(ty) * tiles_x + tx] == 0; }
 };
 
+/// The output of the front end for one frame, at the traced resolution:
+/// kEdge | kCorner bits.
+struct EdgeMap : TraceMap {
+	/// The frame's dark regions at half the traced resolution (kEdge marks
+	/// a dark pixel; the exact rule is at the top of front_end_cpu.cpp),
+	/// the second source of candidates: blur spreads a marker's outline
+	/// over several pixels and the one-pixel edge ring opens, but the dark
+	/// region inside the outline stays whole. Empty (width 0) when region
+	/// candidates are off or the frame is too small for them.
+	TraceMap regions;
+};
+
 /// Scaled frame size for a scale factor: the same rounding everywhere.
 int scaledLength(int full, float scale);
 
 /// A front-end implementation: nearest-neighbour scaling, Sobel gradients,
 /// four-direction non-maximum suppression, the edge threshold, Shi-Tomasi
-/// corners on edge pixels and the empty-tile mask, all in one call.
-/// Implementations must produce byte-identical EdgeMaps.
+/// corners on edge pixels, the empty-tile mask and the region map, all in
+/// one call. Implementations must produce byte-identical EdgeMaps; one that
+/// leaves `regions` empty (width 0) while params ask for it gets the CPU's
+/// region map from the Detector.
 class FrontEnd {
 public:
 	virtual ~FrontEnd() = default;

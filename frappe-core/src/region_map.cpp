@@ -1,0 +1,315 @@
+// SPDX-License-Identifier: MIT
+// The region map (region_map.h): half-resolution block means, the darkest
+// and brightest over 3 x 3 tiles of 4 x 4 pixels around each pixel, and the
+// midpoint threshold between them.
+
+#include "region_map.h"
+
+#include <algorithm>
+#include <cstring>
+
+#ifdef FRAPPE_HAVE_HWY
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "region_map.cpp"
+#include <hwy/foreach_target.h> // IWYU pragma: keep
+
+#include <hwy/highway.h>
+
+HWY_BEFORE_NAMESPACE();
+namespace frappe::detail {
+namespace HWY_NAMESPACE {
+
+namespace hn = hwy::HWY_NAMESPACE;
+
+void DecimateRow(const std::uint8_t *r0, const std::uint8_t *r1, int w, std::uint8_t *out)
+{
+#if HWY_TARGET == HWY_SCALAR
+	decimateRowScalar(r0, r1, w, out);
+#else
+	/* Each 16-bit lane holds two neighbouring pixels of a row: their sum
+	 * is the low byte plus the high one, whatever the byte order. The
+	 * mean (< 256) is narrowed from signed lanes, which this Highway can. */
+	const hn::ScalableTag<std::uint16_t> d16;
+	const hn::RebindToSigned<decltype(d16)> di16;
+	const hn::Repartition<std::uint8_t, decltype(d16)> d8;
+	const hn::Rebind<std::uint8_t, decltype(d16)> d8h;
+	const int N = static_cast<int>(hn::Lanes(d16));
+	const auto low = hn::Set(d16, 0xFF), two = hn::Set(d16, 2);
+	int x = 0;
+	for (; x + N <= w; x += N) {
+		const auto a = hn::BitCast(d16, hn::LoadU(d8, r0 + 2 * x));
+		const auto b = hn::BitCast(d16, hn::LoadU(d8, r1 + 2 * x));
+		const auto sum = hn::Add(hn::Add(hn::And(a, low), hn::ShiftRight<8>(a)),
+					 hn::Add(hn::And(b, low), hn::ShiftRight<8>(b)));
+		hn::StoreU(hn::DemoteTo(d8h, hn::BitCast(di16, hn::ShiftRight<2>(hn::Add(sum, two)))), d8h, out + x);
+	}
+	if (x < w)
+		decimateRowScalar(r0 + 2 * x, r1 + 2 * x, w - x, out + x);
+#endif
+}
+
+/* out[x] = the least (Op = Min) or greatest (Max) of a0[2x], a0[2x + 1],
+ * a1[2x], a1[2x + 1]: 16-bit lanes hold the pairs, as in DecimateRow. */
+template <bool kMin>
+void ExtremePairs(const std::uint8_t *a0, const std::uint8_t *a1, int w, std::uint8_t *out)
+{
+#if HWY_TARGET == HWY_SCALAR
+	extremePairsScalar(a0, a1, w, out, kMin);
+#else
+	const hn::ScalableTag<std::uint16_t> d16;
+	const hn::RebindToSigned<decltype(d16)> di16;
+	const hn::Repartition<std::uint8_t, decltype(d16)> d8;
+	const hn::Rebind<std::uint8_t, decltype(d16)> d8h;
+	const int N = static_cast<int>(hn::Lanes(d16));
+	const auto low = hn::Set(d16, 0xFF);
+	int x = 0;
+	for (; x + N <= w; x += N) {
+		const auto a = hn::BitCast(d16, hn::LoadU(d8, a0 + 2 * x));
+		const auto b = hn::BitCast(d16, hn::LoadU(d8, a1 + 2 * x));
+		auto e = kMin ? hn::Min(hn::Min(hn::And(a, low), hn::ShiftRight<8>(a)), hn::Min(hn::And(b, low), hn::ShiftRight<8>(b)))
+			      : hn::Max(hn::Max(hn::And(a, low), hn::ShiftRight<8>(a)), hn::Max(hn::And(b, low), hn::ShiftRight<8>(b)));
+		hn::StoreU(hn::DemoteTo(d8h, hn::BitCast(di16, e)), d8h, out + x);
+	}
+	if (x < w)
+		extremePairsScalar(a0 + 2 * x, a1 + 2 * x, w - x, out + x, kMin);
+#endif
+}
+
+void MinPairs(const std::uint8_t *a0, const std::uint8_t *a1, int w, std::uint8_t *out)
+{
+	ExtremePairs<true>(a0, a1, w, out);
+}
+
+void MaxPairs(const std::uint8_t *a0, const std::uint8_t *a1, int w, std::uint8_t *out)
+{
+	ExtremePairs<false>(a0, a1, w, out);
+}
+
+bool DarkRow(const std::uint8_t *d, const std::uint8_t *mid, int w, std::uint8_t *out)
+{
+	const hn::ScalableTag<std::uint8_t> d8;
+	const int N = static_cast<int>(hn::Lanes(d8));
+	const auto one = hn::Set(d8, 1);
+	auto any = hn::Zero(d8);
+	int x = 0;
+	for (; x + N <= w; x += N) {
+		const auto dark = hn::IfThenElseZero(hn::Lt(hn::LoadU(d8, d + x), hn::LoadU(d8, mid + x)), one);
+		hn::StoreU(dark, d8, out + x);
+		any = hn::Or(any, dark);
+	}
+	bool found = !hn::AllTrue(d8, hn::Eq(any, hn::Zero(d8)));
+	if (x < w)
+		found = darkRowScalar(d + x, mid + x, w - x, out + x) || found;
+	return found;
+}
+
+} // namespace HWY_NAMESPACE
+} // namespace frappe::detail
+HWY_AFTER_NAMESPACE();
+#endif
+
+#if !defined(FRAPPE_HAVE_HWY) || HWY_ONCE
+namespace frappe::detail {
+
+void decimateRowScalar(const std::uint8_t *r0, const std::uint8_t *r1, int w, std::uint8_t *out)
+{
+	for (int x = 0; x < w; ++x)
+		out[x] = static_cast<std::uint8_t>((r0[2 * x] + r0[2 * x + 1] + r1[2 * x] + r1[2 * x + 1] + 2) >> 2);
+}
+
+void extremePairsScalar(const std::uint8_t *a0, const std::uint8_t *a1, int w, std::uint8_t *out, bool least)
+{
+	for (int x = 0; x < w; ++x) {
+		const std::uint8_t p = least ? std::min(a0[2 * x], a0[2 * x + 1]) : std::max(a0[2 * x], a0[2 * x + 1]);
+		const std::uint8_t q = least ? std::min(a1[2 * x], a1[2 * x + 1]) : std::max(a1[2 * x], a1[2 * x + 1]);
+		out[x] = least ? std::min(p, q) : std::max(p, q);
+	}
+}
+
+bool darkRowScalar(const std::uint8_t *d, const std::uint8_t *mid, int w, std::uint8_t *out)
+{
+	std::uint8_t any = 0;
+	for (int x = 0; x < w; ++x) {
+		out[x] = d[x] < mid[x] ? TraceMap::kEdge : 0;
+		any |= out[x];
+	}
+	return any != 0;
+}
+
+#ifdef FRAPPE_HAVE_HWY
+HWY_EXPORT(DecimateRow);
+HWY_EXPORT(DarkRow);
+HWY_EXPORT(MinPairs);
+HWY_EXPORT(MaxPairs);
+
+void extremePairs(const std::uint8_t *a0, const std::uint8_t *a1, int w, std::uint8_t *out, bool least)
+{
+	if (least)
+		HWY_DYNAMIC_DISPATCH(MinPairs)(a0, a1, w, out);
+	else
+		HWY_DYNAMIC_DISPATCH(MaxPairs)(a0, a1, w, out);
+}
+
+void decimateRow(const std::uint8_t *r0, const std::uint8_t *r1, int w, std::uint8_t *out)
+{
+	HWY_DYNAMIC_DISPATCH(DecimateRow)(r0, r1, w, out);
+}
+
+bool darkRow(const std::uint8_t *d, const std::uint8_t *mid, int w, std::uint8_t *out)
+{
+	return HWY_DYNAMIC_DISPATCH(DarkRow)(d, mid, w, out);
+}
+#else
+void decimateRow(const std::uint8_t *r0, const std::uint8_t *r1, int w, std::uint8_t *out)
+{
+	decimateRowScalar(r0, r1, w, out);
+}
+
+void extremePairs(const std::uint8_t *a0, const std::uint8_t *a1, int w, std::uint8_t *out, bool least)
+{
+	extremePairsScalar(a0, a1, w, out, least);
+}
+
+bool darkRow(const std::uint8_t *d, const std::uint8_t *mid, int w, std::uint8_t *out)
+{
+	return darkRowScalar(d, mid, w, out);
+}
+#endif
+
+void regionMap(const ImageView &src, float srcScale, int minContrast, TraceMap &out, RegionScratch &s)
+{
+	const int w = src.width / 2, h = src.height / 2;
+	if (minContrast <= 0 || w < 3 || h < 3) {
+		out.resize(0, 0);
+		return;
+	}
+	out.resize(w, h);
+	out.scale = srcScale / 2.0f;
+	constexpr int T = kRegionTile;
+	const int tx = (w + T - 1) / T, ty = (h + T - 1) / T;
+	const std::size_t nt = static_cast<std::size_t>(tx) * ty;
+	s.decimated.resize(static_cast<std::size_t>(w) * h);
+	s.tileMin.resize(nt);
+	s.tileMax.resize(nt);
+	s.lo.resize(std::max(w, tx + 2));
+	s.hi.resize(std::max(w, tx + 2));
+	s.mid.resize(std::max(tx * T, 2 * tx));
+	std::uint8_t *dec = s.decimated.data();
+	for (int y = 0; y < h; ++y)
+		decimateRow(src.row(2 * y), src.row(2 * y + 1), w, dec + static_cast<std::size_t>(y) * w);
+
+	/* Each tile's darkest and brightest, by two halvings of the
+	 * decimated image: extremes of 2 x 2 pixels, then of 2 x 2 of those.
+	 * A row or column left over at the bottom or right (odd sizes) is
+	 * taken with the one before it, by replicating it. */
+	const int w1 = (w + 1) / 2, h1 = (h + 1) / 2; /* after the first halving */
+	static_assert(T == 4);
+	s.level.resize(4 * (static_cast<std::size_t>(w1) + 2) * 2 + 4 * static_cast<std::size_t>(w) + 8);
+	std::uint8_t *pad0 = s.level.data(), *pad1 = pad0 + 2 * w1 + 2; /* rows of w padded to even */
+	std::uint8_t *l1min = pad1 + 2 * w1 + 2, *l1max = l1min + 2 * w1 + 4;
+	std::uint8_t *l1min2 = l1max + 2 * w1 + 4, *l1max2 = l1min2 + 2 * w1 + 4;
+	auto paddedRow = [&](int y, std::uint8_t *buf) {
+		const std::uint8_t *r = dec + static_cast<std::size_t>(std::min(y, h - 1)) * w;
+		if (!(w & 1))
+			return r;
+		std::memcpy(buf, r, w);
+		buf[w] = r[w - 1];
+		return static_cast<const std::uint8_t *>(buf);
+	};
+	/* level-1 rows 2j and 2j + 1 (each padded to an even count) give tile row j */
+	for (int j = 0; j < ty; ++j) {
+		for (int k = 0; k < 2; ++k) {
+			const int y1 = std::min(2 * j + k, h1 - 1);
+			const std::uint8_t *r0 = paddedRow(2 * y1, pad0), *r1 = paddedRow(2 * y1 + 1, pad1);
+			std::uint8_t *mn = k ? l1min2 : l1min, *mx = k ? l1max2 : l1max;
+			extremePairs(r0, r1, w1, mn, true);
+			extremePairs(r0, r1, w1, mx, false);
+			if (w1 & 1) {
+				mn[w1] = mn[w1 - 1];
+				mx[w1] = mx[w1 - 1];
+			}
+		}
+		extremePairs(l1min, l1min2, tx, s.tileMin.data() + static_cast<std::size_t>(j) * tx, true);
+		extremePairs(l1max, l1max2, tx, s.tileMax.data() + static_cast<std::size_t>(j) * tx, false);
+	}
+	/* Then over the 3 x 3 tiles around each: across, through a copy with
+	 * the end tiles repeated, then down, keeping the row above aside. */
+	std::uint8_t *__restrict a = s.lo.data(), *__restrict b = s.hi.data();
+	for (int j = 0; j < ty; ++j) {
+		std::uint8_t *__restrict tmin = s.tileMin.data() + static_cast<std::size_t>(j) * tx;
+		std::uint8_t *__restrict tmax = s.tileMax.data() + static_cast<std::size_t>(j) * tx;
+		std::memcpy(a + 1, tmin, tx);
+		std::memcpy(b + 1, tmax, tx);
+		a[0] = a[1];
+		a[tx + 1] = a[tx];
+		b[0] = b[1];
+		b[tx + 1] = b[tx];
+		for (int i = 0; i < tx; ++i) {
+			tmin[i] = std::min(std::min(a[i], a[i + 1]), a[i + 2]);
+			tmax[i] = std::max(std::max(b[i], b[i + 1]), b[i + 2]);
+		}
+	}
+	std::uint8_t *__restrict upMin = s.mid.data(), *__restrict upMax = s.mid.data() + tx;
+	for (int j = 0; j < ty; ++j) {
+		std::uint8_t *__restrict tmin = s.tileMin.data() + static_cast<std::size_t>(j) * tx;
+		std::uint8_t *__restrict tmax = s.tileMax.data() + static_cast<std::size_t>(j) * tx;
+		const std::uint8_t *__restrict dnMin = j + 1 < ty ? tmin + tx : tmin;
+		const std::uint8_t *__restrict dnMax = j + 1 < ty ? tmax + tx : tmax;
+		if (j == 0) {
+			std::memcpy(upMin, tmin, tx);
+			std::memcpy(upMax, tmax, tx);
+		}
+		for (int i = 0; i < tx; ++i) {
+			const std::uint8_t m = tmin[i], n = tmax[i];
+			tmin[i] = std::min(std::min(upMin[i], m), dnMin[i]);
+			tmax[i] = std::max(std::max(upMax[i], n), dnMax[i]);
+			upMin[i] = m;
+			upMax[i] = n;
+		}
+	}
+
+	std::fill(out.tiles.begin(), out.tiles.end(), 0);
+	std::fill_n(out.pixels.data(), w, 0);
+	std::fill_n(out.pixels.data() + static_cast<std::size_t>(h - 1) * w, w, 0);
+	constexpr int ET = TraceMap::kTile;
+	std::uint8_t *mid = s.mid.data();
+	std::uint8_t *acc = s.lo.data(); /* the OR of a tile row's dark rows */
+	bool accAny = false;
+	std::fill_n(acc, w, 0);
+	for (int j = 0; j < ty; ++j) {
+		/* The threshold of each tile of this row: the midpoint, rounded
+		 * up, of the extremes around it, or 0 (no pixel is dark) where
+		 * they are too close. */
+		const std::uint8_t *tmin = s.tileMin.data() + static_cast<std::size_t>(j) * tx;
+		const std::uint8_t *tmax = s.tileMax.data() + static_cast<std::size_t>(j) * tx;
+		for (int i = 0; i < tx; ++i) {
+			const int lo = tmin[i], hi = tmax[i];
+			const std::uint32_t m = hi - lo >= minContrast ? static_cast<std::uint32_t>((lo + hi + 1) >> 1) : 0u;
+			const std::uint32_t word = m * 0x01010101u;
+			std::memcpy(mid + i * T, &word, 4); /* mid has room for whole tiles */
+		}
+		mid[0] = mid[w - 1] = 0; /* the outermost columns are never dark */
+		for (int y = std::max(1, j * T); y < std::min(h - 1, (j + 1) * T); ++y) {
+			std::uint8_t *o = out.pixels.data() + static_cast<std::size_t>(y) * w;
+			if (darkRow(dec + static_cast<std::size_t>(y) * w, mid, w, o)) {
+				for (int x = 0; x < w; ++x)
+					acc[x] |= o[x];
+				accAny = true;
+			}
+			if (accAny && ((y + 1) % ET == 0 || y + 1 == h - 1)) {
+				std::uint8_t *tileRow = out.tiles.data() + static_cast<std::size_t>(y / ET) * out.tiles_x;
+				for (int t = 0; t < out.tiles_x; ++t) {
+					std::uint8_t any = 0;
+					for (int x = t * ET; x < std::min(w, (t + 1) * ET); ++x)
+						any |= acc[x];
+					tileRow[t] = any;
+				}
+				std::fill_n(acc, w, 0);
+				accAny = false;
+			}
+		}
+	}
+}
+
+} // namespace frappe::detail
+#endif

@@ -1,0 +1,44 @@
+// SPDX-License-Identifier: MIT
+// The region map: the frame's dark regions at half resolution, where the
+// second source of candidates is traced (see EdgeMap::regions). The exact
+// integer rule is at the top of front_end_cpu.cpp; the row kernels are
+// vectorised where Highway is built in, beside their scalar references.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "frappe/edge_map.h"
+#include "frappe/image.h"
+
+namespace frappe::detail {
+
+/// Side of a threshold tile, in region-map pixels (8 pixels of the frame).
+constexpr int kRegionTile = 4;
+
+/// Working rows of regionMap(), kept between frames.
+struct RegionScratch {
+	std::vector<std::uint8_t> decimated; ///< the half-resolution image
+	std::vector<std::uint8_t> tileMin, tileMax, lo, hi, mid, level;
+};
+
+/// Fills `out` with the dark pixels of `src` at half its resolution;
+/// out.scale = srcScale / 2. Leaves `out` empty (0 x 0) when minContrast is
+/// 0 or `src` is too small for a 3 x 3 map.
+void regionMap(const ImageView &src, float srcScale, int minContrast, TraceMap &out, RegionScratch &scratch);
+
+/// out[x] = the rounded mean of r0[2x], r0[2x + 1], r1[2x], r1[2x + 1] for
+/// x in [0, w).
+void decimateRow(const std::uint8_t *r0, const std::uint8_t *r1, int w, std::uint8_t *out);
+/// out[x] = the least (or greatest) of a0[2x], a0[2x + 1], a1[2x],
+/// a1[2x + 1] for x in [0, w).
+void extremePairs(const std::uint8_t *a0, const std::uint8_t *a1, int w, std::uint8_t *out, bool least);
+/// out[x] = kEdge if d[x] < mid[x], else 0, for x in [0, w); whether any is.
+bool darkRow(const std::uint8_t *d, const std::uint8_t *mid, int w, std::uint8_t *out);
+
+/// The same without SIMD, the references the vector forms are tested against.
+void decimateRowScalar(const std::uint8_t *r0, const std::uint8_t *r1, int w, std::uint8_t *out);
+void extremePairsScalar(const std::uint8_t *a0, const std::uint8_t *a1, int w, std::uint8_t *out, bool least);
+bool darkRowScalar(const std::uint8_t *d, const std::uint8_t *mid, int w, std::uint8_t *out);
+
+} // namespace frappe::detail

@@ -1,0 +1,165 @@
+// SPDX-License-Identifier: MIT
+// The region map: its row kernels against their scalar references on every
+// Highway target, the whole map against a slow transcription of the rule at
+// the top of front_end_cpu.cpp, and what it is for: strongly blurred
+// markers, whose edge ring opens, found through their dark regions.
+#include <algorithm>
+#include <cstdio>
+#include <random>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "every_target.h"
+#include "frappe/frappe.h"
+#include "frappe/render.h"
+#include "region_map.h"
+#include "scene.h"
+
+using namespace frappe;
+using frappe::test::Image;
+using frappe::test::onEveryTarget;
+
+namespace {
+
+std::vector<std::uint8_t> randomBytes(std::size_t n, std::mt19937 &rng)
+{
+	std::vector<std::uint8_t> v(n);
+	for (auto &b : v)
+		b = static_cast<std::uint8_t>(rng() & 0xFF);
+	return v;
+}
+
+/* The documented rule, pixel by pixel. */
+std::vector<std::uint8_t> slowRegionMap(const Image &img, int minContrast, int &w, int &h)
+{
+	w = img.width / 2;
+	h = img.height / 2;
+	std::vector<int> r(static_cast<std::size_t>(w) * h);
+	for (int y = 0; y < h; ++y)
+		for (int x = 0; x < w; ++x) {
+			const auto &p = img.pixels;
+			const int s = img.stride;
+			r[y * w + x] = (p[2 * y * s + 2 * x] + p[2 * y * s + 2 * x + 1] + p[(2 * y + 1) * s + 2 * x] +
+					p[(2 * y + 1) * s + 2 * x + 1] + 2) >> 2;
+		}
+	const int tx = (w + 3) / 4, ty = (h + 3) / 4;
+	std::vector<std::uint8_t> out(static_cast<std::size_t>(w) * h, 0);
+	for (int y = 1; y < h - 1; ++y)
+		for (int x = 1; x < w - 1; ++x) {
+			int lo = 255, hi = 0;
+			for (int j = std::max(0, y / 4 - 1); j <= std::min(ty - 1, y / 4 + 1); ++j)
+				for (int i = std::max(0, x / 4 - 1); i <= std::min(tx - 1, x / 4 + 1); ++i)
+					for (int yy = 4 * j; yy < std::min(h, 4 * j + 4); ++yy)
+						for (int xx = 4 * i; xx < std::min(w, 4 * i + 4); ++xx) {
+							lo = std::min(lo, r[yy * w + xx]);
+							hi = std::max(hi, r[yy * w + xx]);
+						}
+			out[y * w + x] = hi - lo >= minContrast && r[y * w + x] < ((lo + hi + 1) >> 1) ? 1 : 0;
+		}
+	return out;
+}
+
+} // namespace
+
+TEST(RegionMap, RowKernelsMatchTheirScalarReferences)
+{
+	onEveryTarget([](const char *target) {
+		std::mt19937 rng(7);
+		for (int w : { 1, 2, 15, 16, 17, 63, 64, 65, 320, 333 }) {
+			const auto a0 = randomBytes(2 * w + 1, rng), a1 = randomBytes(2 * w + 1, rng);
+			std::vector<std::uint8_t> got(w + 1, 0xAA), want(w + 1, 0xAA);
+			detail::decimateRow(a0.data(), a1.data(), w, got.data());
+			detail::decimateRowScalar(a0.data(), a1.data(), w, want.data());
+			EXPECT_EQ(got, want) << target << " decimate, w " << w;
+			for (bool least : { true, false }) {
+				detail::extremePairs(a0.data(), a1.data(), w, got.data(), least);
+				detail::extremePairsScalar(a0.data(), a1.data(), w, want.data(), least);
+				EXPECT_EQ(got, want) << target << (least ? " min" : " max") << " pairs, w " << w;
+			}
+			bool anyGot = detail::darkRow(a0.data(), a1.data(), w, got.data());
+			bool anyWant = detail::darkRowScalar(a0.data(), a1.data(), w, want.data());
+			EXPECT_EQ(got, want) << target << " dark row, w " << w;
+			EXPECT_EQ(anyGot, anyWant) << target;
+			/* A row with nothing dark says so. */
+			const std::vector<std::uint8_t> zeros(w, 0);
+			EXPECT_FALSE(detail::darkRow(a0.data(), zeros.data(), w, got.data())) << target;
+		}
+	});
+}
+
+TEST(RegionMap, FollowsTheDocumentedRuleAtOddSizesAndStrides)
+{
+	onEveryTarget([](const char *target) {
+		std::mt19937 rng(11);
+		for (auto [W, H, pad] : { std::tuple{ 640, 480, 0 }, { 37, 29, 5 }, { 6, 6, 0 }, { 101, 67, 3 }, { 250, 9, 1 } }) {
+			Image img(W, H, 0, pad);
+			/* Blocks of random grey with noise: every kind of tile. */
+			for (int y = 0; y < H; ++y)
+				for (int x = 0; x < W; ++x)
+					img.at(x, y) = static_cast<std::uint8_t>(((x / 7 + y / 5) * 53 + rng() % 40) & 0xFF);
+			for (int contrast : { 1, 40, 200 }) {
+				int w, h;
+				const auto want = slowRegionMap(img, contrast, w, h);
+				TraceMap map;
+				detail::RegionScratch scratch;
+				detail::regionMap(img.view(), 1.0f, contrast, map, scratch);
+				ASSERT_EQ(map.width, w);
+				ASSERT_EQ(map.height, h);
+				EXPECT_EQ(map.pixels, want) << target << " " << W << "x" << H << " contrast " << contrast;
+				EXPECT_FLOAT_EQ(map.scale, 0.5f);
+				for (int ty = 0; ty < map.tiles_y; ++ty)
+					for (int tx = 0; tx < map.tiles_x; ++tx) {
+						bool any = false;
+						for (int y = ty * 16; y < std::min(h, ty * 16 + 16); ++y)
+							for (int x = tx * 16; x < std::min(w, tx * 16 + 16); ++x)
+								any = any || want[y * w + x];
+						EXPECT_EQ(!map.tileEmpty(tx, ty), any) << target << " tile " << tx << "," << ty;
+					}
+			}
+		}
+	});
+}
+
+TEST(RegionMap, EmptyWhenOffOrTooSmall)
+{
+	Image img(5, 100, 0);
+	TraceMap map;
+	detail::RegionScratch scratch;
+	detail::regionMap(img.view(), 1.0f, 40, map, scratch);
+	EXPECT_EQ(map.width, 0);
+	Image big(64, 64, 0);
+	detail::regionMap(big.view(), 1.0f, 0, map, scratch);
+	EXPECT_EQ(map.width, 0);
+}
+
+/* A marker smeared by a 12 px motion blur and a defocus: its edges spread
+ * over more than a cell and the edge ring opens. The region candidates find
+ * it, with its corners; without them it is lost. */
+TEST(RegionCandidates, FindAStronglyBlurredMarker)
+{
+	const Dictionary &dict = *findDictionary("aruco_mip_36h12");
+	int found = 0, foundWithout = 0, tried = 0;
+	for (int k = 0; k < 6; ++k) {
+		Image img(320, 240, 110);
+		const float side = 90.0f + 8.0f * k;
+		const auto corners = test::squarePose(160.0f, 120.0f, side, 10.0f + 13.0f * k, 20.0f);
+		renderMarker(img.mut(), dict, 7 + k, corners);
+		test::motionBlur(img, 12.0f, 0.2f * k);
+		test::blur(img, 1.5f);
+		std::mt19937 rng(k);
+		test::addNoise(img, 3.0f, rng);
+		Config on, off;
+		off.region_contrast = 0.0f;
+		Detector withRegions(on), without(off);
+		const Marker *m = test::findMarker(withRegions.detect(img.view()).markers, 7 + k);
+		++tried;
+		if (m && test::meanCornerError(m->corners, corners) < 1.0f)
+			++found;
+		if (test::findMarker(without.detect(img.view()).markers, 7 + k))
+			++foundWithout;
+	}
+	std::printf("found %d of %d with region candidates, %d without\n", found, tried, foundWithout);
+	EXPECT_EQ(found, tried);
+	EXPECT_LT(foundWithout, tried / 2);
+}
