@@ -16,7 +16,7 @@ Runs, all at defaults and single-threaded:
 scores everything with shared/tools/eval.py and prints Markdown tables, then
 the checks of tests/data/floors.py (measured, enforced floor, issue target).
 See docs/quality.md. Needs python3-numpy (the scorer) and a build with
-OpenCV (frappe-sweep, frappe-bench). Takes about three minutes on two cores.
+OpenCV (frappe-sweep, frappe-bench). About a minute on two quiet cores.
 """
 import argparse
 import concurrent.futures
