@@ -10,6 +10,8 @@ packages=(
 	libopencv-dev libeigen3-dev libhwy-dev
 	# tests
 	libgtest-dev libgmock-dev libbenchmark-dev libapriltag-dev
+	# the data tests' scorer (../shared/tools/eval.py) and scripts/quality.py
+	python3-numpy
 	# the GStreamer element and its examples
 	libgstreamer1.0-dev libgstreamer-plugins-base1.0-dev
 	gstreamer1.0-tools gstreamer1.0-plugins-base gstreamer1.0-plugins-good
