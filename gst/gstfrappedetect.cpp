@@ -19,7 +19,8 @@
  * dictionary, four sub-pixel corners, Hamming distance, pose when known; see
  * gstfrappemeta.h and the `gstfrappemeta` pkg-config package) and a
  * #GstVideoRegionOfInterestMeta of type "fiducial" whose parameter structure
- * `fiducial` holds `id` (int), `dictionary` (string) and `hamming` (uint).
+ * `fiducial` holds `id` (int), `dictionary` (string), `hamming` (uint) and
+ * `margin` (double).
  *
  * Corners are in OpenCV's order (top-left, top-right, bottom-right,
  * bottom-left of the marker's outer black border in its canonical
@@ -34,7 +35,10 @@
  * * `duration` (guint64): the buffer's duration
  * * `markers` (GstValueList of GstStructure `marker`): one per marker with
  *   `id` (int), `dictionary` (string), `corners` (GstValueArray of 8 doubles:
- *   x0, y0, ..., x3, y3), `hamming` (uint) and, when the pose is known,
+ *   x0, y0, ..., x3, y3), `hamming` (uint), `margin` (double: how clearly
+ *   the code was read, in [0, 1], the weakest code cell's distance from
+ *   the black-white threshold as a fraction of half the contrast; near 0
+ *   some cell was nearly a coin toss) and, when the pose is known,
  *   `rvec` and `tvec` (GstValueArray of 3 doubles: Rodrigues rotation and
  *   translation in metres), `reprojection-error` (double, RMS pixels) and
  *   `alternative-reprojection-error` (double: the error of the other planar
@@ -629,6 +633,8 @@ static void finish(GstFrappeDetect *self, InFlight &f)
 		}
 		GstFrappeMarkerMeta *meta = gst_buffer_add_frappe_marker_meta(
 			f.buffer, m.id, dictName.c_str(), corners, static_cast<guint>(m.hamming));
+		if (meta)
+			meta->margin = m.margin;
 		if (meta && poses[i]) {
 			meta->has_pose = TRUE;
 			for (int k = 0; k < 3; ++k) {
@@ -654,7 +660,8 @@ static void finish(GstFrappeDetect *self, InFlight &f)
 				roi, gst_structure_new(GST_FRAPPE_ROI_TYPE, "id", G_TYPE_INT, m.id,
 						       "dictionary", G_TYPE_STRING, dictName.c_str(),
 						       "hamming", G_TYPE_UINT,
-						       static_cast<guint>(m.hamming), nullptr));
+						       static_cast<guint>(m.hamming), "margin", G_TYPE_DOUBLE,
+						       static_cast<gdouble>(m.margin), nullptr));
 		}
 
 		if (s.postMessages) {
@@ -664,7 +671,8 @@ static void finish(GstFrappeDetect *self, InFlight &f)
 			for (int k = 0; k < 8; ++k)
 				dc[k] = corners[k];
 			add_double_array(ms, "corners", dc, 8);
-			gst_structure_set(ms, "hamming", G_TYPE_UINT, static_cast<guint>(m.hamming), nullptr);
+			gst_structure_set(ms, "hamming", G_TYPE_UINT, static_cast<guint>(m.hamming), "margin",
+					  G_TYPE_DOUBLE, static_cast<gdouble>(m.margin), nullptr);
 			if (poses[i]) {
 				add_double_array(ms, "rvec", poses[i]->rvec.data(), 3);
 				add_double_array(ms, "tvec", poses[i]->tvec.data(), 3);
@@ -1274,8 +1282,8 @@ static void gst_frappe_detect_class_init(GstFrappeDetectClass *klass)
 	g_object_class_install_property(
 		gobject_class, PROP_MAX_HAMMING,
 		g_param_spec_int("max-hamming", "Max Hamming",
-				 "Most bit errors corrected when decoding (-1 = the dictionary's safe default; "
-				 "clamped to half the bits of the dictionary)",
+				 "Most bit errors corrected among cells read clearly (-1 = the dictionary's "
+				 "careful default; clamped to half the bits of the dictionary)",
 				 -1, MAX_MAX_HAMMING, DEFAULT_MAX_HAMMING, live));
 	g_object_class_install_property(
 		gobject_class, PROP_SCALED_SIZE,

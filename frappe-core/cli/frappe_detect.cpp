@@ -42,7 +42,10 @@ const char kUsage[] =
 	"      --corner-threshold C  Shi-Tomasi threshold for a corner (default 0.19)\n"
 	"      --region-contrast R  contrast for the dark-region candidates that find blurred\n"
 	"                          markers, intensities in [0,1]; 0 = off (default 0.16)\n"
-	"      --max-hamming H     bits corrected (default: the dictionary's safe maximum)\n"
+	"      --max-hamming H     bits read clearly that may be corrected (default: the\n"
+	"                          dictionary's careful default, see --dictionaries)\n"
+	"      --weak-margin W     a cell nearer the threshold than W (of half the contrast)\n"
+	"                          is a weak read, correctable beyond H (default 0.3; 0: off)\n"
 	"      --backend B         front end: auto, cpu, vc4 (the Pi's QPUs), vc4-emu (the QPU\n"
 	"                          kernels on an emulator: slow, bit-exact) (default auto)\n"
 	"  -a, --annotate PATH     write the image with the markers drawn (a folder for several images)\n"
@@ -100,7 +103,7 @@ Options parse(int argc, char **argv)
 			for (const auto &d : frappe::dictionaries())
 				std::cout << d.name << "  (" << d.bits << "x" << d.bits << ", " << d.size()
 					  << " ids, min distance " << d.min_hamming << ", corrects "
-					  << d.defaultMaxHamming() << ")\n";
+					  << d.defaultMaxHamming() << ", " << d.weakMaxHamming() << " with weak cells)\n";
 			std::exit(0);
 		} else if (a == "-d" || a == "--dictionary") {
 			o.config.dictionary = value();
@@ -122,6 +125,8 @@ Options parse(int argc, char **argv)
 			o.config.region_contrast = parseNumber<float>(a, value());
 		} else if (a == "--max-hamming") {
 			o.config.max_hamming = parseNumber<int>(a, value());
+		} else if (a == "--weak-margin") {
+			o.config.weak_margin = parseNumber<float>(a, value());
 		} else if (a == "--backend") {
 			o.backend = value();
 			if (o.backend != "auto" && o.backend != "cpu" && o.backend != "vc4" && o.backend != "vc4-emu")
@@ -203,7 +208,8 @@ std::string jsonLine(const std::string &image, const std::vector<Marker> &marker
 			std::snprintf(buf, sizeof(buf), "%s[%.3f, %.3f]", k ? ", " : "", m.corners[k].x, m.corners[k].y);
 			o << buf;
 		}
-		o << "], \"hamming\": " << m.hamming << "}";
+		std::snprintf(buf, sizeof(buf), "%.3f", m.margin);
+		o << "], \"hamming\": " << m.hamming << ", \"margin\": " << buf << "}";
 	}
 	std::snprintf(buf, sizeof(buf), "%.4f", ms);
 	o << "], \"time_ms\": " << buf << "}";
@@ -334,7 +340,7 @@ int main(int argc, char **argv)
 			std::printf("%s: %zu marker%s (%s) in %.2f ms\n", f.path.c_str(), f.markers.size(),
 				    f.markers.size() == 1 ? "" : "s", std::string(detector->dictionary().name).c_str(), f.ms);
 			for (const Marker &m : f.markers) {
-				std::printf("  id %4d  hamming %d  corners", m.id, m.hamming);
+				std::printf("  id %4d  hamming %d  margin %.2f  corners", m.id, m.hamming, m.margin);
 				for (const auto &p : m.corners)
 					std::printf(" (%.2f, %.2f)", p.x, p.y);
 				std::printf("\n");

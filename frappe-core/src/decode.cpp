@@ -94,6 +94,7 @@ Binarised binarise(const WarpedMarker &w, int bits)
 	};
 	Binarised out;
 	out.contrast = hi - lo;
+	out.threshold = thr;
 	for (int cy = 1; cy <= bits; ++cy) {
 		for (int cx = 1; cx <= bits; ++cx)
 			out.code = (out.code << 1) | (cellMean(cx, cy) > thr ? 1u : 0u);
@@ -149,35 +150,45 @@ __attribute__((target_clones("popcnt", "default")))
 Decoded decode(const Dictionary &dict, std::uint64_t code, int maxHamming)
 {
 	const std::array<std::uint64_t, 4> rotations = rotationsOf(code, dict.bits);
+	/* The nearest id and the nearest other id: an id's distance is its
+	 * nearest rotation's. Ids further than the runner-up cannot matter. */
+	const int words = dict.bits * dict.bits;
 	Decoded best;
-	int bestDist = maxHamming + 1;
-	bool ambiguous = false;
+	best.hamming = words + 1;
+	best.runnerUp = words + 1;
 	const int n = dict.size();
 	for (int id = 0; id < n; ++id) {
 		const std::uint64_t word = dict.codes[id];
+		int nearest = words + 1, rotation = 0;
 		for (int r = 0; r < 4; ++r) {
 #if defined(__arm__) && !defined(__ARM_NEON)
 			/* Without a popcount instruction, count the low 32 bits first:
-			 * most words already differ there in more bits than the best. */
+			 * most words already differ there in more bits than the
+			 * runner-up. */
 			const std::uint64_t x = word ^ rotations[r];
 			const int low = bitCount32(static_cast<std::uint32_t>(x));
-			if (low > bestDist)
+			if (low >= best.runnerUp)
 				continue;
 			const int d = low + bitCount32(static_cast<std::uint32_t>(x >> 32));
 #else
 			const int d = bitCount(word ^ rotations[r]);
 #endif
-			if (d < bestDist) {
-				bestDist = d;
-				best = { id, d, r };
-				ambiguous = false;
-			} else if (d == bestDist && best.id != id) {
-				ambiguous = true;
+			if (d < nearest) {
+				nearest = d;
+				rotation = r;
 			}
 		}
+		if (nearest < best.hamming) {
+			best.runnerUp = best.hamming;
+			best.id = id;
+			best.hamming = nearest;
+			best.rotation = rotation;
+		} else if (nearest < best.runnerUp) {
+			best.runnerUp = nearest;
+		}
 	}
-	if (best.id < 0 || ambiguous)
-		return {};
+	if (best.id < 0 || best.hamming > maxHamming || best.runnerUp == best.hamming)
+		return { -1, 0, 0, best.runnerUp };
 	return best;
 }
 
@@ -201,7 +212,7 @@ Decoded CodeBook::decode(std::uint64_t code, int maxHamming) const
 		auto it = std::lower_bound(sorted_.begin(), sorted_.end(), std::make_pair(rotations[r], -1));
 		for (; it != sorted_.end() && it->first == rotations[r]; ++it) {
 			if (exact.id < 0)
-				exact = { it->second, 0, r };
+				exact = { it->second, 0, r, std::max(1, dict_->min_hamming) };
 			else if (it->second != exact.id)
 				return {};
 		}

@@ -44,6 +44,7 @@ struct Binarised {
 	std::uint64_t code = 0;
 	int border_errors = 0; ///< border cells that read white
 	float contrast = 0.0f; ///< max - min sample over the payload
+	float threshold = 0.0f; ///< the grey level between black and white
 };
 
 /// Thresholds the payload at the mid-point of its darkest and brightest
@@ -56,10 +57,14 @@ struct Decoded {
 	int id = -1;
 	int hamming = 0;
 	int rotation = 0; ///< the quad's corner that is the marker's top-left
+	/// Distance to the nearest codeword of any other id, in any rotation
+	/// (at least this much: an exact read reports the dictionary's minimum
+	/// distance, a lower bound).
+	int runnerUp = 0;
 };
 
 /// Hamming-nearest codeword over the four rotations; id = -1 when none is
-/// within maxHamming or the nearest is ambiguous.
+/// within maxHamming or another id is as near.
 Decoded decode(const Dictionary &dict, std::uint64_t code, int maxHamming);
 
 /// A dictionary's codes sorted for exact lookup. Most markers read without a

@@ -15,6 +15,7 @@
 #include "corner_refine.h"
 #include "decode.h"
 #include "region_map.h"
+#include "verify.h"
 
 namespace frappe {
 
@@ -37,6 +38,8 @@ void validate(const Config &c, const Dictionary &d)
 	if (c.max_hamming < -1 || c.max_hamming > d.bits * d.bits / 2)
 		fail("max_hamming must be -1 (dictionary default) or 0.." + std::to_string(d.bits * d.bits / 2) +
 		     " for " + std::string(d.name) + ", got " + std::to_string(c.max_hamming));
+	if (!(c.weak_margin >= 0.0f && c.weak_margin <= 1.0f))
+		fail("weak_margin must be in [0, 1], got " + std::to_string(c.weak_margin));
 	if (!(c.scaled_size >= 8.0f && c.scaled_size <= 1000.0f))
 		fail("scaled_size must be in [8, 1000] pixels, got " + std::to_string(c.scaled_size));
 	if (c.max_scaled_frames < 0 || c.max_scaled_frames > 1000)
@@ -82,9 +85,14 @@ Point2f quadCentre(const std::array<Point2f, 4> &q)
 }
 
 /* A candidate around an already decoded marker, of about its size: the
- * outline of its quiet zone, which would decode to the same marker again. */
-bool surroundsDecoded(const std::array<Point2f, 4> &q, float area, const std::vector<Marker> &found)
+ * outline of its quiet zone, which would decode to the same marker again.
+ * Not one whose traced frame read dark (probeRead, when the probe saw it):
+ * that is a marker's own border, around what decoded inside it. */
+bool surroundsDecoded(const std::array<Point2f, 4> &q, float area, int probeRead, int bits,
+		      const std::vector<Marker> &found)
 {
+	if (probeRead >= 0 && probeRead <= allowedBorderErrors(bits))
+		return false;
 	const Point2f c = quadCentre(q);
 	for (const Marker &m : found) {
 		const float am = quadArea(m.corners);
@@ -169,6 +177,7 @@ struct Detector::Impl {
 	const Dictionary *dict = nullptr;
 	std::unique_ptr<detail::CodeBook> codes;
 	int maxHamming = 0;
+	detail::DecodePolicy policy;
 	FrontEndParams params;
 	std::unique_ptr<FrontEnd> frontEnd;
 	std::unique_ptr<CandidateWarper> warper; /* nullptr: warp on the CPU, one by one */
@@ -336,7 +345,7 @@ void Detector::Impl::finish(const ImageView &image, Slot &slot)
 		detail::Quad &q = slot.quads[k];
 		t = Clock::now();
 		const std::array<Point2f, 4> outline = batched ? batch.outlines[k] : q.corners;
-		if (surroundsDecoded(outline, quadArea(outline), res.markers)) {
+		if (surroundsDecoded(outline, quadArea(outline), q.probeRead, bits, res.markers)) {
 			refineMs += msSince(t);
 			continue;
 		}
@@ -351,10 +360,10 @@ void Detector::Impl::finish(const ImageView &image, Slot &slot)
 			       : traced < whiteFrame && detail::refineCorners(image, q.corners, qsearch);
 		refineMs += msSince(t);
 		detail::Binarised b;
+		const detail::WarpedMarker *samples = &warped;
 		if (refined && sidesAtLeast(q.corners, config.min_marker_side)) {
 			++res.candidates;
 			t = Clock::now();
-			const detail::WarpedMarker *samples = &warped;
 			if (batched) {
 				const int j = batch.place[k];
 				refined = batch.warpedOk[static_cast<std::size_t>(j)] != 0;
@@ -381,34 +390,37 @@ void Detector::Impl::finish(const ImageView &image, Slot &slot)
 				continue;
 			++res.candidates;
 			t = Clock::now();
+			samples = &warped;
 			b = detail::binarise(warped, bits);
 			decodeMs += msSince(t);
 		}
 		t = Clock::now();
-		detail::Decoded d;
+		detail::MarkerRead read;
 		if (b.contrast >= 10.0f && b.border_errors <= borderAllowance)
-			d = codes->decode(b.code, maxHamming);
+			read = detail::readMarker(image, q.corners, *codes, policy, *samples, b);
 		decodeMs += msSince(t);
-		if (d.id < 0 && refined && b.border_errors < whiteFrame) {
+		if (!read.ok() && refined && b.border_errors < whiteFrame) {
 			/* Refinement can pull a small, blurred marker's sides onto its
 			 * code's edges; the traced outline may still read. */
 			t = Clock::now();
 			if (detail::warpMarker(image, outline, bits, warped)) {
 				const detail::Binarised bt = detail::binarise(warped, bits);
 				if (bt.contrast >= 10.0f && bt.border_errors <= borderAllowance) {
-					d = codes->decode(bt.code, maxHamming);
-					if (d.id >= 0)
+					read = detail::readMarker(image, outline, *codes, policy, warped, bt);
+					if (read.ok())
 						q.corners = outline;
 				}
 			}
 			decodeMs += msSince(t);
 		}
-		if (d.id < 0)
+		if (!read.ok())
 			continue;
 
+		const detail::Decoded &d = read.decoded;
 		Marker m;
 		m.id = d.id;
 		m.hamming = d.hamming;
+		m.margin = read.margin;
 		for (int i = 0; i < 4; ++i)
 			m.corners[i] = q.corners[(i + d.rotation) & 3];
 
@@ -431,6 +443,11 @@ void Detector::Impl::finish(const ImageView &image, Slot &slot)
 		if (!duplicate)
 			res.markers.push_back(m);
 	}
+	/* Smallest first, a block of a marker's code cells decoded before the
+	 * marker around it did: now that both are known, drop it. */
+	t = Clock::now();
+	detail::dropNestedMarkers(res.markers, bits);
+	decodeMs += msSince(t);
 	res.times[Stage::Refine] = refineMs;
 	res.times[Stage::Warp] = warpMs;
 	res.times[Stage::Decode] = decodeMs;
@@ -447,6 +464,10 @@ Detector::Detector(const Config &config) : impl_(std::make_unique<Impl>())
 	impl_->dict = d;
 	impl_->codes = std::make_unique<detail::CodeBook>(*d);
 	impl_->maxHamming = config.max_hamming >= 0 ? config.max_hamming : d->defaultMaxHamming();
+	impl_->policy.maxHamming = impl_->maxHamming;
+	impl_->policy.weakMargin = config.weak_margin;
+	impl_->policy.maxTotal =
+		config.weak_margin > 0.0f ? std::max(impl_->maxHamming, d->weakMaxHamming()) : impl_->maxHamming;
 	const double e = static_cast<double>(config.edge_threshold) * 255.0;
 	impl_->params.edge_threshold_sq = static_cast<std::int64_t>(std::floor(e * e));
 	impl_->params.corner_threshold =

@@ -3,14 +3,45 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 
 #include "dictionary_table.h"
 
 namespace frappe {
 
+namespace {
+
+/* The most bits up to `limit` whose chance stays below `chance`. */
+int mostWithin(const Dictionary &d, int limit, double chance)
+{
+	int t = 0;
+	while (t < limit && d.randomDecodeChance(t + 1) < chance)
+		++t;
+	return t;
+}
+
+} // namespace
+
+/* A union bound: 4 n C(bits^2, <= t) / 2^bits^2. */
+double Dictionary::randomDecodeChance(int t) const
+{
+	const int cells = bits * bits;
+	double within = 0.0, choose = 1.0;
+	for (int i = 0; i <= t && i <= cells; ++i) {
+		within += choose;
+		choose = choose * (cells - i) / (i + 1);
+	}
+	return 4.0 * size() * within / std::ldexp(1.0, cells);
+}
+
 int Dictionary::defaultMaxHamming() const
 {
-	return std::clamp((min_hamming - 1) / 2, 0, 5);
+	return mostWithin(*this, std::clamp((min_hamming - 1) / 2, 0, 5), 1e-5);
+}
+
+int Dictionary::weakMaxHamming() const
+{
+	return std::max(defaultMaxHamming(), mostWithin(*this, std::clamp((min_hamming - 1) / 2, 0, 5), 2e-2));
 }
 
 std::span<const Dictionary> dictionaries()

@@ -33,6 +33,7 @@ static gboolean frappe_marker_meta_init(GstMeta *meta, gpointer, GstBuffer *)
 	std::memset(m->tvec, 0, sizeof(m->tvec));
 	m->reprojection_error = 0.0;
 	m->alternative_reprojection_error = 0.0;
+	m->margin = 0.0f;
 	return TRUE;
 }
 
@@ -51,6 +52,7 @@ static gboolean frappe_marker_meta_transform(GstBuffer *dest, GstMeta *meta, Gst
 		std::memcpy(m->tvec, src->tvec, sizeof(m->tvec));
 		m->reprojection_error = src->reprojection_error;
 		m->alternative_reprojection_error = src->alternative_reprojection_error;
+		m->margin = src->margin;
 		return TRUE;
 	}
 
@@ -79,6 +81,7 @@ static gboolean frappe_marker_meta_transform(GstBuffer *dest, GstMeta *meta, Gst
 		std::memcpy(m->tvec, src->tvec, sizeof(m->tvec));
 		m->reprojection_error = src->reprojection_error * (sx + sy) / 2.0;
 		m->alternative_reprojection_error = src->alternative_reprojection_error * (sx + sy) / 2.0;
+		m->margin = src->margin;
 		return TRUE;
 	}
 

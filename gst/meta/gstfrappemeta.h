@@ -35,6 +35,11 @@ G_BEGIN_DECLS
  *   planar pose problem (IPPE's second pose, the marker "flipped"). When it
  *   is close to @reprojection_error the pose is ambiguous (typical of small
  *   or distant markers seen face on); infinity when there was one solution.
+ * @margin: how clearly the code was read, in [0, 1]: over the code cells,
+ *   the smallest distance of a cell's mean grey level from the threshold
+ *   between black and white, as a fraction of half the black-white
+ *   contrast (frappe::Marker::margin). Near 0, some cell was nearly a coin
+ *   toss; filter on it to trade misses for certainty.
  *
  * One marker found by frappedetect. A buffer carries one meta per marker;
  * iterate them with gst_buffer_iterate_meta_filtered() and
@@ -61,6 +66,8 @@ typedef struct {
 	gdouble tvec[3];
 	gdouble reprojection_error;
 	gdouble alternative_reprojection_error;
+
+	gfloat margin;
 } GstFrappeMarkerMeta;
 
 GType gst_frappe_marker_meta_api_get_type(void);
@@ -75,7 +82,8 @@ const GstMetaInfo *gst_frappe_marker_meta_get_info(void);
  * @hamming: corrected bits
  *
  * Returns: (transfer none): the new meta, without pose (set has_pose, rvec,
- * tvec and reprojection_error afterwards when known).
+ * tvec and reprojection_error afterwards when known) and with a margin of 0
+ * (set margin afterwards).
  */
 GstFrappeMarkerMeta *gst_buffer_add_frappe_marker_meta(GstBuffer *buffer, gint id,
 						       const gchar *dictionary,

@@ -34,10 +34,10 @@ TEST(Dictionary, KnownCodesAndSizes)
 	EXPECT_EQ(d->size(), 250);
 	EXPECT_EQ(d->min_hamming, 12);
 	EXPECT_EQ(d->codes[0], 0xd2b63a09dull); /* id 0, from the dictionary README */
-	EXPECT_EQ(d->defaultMaxHamming(), 5);
+	EXPECT_EQ(d->defaultMaxHamming(), 2);
 	EXPECT_EQ(findDictionary("apriltag_36h11")->size(), 587);
-	EXPECT_EQ(findDictionary("apriltag_36h11")->defaultMaxHamming(), 5);
-	EXPECT_EQ(findDictionary("4x4_50")->defaultMaxHamming(), 1);
+	EXPECT_EQ(findDictionary("apriltag_36h11")->defaultMaxHamming(), 1);
+	EXPECT_EQ(findDictionary("4x4_50")->defaultMaxHamming(), 0);
 	EXPECT_EQ(findDictionary("aruco_original")->defaultMaxHamming(), 0);
 }
 

@@ -159,7 +159,7 @@ def built_in_dictionaries(detect):
     corrects = {}
     for line in out.splitlines():
         if line.strip():
-            corrects[line.split()[0]] = int(line.rsplit('corrects', 1)[1].strip(' )'))
+            corrects[line.split()[0]] = int(line.rsplit('corrects', 1)[1].split(',')[0].strip(' )'))
     return corrects
 
 

@@ -154,6 +154,7 @@ TEST(Metas, CopyAndScaleTransforms)
 	GstFrappeMarkerMeta *m = gst_buffer_add_frappe_marker_meta(in, 3, "4x4_50", corners, 1);
 	m->has_pose = TRUE;
 	m->tvec[2] = 1.5;
+	m->margin = 0.625f;
 
 	GstBuffer *copy = gst_buffer_copy(in);
 	auto metas = markerMetas(copy);
@@ -164,6 +165,7 @@ TEST(Metas, CopyAndScaleTransforms)
 	EXPECT_TRUE(metas[0]->has_pose);
 	EXPECT_DOUBLE_EQ(metas[0]->tvec[2], 1.5);
 	EXPECT_FLOAT_EQ(metas[0]->corners[2], 29.5f);
+	EXPECT_FLOAT_EQ(metas[0]->margin, 0.625f);
 
 	/* Half size: pixel centres move with the image's corner fixed. */
 	GstVideoInfo inInfo, outInfo;
@@ -178,6 +180,7 @@ TEST(Metas, CopyAndScaleTransforms)
 	EXPECT_FLOAT_EQ(metas[0]->corners[0], 4.5f);
 	EXPECT_FLOAT_EQ(metas[0]->corners[1], 9.5f);
 	EXPECT_FLOAT_EQ(metas[0]->corners[4], 14.5f);
+	EXPECT_FLOAT_EQ(metas[0]->margin, 0.625f);
 
 	gst_buffer_unref(scaled);
 	gst_buffer_unref(copy);
@@ -225,6 +228,10 @@ TEST(Messages, OnePerFrameWithMarkers)
 			ASSERT_TRUE(gst_structure_get_int(m, "id", &id));
 			ASSERT_TRUE(gst_structure_get_uint(m, "hamming", &hamming));
 			EXPECT_EQ(hamming, 0u);
+			double margin = -1.0;
+			ASSERT_TRUE(gst_structure_get_double(m, "margin", &margin));
+			EXPECT_GT(margin, 0.5);
+			EXPECT_LE(margin, 1.0);
 			const GValue *corners = gst_structure_get_value(m, "corners");
 			ASSERT_TRUE(GST_VALUE_HOLDS_ARRAY(corners));
 			ASSERT_EQ(gst_value_array_get_size(corners), 8u);

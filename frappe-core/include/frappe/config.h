@@ -39,10 +39,21 @@ struct Config {
 	/// markers; too low splits one corner into several clusters.
 	float corner_threshold = 0.19f;
 
-	/// h_thr: the most bit errors corrected when decoding. -1 takes the
-	/// dictionary's safe default, min(5, (dmin - 1) / 2). Higher finds damaged
-	/// markers but raises the chance of a wrong id.
+	/// h_thr: the most bit errors corrected when decoding, among cells read
+	/// clearly. -1 takes the dictionary's careful default,
+	/// Dictionary::defaultMaxHamming() (0 for 4x4 families, 2 for
+	/// aruco_mip_36h12). Higher finds damaged markers but raises the chance
+	/// of a wrong id. Range -1 .. bits^2 / 2.
 	int max_hamming = -1;
+
+	/// A code cell whose mean lies closer to the threshold than this
+	/// fraction of half the black-white contrast is a weak read: blur and
+	/// small cells put true errors there, chance puts them anywhere. Weak
+	/// cells may be corrected beyond max_hamming, up to
+	/// Dictionary::weakMaxHamming() bits in all. Higher finds more blurred
+	/// and small markers at a higher chance of a wrong id; 0 corrects only
+	/// max_hamming bits of any kind. Range [0, 1].
+	float weak_margin = 0.3f;
 
 	/// beta (AScale only): target side in pixels of the smallest marker after
 	/// scaling. Smaller scales more aggressively (faster) but loses markers

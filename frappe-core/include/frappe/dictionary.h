@@ -20,9 +20,26 @@ struct Dictionary {
 	int opencv_max_correction = 0;        ///< what OpenCV corrects for it, for reference
 	std::span<const std::uint64_t> codes; ///< codes[id]
 
-	/// The correction the detector applies unless told otherwise:
-	/// min(5, (dmin - 1) / 2), never negative.
+	/// The bit errors the detector corrects unless told otherwise, among
+	/// cells read clearly: the most, up to min(5, (dmin - 1) / 2), for which a
+	/// random pattern decodes with a chance below 1e-5, that chance being
+	/// 4 rotations x codes x patterns within t bits / 2^(bits^2). 0 for
+	/// every 4x4 and 5x5 family (one pattern in 300 to 20,000 is a codeword
+	/// already), 1 for apriltag_36h11 and 36h10, 2 for aruco_mip_36h12 and
+	/// 6x6_250.
 	int defaultMaxHamming() const;
+	/// The bits corrected in all when the ones beyond defaultMaxHamming()
+	/// were read weakly (a cell's mean near the threshold, where blur and
+	/// small cells put them): the most, up to min(5, (dmin - 1) / 2), for
+	/// which even a pattern of weak cells only decodes with a chance below
+	/// 2e-2; never less than defaultMaxHamming(). 5 for aruco_mip_36h12 and
+	/// apriltag_36h11, 0 for every 4x4 family.
+	int weakMaxHamming() const;
+	/// The chance that a pattern of random bits lies within `bits` bits of
+	/// some codeword in some rotation: 4 x codes x patterns within `bits`
+	/// / 2^(bits^2). What a read corrected by that much is worth as
+	/// evidence on its own.
+	double randomDecodeChance(int bits) const;
 	int size() const { return static_cast<int>(codes.size()); }
 };
 

@@ -19,6 +19,14 @@ struct Marker {
 	std::array<Point2f, 4> corners{};
 	/// Bits corrected to reach the codeword.
 	int hamming = 0;
+	/// How clearly the code was read, in [0, 1]: over the code cells, the
+	/// smallest distance of a cell's mean grey level from the threshold
+	/// between black and white, as a fraction of half the black-white
+	/// contrast. 1: every cell is as dark as the darkest sample or as light
+	/// as the lightest; near 0: some cell was nearly a coin toss (blur, a
+	/// glint, a cell cut by the edge of a shadow). Filter on it to trade
+	/// misses for certainty.
+	float margin = 0.0f;
 };
 
 } // namespace frappe

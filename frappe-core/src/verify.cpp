@@ -1,0 +1,226 @@
+// SPDX-License-Identifier: MIT
+#include "verify.h"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <optional>
+
+#include "frappe/homography.h"
+#include "sampling.h"
+
+namespace frappe::detail {
+
+namespace {
+
+/* A cell straddles when its darkest sample is this fraction of the contrast
+ * below the threshold and its brightest as far above: blur alone moves a
+ * true cell's quarter-point samples apart by less. */
+constexpr float kStraddle = 0.15f;
+
+/* The nearest other id must be this many bits further than the decoded one
+ * (fewer where the dictionary's own codes are closer): one bit more is a
+ * coin toss between two ids. */
+constexpr int kAmbiguityGap = 2;
+
+/* A read that a random pattern would match with at most this chance is
+ * strong evidence on its own (a 6x6 code read exactly: 1e-8). */
+constexpr double kStrongRead = 1e-4;
+
+} // namespace
+
+CellRead readCells(const WarpedMarker &w, int bits, const Binarised &b, float weakMargin)
+{
+	const int cells = bits + 2;
+	const int k = std::max(1, w.side / cells);
+	const float thr = b.threshold;
+	const float clear = kStraddle * b.contrast;
+	const float half = 0.5f * b.contrast;
+	CellRead out;
+	out.margin = 1.0f;
+	for (int cy = 0; cy < cells; ++cy) {
+		for (int cx = 0; cx < cells; ++cx) {
+			float lo = 1e9f, hi = -1e9f, sum = 0.0f;
+			for (int y = 0; y < k; ++y) {
+				for (int x = 0; x < k; ++x) {
+					const float v = w.at(cx * k + x, cy * k + y);
+					lo = std::min(lo, v);
+					hi = std::max(hi, v);
+					sum += v;
+				}
+			}
+			out.straddling += lo < thr - clear && hi > thr + clear;
+			if (cx == 0 || cy == 0 || cx > bits || cy > bits)
+				continue;
+			const float mean = sum / static_cast<float>(k * k);
+			const float margin = half > 0.0f ? std::min(std::abs(mean - thr) / half, 1.0f) : 0.0f;
+			out.margin = std::min(out.margin, margin);
+			out.weak = (out.weak << 1) | (margin < weakMargin ? 1u : 0u);
+		}
+	}
+	return out;
+}
+
+int clearErrors(const Dictionary &dict, std::uint64_t code, std::uint64_t weak, const Decoded &d)
+{
+	/* Turn the read and its weak cells as decode() turned the read for
+	 * the codeword: rotation r is three quarter turns per step. */
+	for (int r = 0; r < (4 - d.rotation) % 4; ++r) {
+		code = rotateCode(code, dict.bits);
+		weak = rotateCode(weak, dict.bits);
+	}
+	return std::popcount((code ^ dict.codes[static_cast<std::size_t>(d.id)]) & ~weak);
+}
+
+QuietZone readQuietZone(const ImageView &image, const std::array<Point2f, 4> &corners, int bits,
+			const Binarised &b)
+{
+	const float threshold = b.threshold, black = b.threshold - kStraddle * b.contrast;
+	QuietZone out;
+	const auto H = Homography::fromUnitSquare(corners);
+	if (!H)
+		return out;
+	const int cells = bits + 2;
+	const double step = 1.0 / cells;
+	const float maxX = static_cast<float>(image.width - 1), maxY = static_cast<float>(image.height - 1);
+	auto sample = [&](int cx, int cy) {
+		const Point2f p = H->map((cx + 0.5) * step, (cy + 0.5) * step);
+		if (!(p.x >= 0.0f && p.y >= 0.0f && p.x <= maxX && p.y <= maxY))
+			return;
+		++out.seen;
+		const float v = sampleBilinear(image, p.x, p.y);
+		out.light += v > threshold;
+		out.dark += v < black;
+	};
+	/* Cells -1 and bits + 2 on each side, corners once. */
+	for (int c = -1; c <= cells; ++c) {
+		sample(c, -1);
+		sample(c, cells);
+	}
+	for (int c = 0; c < cells; ++c) {
+		sample(-1, c);
+		sample(cells, c);
+	}
+	return out;
+}
+
+bool borderIsBlack(const Binarised &b, int bits)
+{
+	return b.border_errors <= (4 * (bits + 1)) / 8;
+}
+
+Scrutiny scrutinyFor(const Dictionary &dict, int hamming)
+{
+	return dict.randomDecodeChance(hamming) > kStrongRead ? Scrutiny::Strict : Scrutiny::Tolerant;
+}
+
+bool quietZoneIsLight(const QuietZone &q, Scrutiny scrutiny)
+{
+	if (q.seen < 8)
+		return true;
+	if (scrutiny == Scrutiny::Tolerant)
+		return 3 * q.light >= 2 * q.seen;
+	return 4 * q.light >= 3 * q.seen && 16 * q.dark <= q.seen;
+}
+
+bool cellsAgree(const CellRead &c, int bits, Scrutiny scrutiny)
+{
+	return (scrutiny == Scrutiny::Tolerant ? 4 : 8) * c.straddling <= bits * bits;
+}
+
+bool unambiguous(const Decoded &d, const Dictionary &dict)
+{
+	const int gap = std::clamp(dict.min_hamming, 1, kAmbiguityGap);
+	return d.runnerUp - d.hamming >= gap;
+}
+
+namespace {
+
+/* The marker's unit square (inverse of its homography), for testing where
+ * other quads lie in it. */
+std::optional<Homography> unitSquareOf(const std::array<Point2f, 4> &marker)
+{
+	const auto H = Homography::fromUnitSquare(marker);
+	return H ? H->inverse() : std::nullopt;
+}
+
+bool insideWith(const Homography &toUnit, const std::array<Point2f, 4> &inner, int bits)
+{
+	/* The code area is [1, bits + 1] cells; corners within half a cell of
+	 * the border count as inside. */
+	const double lo = 0.5 / (bits + 2), hi = 1.0 - lo;
+	for (const Point2f &p : inner) {
+		const Point2f u = toUnit.map(p.x, p.y);
+		if (!(u.x >= lo && u.x <= hi && u.y >= lo && u.y <= hi))
+			return false;
+	}
+	return true;
+}
+
+} // namespace
+
+bool insideCodeArea(const std::array<Point2f, 4> &inner, const std::array<Point2f, 4> &marker, int bits)
+{
+	const auto toUnit = unitSquareOf(marker);
+	return toUnit && insideWith(*toUnit, inner, bits);
+}
+
+void dropNestedMarkers(std::vector<Marker> &markers, int bits)
+{
+	if (markers.size() < 2)
+		return;
+	/* Marks by id = -1 first: a marker inside one that is itself nested
+	 * still shows where the outer one's code is. */
+	std::size_t dropped = 0;
+	for (const Marker &outer : markers) {
+		const auto toUnit = unitSquareOf(outer.corners);
+		if (!toUnit)
+			continue;
+		for (Marker &m : markers) {
+			if (&m != &outer && m.id >= 0 && insideWith(*toUnit, m.corners, bits)) {
+				m.id = -1;
+				++dropped;
+			}
+		}
+	}
+	if (dropped)
+		std::erase_if(markers, [](const Marker &m) { return m.id < 0; });
+}
+
+MarkerRead readMarker(const ImageView &image, const std::array<Point2f, 4> &corners, const CodeBook &codes,
+		      const DecodePolicy &policy, const WarpedMarker &w, const Binarised &b)
+{
+	const Dictionary &dict = codes.dictionary();
+	MarkerRead out;
+	out.decoded = codes.decode(b.code, policy.maxTotal);
+	if (out.decoded.id < 0)
+		return out;
+	if (!unambiguous(out.decoded, dict)) {
+		out.rejection = Rejection::Ambiguous;
+		return out;
+	}
+	if (!borderIsBlack(b, dict.bits)) {
+		out.rejection = Rejection::BorderNotBlack;
+		return out;
+	}
+	const CellRead cells = readCells(w, dict.bits, b, policy.weakMargin);
+	out.margin = cells.margin;
+	if (out.decoded.hamming > policy.maxHamming &&
+	    clearErrors(dict, b.code, cells.weak, out.decoded) > policy.maxHamming) {
+		out.rejection = Rejection::TooManyClearErrors;
+		return out;
+	}
+	const Scrutiny scrutiny = scrutinyFor(dict, out.decoded.hamming);
+	if (!cellsAgree(cells, dict.bits, scrutiny)) {
+		out.rejection = Rejection::CellsDisagree;
+		return out;
+	}
+	if (!quietZoneIsLight(readQuietZone(image, corners, dict.bits, b), scrutiny)) {
+		out.rejection = Rejection::NoQuietZone;
+		return out;
+	}
+	out.rejection = Rejection::None;
+	return out;
+}
+
+} // namespace frappe::detail
