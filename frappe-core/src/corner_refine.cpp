@@ -59,16 +59,15 @@ struct Line {
 
 constexpr int kCoarsePoints = 12; /* columns per side, first pass */
 constexpr int kFinePoints = 48;  /* columns per side, second pass */
-/* How far (pixels along the column) the falls may extend beyond the two
- * differences at the steepest point: a blurred edge spreads over a few
- * pixels, but more lets noise and neighbouring edges in. */
-constexpr int kRun = 3;
-/* Half the final window, in 1/16 pixel, plus half a pixel: the window is
- * 1.5 px either side of the first centroid, and a difference (a pixel wide)
- * counts by how much of it lies inside. */
-constexpr int kWindow16 = 32;
+/* RefineWindow's run (how far, pixels along the column, the falls may
+ * extend beyond the two differences at the steepest point: a blurred edge
+ * spreads over a few pixels, but more lets noise and neighbouring edges in)
+ * is at most this. Its window16 is half the final window, in 1/16 pixel,
+ * plus half a pixel (32: 1.5 px either side of the first centroid); a
+ * difference, a pixel wide, counts by how much of it lies inside. */
+constexpr int kMaxRun = 8;
 constexpr int kMaxReach = 23; /* search window, pixels either side */
-constexpr int kMaxProfile = 2 * (kMaxReach + kRun + 1) + 1;
+constexpr int kMaxProfile = 2 * (kMaxReach + kMaxRun + 1) + 1;
 /* Steepest fall over two pixels below which a column is noise, not edge. */
 constexpr int kMinDrop = 6;
 
@@ -83,6 +82,7 @@ struct Columns {
 	static constexpr int kPad = 16;
 	int n;
 	int kLoMin, kHiMax;
+	int run, window16; /* RefineWindow's */
 	alignas(64) std::uint8_t p[kMaxProfile][kLanes];
 	alignas(64) std::int32_t kLo[kLanes];
 	alignas(64) std::int32_t kHi[kLanes];
@@ -114,7 +114,7 @@ void MeasureColumns(Columns &c)
 	const hn::Rebind<float, decltype(d)> df;
 	const int N = static_cast<int>(hn::Lanes(d));
 	/* The differences p(m) - p(m + 1), m = m0..m1 (as far as falls reach). */
-	const int m0 = c.kLoMin - kRun - 1, m1 = c.kHiMax + kRun;
+	const int m0 = c.kLoMin - c.run - 1, m1 = c.kHiMax + c.run;
 	HWY_ALIGN std::int32_t diff[(kMaxProfile - 1) * HWY_LANES(std::int32_t)];
 	HWY_ALIGN std::int32_t falls[(kMaxProfile - 1) * HWY_LANES(std::int32_t)];
 	const auto zero = hn::Zero(d), one = hn::Set(d, 1);
@@ -151,14 +151,14 @@ void MeasureColumns(Columns &c)
 			const auto stop = hn::And(hn::Lt(at(m), one), hn::Lt(mv, loStop));
 			lo = hn::IfThenElse(stop, hn::Add(mv, one), lo);
 		}
-		lo = hn::Max(lo, hn::Sub(best, hn::Set(d, kRun + 1)));
+		lo = hn::Max(lo, hn::Sub(best, hn::Set(d, c.run + 1)));
 		auto hi = hn::Set(d, m1 + 1);
 		for (int m = m1; m >= c.kLoMin + 1; --m) {
 			const auto mv = hn::Set(d, m);
 			const auto stop = hn::And(hn::Lt(at(m), one), hn::Gt(mv, best));
 			hi = hn::IfThenElse(stop, mv, hi);
 		}
-		hi = hn::Min(hi, hn::Add(best, hn::Set(d, kRun + 1)));
+		hi = hn::Min(hi, hn::Add(best, hn::Set(d, c.run + 1)));
 
 		/* The falls from lo to hi, and their centroid in 1/16 pixel. */
 		const auto lo1 = hn::Sub(lo, one);
@@ -187,7 +187,7 @@ void MeasureColumns(Columns &c)
 		const auto full = hn::Set(d, 16);
 		for (int m = m0; m <= m1; ++m) {
 			const auto dist = hn::Abs(hn::Sub(hn::Set(d, 16 * m + 8), c16));
-			const auto f16 = hn::Min(hn::Max(hn::Sub(hn::Set(d, kWindow16), dist), zero), full);
+			const auto f16 = hn::Min(hn::Max(hn::Sub(hn::Set(d, c.window16), dist), zero), full);
 			const auto wf = hn::Mul(f16, hn::Load(d, falls + (m - m0) * N));
 			wMass = hn::Add(wMass, wf);
 			wMoment2 = hn::Add(wMoment2, hn::Mul(wf, hn::Set(d, 2 * m + 1)));
@@ -230,7 +230,7 @@ inline int ceilInt(float x)
  * w (0: no edge) and their moment2, so that the crossing is at
  * moment2 / (2 w) steps, both in sixteenths of the falls. */
 template <typename Pixel>
-inline int measureColumn(Pixel p, int kLo, int kHi, int &moment2Out)
+inline int measureColumn(Pixel p, int kLo, int kHi, int kRun, int kWindow16, int &moment2Out)
 {
 	/* Strongest fall in intensity going inwards (white border outside,
 	 * black frame inside); rises belong to other edges. */
@@ -255,7 +255,7 @@ inline int measureColumn(Pixel p, int kLo, int kHi, int &moment2Out)
 	for (int next; hi <= best + kRun && prev > (next = p(hi + 1)); prev = next)
 		++hi;
 	/* falls[i] at lo + i; hi is one past the last. */
-	int falls[2 * kRun + 2];
+	int falls[2 * kMaxRun + 2];
 	int mass = 0, moment2 = 0;
 	prev = p(lo);
 	for (int k = lo; k < hi; ++k) {
@@ -342,8 +342,10 @@ inline void addCrossing(Sums &s, int U, std::int32_t vFix, int vc, int wMass, in
 
 /* Measures one side from a to b (clockwise quad, so the marker interior is
  * on the right of a->b on screen). */
-bool fitSide(const ImageView &img, Point2f a, Point2f b, float search, int maxPoints, Line &line)
+bool fitSide(const ImageView &img, Point2f a, Point2f b, float search, int maxPoints, const RefineWindow &win,
+	     Line &line)
 {
+	const int kRun = win.run, kWindow16 = win.window16;
 	const float dx = b.x - a.x, dy = b.y - a.y;
 	const float len = std::sqrt(dx * dx + dy * dy);
 	if (len < 2.0f || img.width < 1 || img.height < 1)
@@ -401,6 +403,8 @@ bool fitSide(const ImageView &img, Point2f a, Point2f b, float search, int maxPo
 	Columns cols;
 	int Us[kFinePoints];
 	std::int32_t vFixes[kFinePoints];
+	cols.run = kRun;
+	cols.window16 = kWindow16;
 	cols.kLoMin = kMaxReach;
 	cols.kHiMax = -kMaxReach;
 	for (int i = 0; i < nPoints; ++i, accFix += stepFix) {
@@ -459,13 +463,13 @@ bool fitSide(const ImageView &img, Point2f a, Point2f b, float search, int maxPo
 		if (u >= 0 && u < uDim && vc - half >= 0 && vc + half < vDim) {
 			const std::uint8_t *px = img.data + u * uStep + vc * vStep;
 			wMass = measureColumn([px, step](int j) { return static_cast<int>(px[j * step]); }, kLo, kHi,
-					      wMoment2);
+					      kRun, kWindow16, wMoment2);
 		} else {
 			/* Clamped to the image, as a bilinear sampler would. */
 			const int uc = std::clamp(u, 0, uDim - 1);
 			for (int j = -half; j <= half; ++j)
 				p[j] = img.data[uc * uStep + std::clamp(vc + dir * j, 0, vDim - 1) * vStep];
-			wMass = measureColumn([p](int j) { return p[j]; }, kLo, kHi, wMoment2);
+			wMass = measureColumn([p](int j) { return p[j]; }, kLo, kHi, kRun, kWindow16, wMoment2);
 		}
 		addCrossing(sums, U, vFix, vc, wMass, wMoment2, dir, vRef, reachFix);
 	}
@@ -499,11 +503,12 @@ bool intersect(const Line &l1, const Line &l2, Point2f &p)
 	return true;
 }
 
-bool refineOnce(const ImageView &img, std::array<Point2f, 4> &q, float search, int maxPoints)
+bool refineOnce(const ImageView &img, std::array<Point2f, 4> &q, float search, int maxPoints,
+		const RefineWindow &win)
 {
 	Line lines[4];
 	for (int i = 0; i < 4; ++i) {
-		if (!fitSide(img, q[i], q[(i + 1) & 3], search, maxPoints, lines[i]))
+		if (!fitSide(img, q[i], q[(i + 1) & 3], search, maxPoints, win, lines[i]))
 			return false;
 	}
 	std::array<Point2f, 4> r;
@@ -521,15 +526,18 @@ bool refineOnce(const ImageView &img, std::array<Point2f, 4> &q, float search, i
 
 } // namespace
 
-bool refineCorners(const ImageView &image, std::array<Point2f, 4> &corners, float search)
+bool refineCorners(const ImageView &image, std::array<Point2f, 4> &corners, float search, const RefineWindow &window)
 {
+	RefineWindow win = window;
+	win.run = std::clamp(win.run, 1, kMaxRun);
+	win.window16 = std::clamp(win.window16, 8, 16 * kMaxRun);
 	std::array<Point2f, 4> q = corners;
 	/* The wide first pass only has to place the sides roughly: few points. */
-	if (!refineOnce(image, q, search, kCoarsePoints))
+	if (!refineOnce(image, q, search, kCoarsePoints, win))
 		return false;
 	/* A second, narrow pass: the sides are now well placed, so the
 	 * measurement points avoid the corners exactly and the window shrinks. */
-	refineOnce(image, q, std::min(search, 1.5f), kFinePoints);
+	refineOnce(image, q, std::min(search, 1.5f), kFinePoints, win);
 	corners = q;
 	return true;
 }

@@ -8,6 +8,17 @@
 
 namespace frappe::detail {
 
+/// How much of an edge's profile a column's crossing is measured from: the
+/// falls at most `run` pixels beyond the steepest pair, weighted by a window
+/// of `window16` / 16 - 1/2 pixels either side of their first centroid. The
+/// defaults suit sharp and slightly blurred edges next to code cells a few
+/// pixels away; a wider window stays unbiased on an edge blurred over many
+/// pixels (run at most 8).
+struct RefineWindow {
+	int run = 3;
+	int window16 = 32;
+};
+
 /// Refines the corners of a clockwise quadrilateral on the full-resolution
 /// image. Each side is re-measured: along its normal, at points spread over
 /// the side, the strongest light-to-dark step going inwards is located to a
@@ -19,6 +30,7 @@ namespace frappe::detail {
 /// `search` is how far (pixels) the true side may lie from the initial one.
 /// Returns false when a side cannot be measured; the corners are then
 /// unchanged.
-bool refineCorners(const ImageView &image, std::array<Point2f, 4> &corners, float search);
+bool refineCorners(const ImageView &image, std::array<Point2f, 4> &corners, float search,
+		   const RefineWindow &window = {});
 
 } // namespace frappe::detail

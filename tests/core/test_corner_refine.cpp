@@ -2,6 +2,7 @@
 // CORNER_REFINE on rendered markers: from corners a pixel or two off, the
 // refined ones lie within 0.15 px of the truth on average, and every Highway
 // target (the side's columns are measured a lane each) gives the same bits.
+#include <cstdio>
 #include <cstring>
 #include <random>
 #include <vector>
@@ -69,9 +70,48 @@ TEST(CornerRefine, ConvergesToTheTrueCorners)
 	EXPECT_GE(refined, 22);
 }
 
+/* Markers smeared by 10 px of motion blur, from corners 2 px off: the
+ * default window cuts the blurred sides' ramps short and stays near where
+ * it started; the wide one takes in the whole profile. */
+TEST(CornerRefine, AWideWindowStaysUnbiasedOnMotionBlur)
+{
+	const Dictionary &dict = *findDictionary("aruco_mip_36h12");
+	std::mt19937 rng(5);
+	std::uniform_real_distribution<float> off(-2.0f, 2.0f);
+	const detail::RefineWindow wide{ 6, 64 };
+	double errDefault = 0, errWide = 0;
+	int both = 0;
+	for (int k = 0; k < 16; ++k) {
+		const float side = 80.0f + 6.0f * k;
+		const int size = static_cast<int>(side * 1.6f) + 20;
+		Image img(size, size, 100);
+		const auto truth = squarePose(size / 2.0f + 0.3f, size / 2.0f - 0.2f, side, 11.0f * k, 6.0f * (k % 5));
+		renderMarker(img.mut(), dict, k, truth);
+		motionBlur(img, 10.0f, 0.4f * k);
+		addNoise(img, 2.0f, rng);
+		std::array<Point2f, 4> start;
+		for (int i = 0; i < 4; ++i)
+			start[i] = { truth[i].x + off(rng), truth[i].y + off(rng) };
+		std::array<Point2f, 4> a = start, b = start;
+		if (!detail::refineCorners(img.view(), a, 4.0f) || !detail::refineCorners(img.view(), b, 4.0f, wide))
+			continue;
+		++both;
+		errDefault += meanCornerError(a, truth);
+		errWide += meanCornerError(b, truth);
+	}
+	ASSERT_GE(both, 12);
+	errDefault /= both;
+	errWide /= both;
+	std::printf("10 px motion blur: mean corner error %.3f px with the default window, %.3f with the wide one\n",
+		    errDefault, errWide);
+	EXPECT_LT(errWide, 0.8 * errDefault);
+	EXPECT_LT(errWide, 0.35);
+}
+
 TEST(CornerRefine, EveryTargetGivesTheSameBits)
 {
 	const std::vector<Case> cases = makeCases();
+	for (const detail::RefineWindow window : { detail::RefineWindow{}, detail::RefineWindow{ 6, 64 } }) {
 	std::vector<std::array<Point2f, 4>> first;
 	std::vector<int> firstOk;
 	onEveryTarget([&](const char *target) {
@@ -79,7 +119,7 @@ TEST(CornerRefine, EveryTargetGivesTheSameBits)
 		std::vector<int> ok;
 		for (const Case &c : cases) {
 			std::array<Point2f, 4> q = c.start;
-			ok.push_back(detail::refineCorners(c.image.view(), q, c.search));
+			ok.push_back(detail::refineCorners(c.image.view(), q, c.search, window));
 			got.push_back(q);
 		}
 		if (first.empty()) {
@@ -92,4 +132,5 @@ TEST(CornerRefine, EveryTargetGivesTheSameBits)
 			ASSERT_EQ(std::memcmp(&got[k], &first[k], sizeof got[k]), 0) << target << " case " << k;
 		}
 	});
+	}
 }
