@@ -54,12 +54,6 @@ void validate(const Config &c, const Dictionary &d)
 		fail("threads must be in [0, 256], got " + std::to_string(c.threads));
 }
 
-/* Border cells that may read white before a candidate is rejected: blur
- * and small cells brighten the frame next to the quiet zone. */
-int allowedBorderErrors(int bits)
-{
-	return (4 * (bits + 1)) / 8;
-}
 
 bool sidesAtLeast(const std::array<Point2f, 4> &q, float side)
 {
@@ -91,7 +85,7 @@ Point2f quadCentre(const std::array<Point2f, 4> &q)
 bool surroundsDecoded(const std::array<Point2f, 4> &q, float area, int probeRead, int bits,
 		      const std::vector<Marker> &found)
 {
-	if (probeRead >= 0 && probeRead <= allowedBorderErrors(bits))
+	if (probeRead >= 0 && probeRead <= detail::allowedBorderErrors(bits))
 		return false;
 	const Point2f c = quadCentre(q);
 	for (const Marker &m : found) {
@@ -140,7 +134,7 @@ public:
 		 * inside the quad (markers on a dark panel, say), and with a small
 		 * dictionary and a generous max_hamming a third of all bit patterns
 		 * are within reach of some codeword. */
-		return b.contrast >= 10.0f && b.border_errors <= allowedBorderErrors(dict_.bits) &&
+		return b.contrast >= 10.0f && b.border_errors <= detail::allowedBorderErrors(dict_.bits) &&
 		       codes_.decode(b.code, 0).id >= 0;
 	}
 
@@ -336,7 +330,7 @@ void Detector::Impl::finish(const ImageView &image, Slot &slot)
 
 	const float search = 2.5f / scale;
 	const int bits = dict->bits;
-	const int borderAllowance = allowedBorderErrors(bits);
+	const int borderAllowance = detail::allowedBorderErrors(bits);
 	const int whiteFrame = 3 * bits + 3; /* three quarters of the 4(n+1) border cells */
 	/* The probe's read at the traced outline decides two things before
 	 * refinement. A frame with more white cells than twice what decode

@@ -104,9 +104,14 @@ QuietZone readQuietZone(const ImageView &image, const std::array<Point2f, 4> &co
 	return out;
 }
 
+int allowedBorderErrors(int bits)
+{
+	return (4 * (bits + 1)) / 8;
+}
+
 bool borderIsBlack(const Binarised &b, int bits)
 {
-	return b.border_errors <= (4 * (bits + 1)) / 8;
+	return b.border_errors <= allowedBorderErrors(bits);
 }
 
 Scrutiny scrutinyFor(const Dictionary &dict, int hamming)

@@ -50,8 +50,12 @@ struct QuietZone {
 QuietZone readQuietZone(const ImageView &image, const std::array<Point2f, 4> &corners, int bits,
 			const Binarised &b);
 
-/// The border cells that read white are few enough for blur next to the
-/// quiet zone and an occluded corner, too few for a patch of code.
+/// Border cells that may read white before a candidate is rejected: blur
+/// and small cells brighten the frame next to the quiet zone, a corner may
+/// be occluded; a patch of code has more.
+int allowedBorderErrors(int bits);
+
+/// The border cells that read white are at most allowedBorderErrors().
 bool borderIsBlack(const Binarised &b, int bits);
 
 /// How much a read needs its frame and cells to vouch for it. A code that
