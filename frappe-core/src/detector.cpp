@@ -511,12 +511,12 @@ void Detector::runFrontEnd(const ImageView &image, int slot)
 	s.result.times = {};
 	s.result.times[Stage::AdaptiveScale] = msSince(t0);
 	const auto t1 = Clock::now();
-	s.edges.regions.resize(0, 0);
 	d.frontEnd->run(image, scale, d.params, s.edges);
-	if (s.edges.regions.width == 0 && d.params.region_contrast > 0) {
+	if (!d.frontEnd->makesRegionMap()) {
 		/* A front end without a region map (the QPUs, for now): the
 		 * CPU's, from the full-resolution frame (the edge map's scale
-		 * is taken into account when its quads are mapped). */
+		 * is taken into account when its quads are mapped); empty when
+		 * region_contrast is 0. */
 		detail::regionMap(image, 1.0f, d.params.region_contrast, s.edges.regions, d.regionScratch);
 	}
 	s.result.times[Stage::FrontEnd] = msSince(t1);

@@ -72,6 +72,7 @@ public:
 	const char *name() const override { return "cpu"; }
 	void run(const ImageView &image, float scale, const FrontEndParams &params,
 		 EdgeMap &out) override;
+	bool makesRegionMap() const override { return true; }
 
 private:
 	void runBand(const ImageView &src, const FrontEndParams &params, EdgeMap &out,

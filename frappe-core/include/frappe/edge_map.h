@@ -70,8 +70,8 @@ int scaledLength(int full, float scale);
 /// four-direction non-maximum suppression, the edge threshold, Shi-Tomasi
 /// corners on edge pixels, the empty-tile mask and the region map, all in
 /// one call. Implementations must produce byte-identical EdgeMaps; one that
-/// leaves `regions` empty (width 0) while params ask for it gets the CPU's
-/// region map from the Detector.
+/// does not make the region map (makesRegionMap()) gets the CPU's from the
+/// Detector.
 class FrontEnd {
 public:
 	virtual ~FrontEnd() = default;
@@ -79,6 +79,9 @@ public:
 	/// Fills `out` (resizing it) for `image` sampled at `scale` (<= 1).
 	virtual void run(const ImageView &image, float scale, const FrontEndParams &params,
 			 EdgeMap &out) = 0;
+	/// Whether run() fills out.regions too; otherwise the Detector adds
+	/// the CPU's region map.
+	virtual bool makesRegionMap() const { return false; }
 };
 
 /// The reference CPU front end. `threads` > 1 splits the frame into row
