@@ -21,40 +21,19 @@ namespace HWY_NAMESPACE {
 
 namespace hn = hwy::HWY_NAMESPACE;
 
-void DecimateRow(const std::uint8_t *r0, const std::uint8_t *r1, int w, std::uint8_t *out)
+/* Each output pixel from the 2 x 2 pixels a0[2x], a0[2x + 1], a1[2x],
+ * a1[2x + 1]. A 16-bit lane holds two neighbouring pixels of a row: the
+ * low byte and the high one, whatever the byte order (every reduction here
+ * is symmetric). The result (< 256) is narrowed from signed lanes, which
+ * this Highway can. `reduce` takes the four pixels as 16-bit lanes; the
+ * scalar form does the tail and the scalar target. */
+template <class Reduce>
+void Of2x2(const std::uint8_t *a0, const std::uint8_t *a1, int w, std::uint8_t *out, Reduce reduce,
+	   void (*scalar)(const std::uint8_t *, const std::uint8_t *, int, std::uint8_t *))
 {
 #if HWY_TARGET == HWY_SCALAR
-	decimateRowScalar(r0, r1, w, out);
-#else
-	/* Each 16-bit lane holds two neighbouring pixels of a row: their sum
-	 * is the low byte plus the high one, whatever the byte order. The
-	 * mean (< 256) is narrowed from signed lanes, which this Highway can. */
-	const hn::ScalableTag<std::uint16_t> d16;
-	const hn::RebindToSigned<decltype(d16)> di16;
-	const hn::Repartition<std::uint8_t, decltype(d16)> d8;
-	const hn::Rebind<std::uint8_t, decltype(d16)> d8h;
-	const int N = static_cast<int>(hn::Lanes(d16));
-	const auto low = hn::Set(d16, 0xFF), two = hn::Set(d16, 2);
-	int x = 0;
-	for (; x + N <= w; x += N) {
-		const auto a = hn::BitCast(d16, hn::LoadU(d8, r0 + 2 * x));
-		const auto b = hn::BitCast(d16, hn::LoadU(d8, r1 + 2 * x));
-		const auto sum = hn::Add(hn::Add(hn::And(a, low), hn::ShiftRight<8>(a)),
-					 hn::Add(hn::And(b, low), hn::ShiftRight<8>(b)));
-		hn::StoreU(hn::DemoteTo(d8h, hn::BitCast(di16, hn::ShiftRight<2>(hn::Add(sum, two)))), d8h, out + x);
-	}
-	if (x < w)
-		decimateRowScalar(r0 + 2 * x, r1 + 2 * x, w - x, out + x);
-#endif
-}
-
-/* out[x] = the least (Op = Min) or greatest (Max) of a0[2x], a0[2x + 1],
- * a1[2x], a1[2x + 1]: 16-bit lanes hold the pairs, as in DecimateRow. */
-template <bool kMin>
-void ExtremePairs(const std::uint8_t *a0, const std::uint8_t *a1, int w, std::uint8_t *out)
-{
-#if HWY_TARGET == HWY_SCALAR
-	extremePairsScalar(a0, a1, w, out, kMin);
+	(void)reduce;
+	scalar(a0, a1, w, out);
 #else
 	const hn::ScalableTag<std::uint16_t> d16;
 	const hn::RebindToSigned<decltype(d16)> di16;
@@ -66,23 +45,37 @@ void ExtremePairs(const std::uint8_t *a0, const std::uint8_t *a1, int w, std::ui
 	for (; x + N <= w; x += N) {
 		const auto a = hn::BitCast(d16, hn::LoadU(d8, a0 + 2 * x));
 		const auto b = hn::BitCast(d16, hn::LoadU(d8, a1 + 2 * x));
-		auto e = kMin ? hn::Min(hn::Min(hn::And(a, low), hn::ShiftRight<8>(a)), hn::Min(hn::And(b, low), hn::ShiftRight<8>(b)))
-			      : hn::Max(hn::Max(hn::And(a, low), hn::ShiftRight<8>(a)), hn::Max(hn::And(b, low), hn::ShiftRight<8>(b)));
-		hn::StoreU(hn::DemoteTo(d8h, hn::BitCast(di16, e)), d8h, out + x);
+		const auto r = reduce(d16, hn::And(a, low), hn::ShiftRight<8>(a), hn::And(b, low), hn::ShiftRight<8>(b));
+		hn::StoreU(hn::DemoteTo(d8h, hn::BitCast(di16, r)), d8h, out + x);
 	}
 	if (x < w)
-		extremePairsScalar(a0 + 2 * x, a1 + 2 * x, w - x, out + x, kMin);
+		scalar(a0 + 2 * x, a1 + 2 * x, w - x, out + x);
 #endif
+}
+
+void DecimateRow(const std::uint8_t *r0, const std::uint8_t *r1, int w, std::uint8_t *out)
+{
+	Of2x2(r0, r1, w, out, [](auto d, auto p, auto q, auto r, auto t) {
+		return hn::ShiftRight<2>(hn::Add(hn::Add(hn::Add(p, q), hn::Add(r, t)), hn::Set(d, 2)));
+	}, decimateRowScalar);
 }
 
 void MinPairs(const std::uint8_t *a0, const std::uint8_t *a1, int w, std::uint8_t *out)
 {
-	ExtremePairs<true>(a0, a1, w, out);
+	Of2x2(a0, a1, w, out, [](auto, auto p, auto q, auto r, auto t) {
+		return hn::Min(hn::Min(p, q), hn::Min(r, t));
+	}, [](const std::uint8_t *b0, const std::uint8_t *b1, int n, std::uint8_t *o) {
+		extremePairsScalar(b0, b1, n, o, true);
+	});
 }
 
 void MaxPairs(const std::uint8_t *a0, const std::uint8_t *a1, int w, std::uint8_t *out)
 {
-	ExtremePairs<false>(a0, a1, w, out);
+	Of2x2(a0, a1, w, out, [](auto, auto p, auto q, auto r, auto t) {
+		return hn::Max(hn::Max(p, q), hn::Max(r, t));
+	}, [](const std::uint8_t *b0, const std::uint8_t *b1, int n, std::uint8_t *o) {
+		extremePairsScalar(b0, b1, n, o, false);
+	});
 }
 
 bool DarkRow(const std::uint8_t *d, const std::uint8_t *mid, int w, std::uint8_t *out)
