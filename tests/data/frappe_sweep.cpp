@@ -105,8 +105,9 @@ void writeLine(std::ofstream &out, const std::string &image, const std::vector<f
 		const frappe::Marker &m = markers[i];
 		const auto &c = m.corners;
 		std::snprintf(buf, sizeof(buf),
-			      "%s{\"id\": %d, \"corners\": [[%.3f, %.3f], [%.3f, %.3f], [%.3f, %.3f], [%.3f, %.3f]], \"hamming\": %d}",
-			      i ? ", " : "", m.id, c[0].x, c[0].y, c[1].x, c[1].y, c[2].x, c[2].y, c[3].x, c[3].y, m.hamming);
+			      "%s{\"id\": %d, \"corners\": [[%.3f, %.3f], [%.3f, %.3f], [%.3f, %.3f], [%.3f, %.3f]], \"hamming\": %d, \"margin\": %.3f}",
+			      i ? ", " : "", m.id, c[0].x, c[0].y, c[1].x, c[1].y, c[2].x, c[2].y, c[3].x, c[3].y, m.hamming,
+			      m.margin);
 		out << buf;
 	}
 	out << "]";
