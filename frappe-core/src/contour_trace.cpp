@@ -220,7 +220,7 @@ void ContourTracer::trace(const TraceMap &edges, const TraceParams &params, std:
 		int fromDir;
 		if (f == kUnfollowed && row[x - 1] == 0)
 			fromDir = 4; /* outer border: came from the left */
-		else if (!(f & (kFollowedRightBg ^ kFollowed)) && row[x + 1] == 0)
+		else if (params.holes && !(f & (kFollowedRightBg ^ kFollowed)) && row[x + 1] == 0)
 			fromDir = 0; /* hole border: the hole is to the right */
 		else
 			return;

@@ -20,6 +20,8 @@ struct Quad {
 	/// how many border cells read white at the traced outline); -1 when
 	/// none. Travels with the quad through sorting and deduplication.
 	int probeRead = -1;
+	/// With probeRead: the spread of the grey levels it sampled.
+	float probeContrast = 0.0f;
 	/// Where the quad came from: the edge map, or the region map (whose
 	/// outline lies up to a region pixel inside the marker's).
 	bool fromRegion = false;
@@ -37,6 +39,11 @@ struct TraceParams {
 	/// through texture goes many times. Edge borders also double back
 	/// along open curves (twice the box), which the later checks reject.
 	float max_winding = 1e9f;
+	/// Whether hole borders are followed too. Region borders need only the
+	/// outer ones: a dark region's outer border is the candidate; the
+	/// border of a light hole in it (a marker's white cells, the quiet zone
+	/// of a marker on a dark panel) never outlines a marker's dark frame.
+	bool holes = true;
 };
 
 /// Asked during the scan whether an accepted quad is a marker. Nothing else
@@ -48,7 +55,7 @@ class MarkerProbe
 {
 public:
 	virtual ~MarkerProbe() = default;
-	/// May note what it read in quad.probeRead.
+	/// May note what it read in quad.probeRead and quad.probeContrast.
 	virtual bool isMarker(Quad &quad) = 0;
 };
 

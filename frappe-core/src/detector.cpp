@@ -120,7 +120,8 @@ public:
 	{
 	}
 	/* Notes in quad.probeRead how many border cells read white at the
-	 * traced outline (finish() uses it before refining). */
+	 * traced outline, and in quad.probeContrast the spread of its
+	 * samples (finish() uses both before refining). */
 	bool isMarker(detail::Quad &quad) override
 	{
 		std::array<Point2f, 4> corners;
@@ -130,6 +131,7 @@ public:
 			return false;
 		const detail::Binarised b = detail::binarise(cellCentres_, dict_.bits);
 		quad.probeRead = b.border_errors;
+		quad.probeContrast = b.contrast;
 		/* Only an exact codeword: a wrong "yes" would hide whatever lies
 		 * inside the quad (markers on a dark panel, say), and with a small
 		 * dictionary and a generous max_hamming a third of all bit patterns
@@ -258,6 +260,7 @@ void Detector::Impl::trace(Slot &slot)
 		detail::TraceParams rtp = tp;
 		rtp.min_clusters = 0;
 		rtp.max_winding = 2.0f;
+		rtp.holes = false;
 		rtp.min_side = std::max(4.0f, config.min_marker_side * regions.scale);
 		TracedMarkerProbe regionProbe(slot.image, regions.scale, *codes);
 		regionTracer.trace(regions, rtp, regionQuads, &regionProbe);
@@ -337,9 +340,24 @@ void Detector::Impl::finish(const ImageView &image, Slot &slot)
 	 * forgives, on a quad of at least 4 px a cell (where the traced outline
 	 * lies well within a cell of the refined one), is clutter: nothing to
 	 * refine. A white frame goes straight to the inset read below, which
-	 * starts from the traced outline anyway. */
+	 * starts from the traced outline anyway.
+	 * A region outline lies inside the marker's, so its frame samples fall
+	 * on the border cells at any size: a mixed frame is clutter there
+	 * whatever the size. So is a region whose samples spread less than the
+	 * contrast that made it a dark region: a patch of dark texture, not a
+	 * code. (Together they drop two thirds of the region quads that used
+	 * to be refined for nothing, at the cost of no marker.) */
 	const int mixedFrame = 2 * borderAllowance;
 	const float sureSide = 4.0f * static_cast<float>(bits + 2);
+	const auto flatRegion = static_cast<float>(params.region_contrast);
+	auto isClutter = [&](const detail::Quad &q, const std::array<Point2f, 4> &outline) {
+		const int traced = q.probeRead;
+		if (traced < 0)
+			return false;
+		if (q.fromRegion)
+			return (traced > mixedFrame && traced < whiteFrame) || q.probeContrast < flatRegion;
+		return traced > mixedFrame && traced < whiteFrame && sidesAtLeast(outline, sureSide);
+	};
 	double refineMs = 0, warpMs = 0, decodeMs = 0;
 	for (detail::Quad &q : slot.quads)
 		for (Point2f &p : q.corners)
@@ -357,7 +375,7 @@ void Detector::Impl::finish(const ImageView &image, Slot &slot)
 			continue;
 		}
 		const int traced = q.probeRead;
-		if (traced > mixedFrame && traced < whiteFrame && sidesAtLeast(outline, sureSide)) {
+		if (isClutter(q, outline)) {
 			refineMs += msSince(t);
 			continue;
 		}

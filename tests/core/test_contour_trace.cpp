@@ -85,6 +85,27 @@ TEST(ContourTrace, OneRingGivesOneQuadAtItsCorners)
 	}
 }
 
+TEST(ContourTrace, WithoutHolesOnlyTheOuterBorderIsFollowed)
+{
+	EdgeMap em = emptyMap(80, 60);
+	ring(em, 20, 15, 50, 40);
+	ContourTracer tracer;
+	std::vector<Quad> quads;
+	TraceParams params;
+	params.holes = false;
+	tracer.trace(em, params, quads);
+	EXPECT_EQ(tracer.bordersFollowed(), 1);
+	ASSERT_EQ(quads.size(), 1u);
+	/* The outer border runs on the ring itself: its corners. */
+	const float ex[4] = { 20, 50, 50, 20 }, ey[4] = { 15, 15, 40, 40 };
+	for (const Point2f &c : quads[0].corners) {
+		bool near = false;
+		for (int k = 0; k < 4; ++k)
+			near = near || (std::abs(c.x - ex[k]) <= 1.0f && std::abs(c.y - ey[k]) <= 1.0f);
+		EXPECT_TRUE(near) << c.x << "," << c.y;
+	}
+}
+
 TEST(ContourTrace, OpenCurveIsNotACandidate)
 {
 	EdgeMap em = emptyMap(80, 60);
