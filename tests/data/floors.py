@@ -29,9 +29,10 @@ class Floor:
 SETS = {
     'synth/images':             Floor(sens=(0.91, 0.93), fp=(0, 0), mae=(0.20, 0.20)),
     'synth/apriltag36h11':      Floor(sens=(0.94, 0.95), fp=(0, 0), mae=(0.20, 0.20)),
-    # Corners of the most strongly blurred markers (found by the region map)
-    # are 0.7 px off: see RefineWindow in detector.cpp.
-    'synth/blur':               Floor(sens=(0.65, 0.66), fp=(0, 0), mae=(0.41, 0.35), large=(0.97, 0.95)),
+    # Corners under motion blur of 8-12 px stay 1-2 px off (a fifth of the
+    # markers give a third of the error): the refinement window (detector.cpp,
+    # refineQuad) spans 7 px, not a whole blurred edge.
+    'synth/blur':               Floor(sens=(0.65, 0.66), fp=(0, 0), mae=(0.36, 0.35), large=(0.97, 0.95)),
     'synth/blur-apriltag36h11': Floor(sens=(0.64, 0.64), fp=(0, 0), large=(0.97, 0.95)),
     # Markers needing a corrected bit: the 4x4 families and 16h5 correct
     # none by default now (as OpenCV's defaults), for no wrong ids.
