@@ -129,6 +129,31 @@ bool darkRowScalar(const std::uint8_t *d, const std::uint8_t *mid, int w, std::u
 	return any != 0;
 }
 
+void tileExtremesScalar(const std::uint8_t *rows, std::ptrdiff_t stride, int n, int w, std::uint8_t *tmin,
+			std::uint8_t *tmax)
+{
+	for (int i = 0; i * kRegionTile < w; ++i) {
+		std::uint8_t lo = 255, hi = 0;
+		for (int y = 0; y < n; ++y)
+			for (int x = i * kRegionTile; x < std::min(w, (i + 1) * kRegionTile); ++x) {
+				lo = std::min(lo, rows[y * stride + x]);
+				hi = std::max(hi, rows[y * stride + x]);
+			}
+		tmin[i] = lo;
+		tmax[i] = hi;
+	}
+}
+
+bool darkRowTilesScalar(const std::uint8_t *d, const std::uint8_t *mid, int w, std::uint8_t *out,
+			std::uint8_t *tiles)
+{
+	if (!darkRowScalar(d, mid, w, out))
+		return false;
+	for (int x = 0; x < w; ++x)
+		tiles[x / TraceMap::kTile] |= out[x];
+	return true;
+}
+
 #ifdef FRAPPE_HAVE_HWY
 HWY_EXPORT(DecimateRow);
 HWY_EXPORT(DarkRow);
@@ -155,7 +180,11 @@ bool darkRow(const std::uint8_t *d, const std::uint8_t *mid, int w, std::uint8_t
 #else
 void decimateRow(const std::uint8_t *r0, const std::uint8_t *r1, int w, std::uint8_t *out)
 {
+#ifdef FRAPPE_HAVE_ARMV6_REGION
+	decimateRowV6(r0, r1, w, out);
+#else
 	decimateRowScalar(r0, r1, w, out);
+#endif
 }
 
 void extremePairs(const std::uint8_t *a0, const std::uint8_t *a1, int w, std::uint8_t *out, bool least)
@@ -191,6 +220,14 @@ void regionMap(const ImageView &src, float srcScale, int minContrast, TraceMap &
 	for (int y = 0; y < h; ++y)
 		decimateRow(src.row(2 * y), src.row(2 * y + 1), w, dec + static_cast<std::size_t>(y) * w);
 
+#ifdef FRAPPE_HAVE_ARMV6_REGION
+	/* Each tile's darkest and brightest in one pass over its rows: a
+	 * tile's row is one word. */
+	for (int j = 0; j < ty; ++j)
+		tileExtremesV6(dec + static_cast<std::size_t>(T * j) * w, w, std::min(T, h - T * j), w,
+			       s.tileMin.data() + static_cast<std::size_t>(j) * tx,
+			       s.tileMax.data() + static_cast<std::size_t>(j) * tx);
+#else
 	/* Each tile's darkest and brightest, by two halvings of the
 	 * decimated image: extremes of 2 x 2 pixels, then of 2 x 2 of those.
 	 * A row or column left over at the bottom or right (odd sizes) is
@@ -225,6 +262,7 @@ void regionMap(const ImageView &src, float srcScale, int minContrast, TraceMap &
 		extremePairs(l1min, l1min2, tx, s.tileMin.data() + static_cast<std::size_t>(j) * tx, true);
 		extremePairs(l1max, l1max2, tx, s.tileMax.data() + static_cast<std::size_t>(j) * tx, false);
 	}
+#endif
 	/* Then over the 3 x 3 tiles around each: across, through a copy with
 	 * the end tiles repeated, then down, keeping the row above aside. */
 	std::uint8_t *__restrict a = s.lo.data(), *__restrict b = s.hi.data();
@@ -266,9 +304,11 @@ void regionMap(const ImageView &src, float srcScale, int minContrast, TraceMap &
 	std::fill_n(out.pixels.data() + static_cast<std::size_t>(h - 1) * w, w, 0);
 	constexpr int ET = TraceMap::kTile;
 	std::uint8_t *mid = s.mid.data();
+#ifndef FRAPPE_HAVE_ARMV6_REGION
 	std::uint8_t *acc = s.lo.data(); /* the OR of a tile row's dark rows */
 	bool accAny = false;
 	std::fill_n(acc, w, 0);
+#endif
 	for (int j = 0; j < ty; ++j) {
 		/* The threshold of each tile of this row: the midpoint, rounded
 		 * up, of the extremes around it, or 0 (no pixel is dark) where
@@ -284,6 +324,11 @@ void regionMap(const ImageView &src, float srcScale, int minContrast, TraceMap &
 		mid[0] = mid[w - 1] = 0; /* the outermost columns are never dark */
 		for (int y = std::max(1, j * T); y < std::min(h - 1, (j + 1) * T); ++y) {
 			std::uint8_t *o = out.pixels.data() + static_cast<std::size_t>(y) * w;
+#ifdef FRAPPE_HAVE_ARMV6_REGION
+			/* Each row marks its tiles itself: no row of ORs. */
+			darkRowV6(dec + static_cast<std::size_t>(y) * w, mid, w, o,
+				  out.tiles.data() + static_cast<std::size_t>(y / ET) * out.tiles_x);
+#else
 			if (darkRow(dec + static_cast<std::size_t>(y) * w, mid, w, o)) {
 				for (int x = 0; x < w; ++x)
 					acc[x] |= o[x];
@@ -300,6 +345,7 @@ void regionMap(const ImageView &src, float srcScale, int minContrast, TraceMap &
 				std::fill_n(acc, w, 0);
 				accAny = false;
 			}
+#endif
 		}
 	}
 }

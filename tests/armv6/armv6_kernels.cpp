@@ -20,11 +20,12 @@
 
 #include "frappe/edge_map.h"
 #include "front_end_rows.h"
+#include "region_map.h"
 
 using namespace frappe;
 using namespace frappe::detail;
 
-#ifndef FRAPPE_HAVE_ARMV6_KERNELS
+#if !defined(FRAPPE_HAVE_ARMV6_KERNELS) || !defined(FRAPPE_HAVE_ARMV6_REGION)
 int main()
 {
 	std::puts("armv6-kernels: not an ARMv6 SIMD32 build; skipped");
@@ -190,6 +191,115 @@ std::size_t compareFrontEnds(const Gray &g, const FrontEndParams &params, float 
 	return edges;
 }
 
+/* The region map's row kernels on rows of width w: inputs and outputs at
+ * unaligned offsets, guard bytes after every output. */
+void checkRegionRows(int w, int kind, int misalign)
+{
+	const int W = 2 * w + 8;
+	std::vector<std::uint8_t> buf(2 * W + 8);
+	std::uint8_t *r0 = buf.data() + misalign, *r1 = r0 + W;
+	fillRow(r0, 2 * w + 4, kind);
+	fillRow(r1, 2 * w + 4, kind);
+	std::vector<std::uint8_t> o1(w + 8, 0xAB), o2(w + 9, 0xAB);
+	decimateRowScalar(r0, r1, w, o1.data());
+	decimateRowV6(r0, r1, w, o2.data() + 1);
+	for (int x = 0; x < w + 7; ++x)
+		CHECK(o1[x] == o2[x + 1], "decimateRow w=%d kind=%d mis=%d x=%d: %d vs %d", w, kind, misalign, x, o1[x],
+		      o2[x + 1]);
+
+	/* Tile extremes of 1..4 rows, stride W. */
+	const int tx = (w + 3) / 4;
+	for (int n = 1; n <= 4; ++n) {
+		std::vector<std::uint8_t> rows(static_cast<std::size_t>(4) * W + 8);
+		for (int y = 0; y < 4; ++y)
+			fillRow(rows.data() + misalign + y * W, w, kind);
+		std::vector<std::uint8_t> mn1(tx + 4, 0xAB), mx1(tx + 4, 0xAB), mn2(tx + 4, 0xAB), mx2(tx + 4, 0xAB);
+		tileExtremesScalar(rows.data() + misalign, W, n, w, mn1.data(), mx1.data());
+		tileExtremesV6(rows.data() + misalign, W, n, w, mn2.data(), mx2.data());
+		CHECK(mn1 == mn2 && mx1 == mx2, "tileExtremes w=%d n=%d kind=%d mis=%d", w, n, kind, misalign);
+	}
+
+	/* The dark test, with thresholds per pixel (the map's are per tile)
+	 * and tiles already marked or not. */
+	const int ntiles = (w + 15) / 16;
+	std::vector<std::uint8_t> d(w + 8), mid(w + 8);
+	std::uint8_t *pmid = mid.data() + (3 - misalign);
+	fillRow(d.data() + misalign, w, kind);
+	fillRow(pmid, w, (kind + 1) % 3);
+	std::vector<std::uint8_t> tiles1(ntiles + 2), tiles2;
+	for (auto &t : tiles1)
+		t = static_cast<std::uint8_t>(rng() % 4 == 0);
+	tiles2 = tiles1;
+	std::vector<std::uint8_t> dk1(w + 8, 0xAB), dk2(w + 8, 0xAB);
+	darkRowTilesScalar(d.data() + misalign, pmid, w, dk1.data() + misalign, tiles1.data());
+	darkRowV6(d.data() + misalign, pmid, w, dk2.data() + misalign, tiles2.data());
+	CHECK(dk1 == dk2 && tiles1 == tiles2, "darkRow w=%d kind=%d mis=%d", w, kind, misalign);
+}
+
+/* The documented rule of the region map, pixel by pixel. */
+std::vector<std::uint8_t> slowRegionMap(const Gray &g, int minContrast, int &w, int &h)
+{
+	w = g.w / 2;
+	h = g.h / 2;
+	std::vector<int> r(static_cast<std::size_t>(w) * h);
+	for (int y = 0; y < h; ++y)
+		for (int x = 0; x < w; ++x) {
+			auto p = [&](int xx, int yy) { return static_cast<int>(g.px[static_cast<std::size_t>(yy) * g.w + xx]); };
+			r[static_cast<std::size_t>(y) * w + x] =
+				(p(2 * x, 2 * y) + p(2 * x + 1, 2 * y) + p(2 * x, 2 * y + 1) + p(2 * x + 1, 2 * y + 1) + 2) >> 2;
+		}
+	const int tx = (w + 3) / 4, ty = (h + 3) / 4;
+	std::vector<std::uint8_t> out(static_cast<std::size_t>(w) * h, 0);
+	for (int y = 1; y < h - 1; ++y)
+		for (int x = 1; x < w - 1; ++x) {
+			int lo = 255, hi = 0;
+			for (int j = std::max(0, y / 4 - 1); j <= std::min(ty - 1, y / 4 + 1); ++j)
+				for (int i = std::max(0, x / 4 - 1); i <= std::min(tx - 1, x / 4 + 1); ++i)
+					for (int yy = 4 * j; yy < std::min(h, 4 * j + 4); ++yy)
+						for (int xx = 4 * i; xx < std::min(w, 4 * i + 4); ++xx) {
+							lo = std::min(lo, r[static_cast<std::size_t>(yy) * w + xx]);
+							hi = std::max(hi, r[static_cast<std::size_t>(yy) * w + xx]);
+						}
+			out[static_cast<std::size_t>(y) * w + x] =
+				hi - lo >= minContrast && r[static_cast<std::size_t>(y) * w + x] < ((lo + hi + 1) >> 1);
+		}
+	return out;
+}
+
+/* The whole region map (this build's: the ARMv6 kernels) against the rule,
+ * pixels and tile mask; the number of dark pixels. */
+std::size_t compareRegionMap(const Gray &g, int contrast, const char *what)
+{
+	int w, h;
+	const auto want = slowRegionMap(g, contrast, w, h);
+	TraceMap map;
+	RegionScratch scratch;
+	regionMap(ImageView(g.px.data(), g.w, g.h, g.w), 1.0f, contrast, map, scratch);
+	if (w < 3 || h < 3) {
+		CHECK(map.width == 0, "%s: a map of a frame too small", what);
+		return 0;
+	}
+	CHECK(map.width == w && map.height == h, "%s: region map size", what);
+	if (map.width != w || map.height != h)
+		return 0;
+	std::size_t dark = 0, diff = 0;
+	for (std::size_t i = 0; i < want.size(); ++i) {
+		dark += want[i];
+		if (map.pixels[i] != want[i] && diff++ < 3)
+			CHECK(false, "%s: region pixel (%zu, %zu): %d vs %d", what, i % w, i / w, map.pixels[i], want[i]);
+	}
+	CHECK(diff == 0, "%s: %zu region pixels differ", what, diff);
+	for (int ty = 0; ty < map.tiles_y; ++ty)
+		for (int tx = 0; tx < map.tiles_x; ++tx) {
+			bool any = false;
+			for (int y = ty * 16; y < std::min(h, ty * 16 + 16); ++y)
+				for (int x = tx * 16; x < std::min(w, tx * 16 + 16); ++x)
+					any = any || want[static_cast<std::size_t>(y) * w + x];
+			CHECK(!map.tileEmpty(tx, ty) == any, "%s: region tile %d,%d", what, tx, ty);
+		}
+	return dark;
+}
+
 } // namespace
 
 int main(int argc, char **argv)
@@ -241,7 +351,31 @@ int main(int argc, char **argv)
 	}
 	std::printf("front end: %d constructed images\n", imageCases);
 
-	std::size_t files = 0, edges = 0;
+	int regionRows = 0;
+	for (int w = 1; w <= 70; ++w)
+		for (int kind = 0; kind < 3; ++kind)
+			for (int mis = 0; mis < 4; ++mis, ++regionRows)
+				checkRegionRows(w, kind, mis);
+	for (int w : { 127, 128, 129, 319, 320, 321, 641 })
+		for (int rep = 0; rep < (quick ? 3 : 12); ++rep, ++regionRows)
+			checkRegionRows(w, rep % 3, rep % 4);
+	std::printf("region rows: %d random cases\n", regionRows);
+	int regionCases = 0;
+	for (const auto &[w, h] : { std::pair{ 640, 480 }, std::pair{ 37, 23 }, std::pair{ 6, 6 }, std::pair{ 7, 5 },
+				   std::pair{ 5, 100 }, std::pair{ 101, 67 }, std::pair{ 250, 9 }, std::pair{ 161, 97 } }) {
+		for (int noise : { 0, 12 }) {
+			const Gray g = constructed(w, h, noise, static_cast<unsigned>(w * 17 + h * 3 + noise));
+			for (int contrast : { 1, 40, 200, 256 }) {
+				char what[96];
+				std::snprintf(what, sizeof what, "region map %dx%d noise %d contrast %d", w, h, noise, contrast);
+				compareRegionMap(g, contrast, what);
+				++regionCases;
+			}
+		}
+	}
+	std::printf("region map: %d constructed images\n", regionCases);
+
+	std::size_t files = 0, edges = 0, dark = 0;
 	for (int i = first; i < argc; ++i) {
 		Gray g;
 		if (!readPgm(argv[i], g)) {
@@ -249,11 +383,12 @@ int main(int argc, char **argv)
 			continue;
 		}
 		edges += compareFrontEnds(g, params[0], 1.0f, argv[i]);
+		dark += compareRegionMap(g, 41, argv[i]); /* Config's default 0.16, as an intensity */
 		++files;
 	}
 	if (files)
-		std::printf("front end: %zu images, %zu edge pixels\n", files, edges);
-	std::printf("%s\n", failures ? "FAILED" : "ok: the ARMv6 kernels equal the scalar ones");
+		std::printf("front end: %zu images, %zu edge pixels, %zu dark region pixels\n", files, edges, dark);
+	std::printf("%s\n", failures ? "FAILED" : "ok: the ARMv6 kernels equal the scalar ones, the region map its rule");
 	return failures ? 1 : 0;
 }
 
