@@ -104,7 +104,7 @@ def stage_of(obj, name):
         return "region_map"
     if base == "adaptive_scale":
         return "adaptive_scale"
-    if base in ("contour_trace", "trace_kernels"):
+    if base == "contour_trace" or base.startswith("trace_kernels"):
         return "trace"
     if base == "corner_refine":
         return "refine"
@@ -115,7 +115,7 @@ def stage_of(obj, name):
         if "warpMarker" in name:
             return "warp"
         return "decode"
-    if base in ("homography", "warp_kernels"):
+    if base == "homography" or base.startswith("warp_kernels"):
         return "warp"
     if base in ("dictionary", "dictionaries"):
         return "decode"

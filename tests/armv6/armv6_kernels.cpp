@@ -21,11 +21,12 @@
 #include "frappe/edge_map.h"
 #include "front_end_rows.h"
 #include "region_map.h"
+#include "trace_kernels.h"
 
 using namespace frappe;
 using namespace frappe::detail;
 
-#if !defined(FRAPPE_HAVE_ARMV6_KERNELS) || !defined(FRAPPE_HAVE_ARMV6_REGION)
+#if !defined(FRAPPE_HAVE_ARMV6_KERNELS) || !defined(FRAPPE_HAVE_ARMV6_REGION) || !defined(FRAPPE_HAVE_ARMV6_TRACE)
 int main()
 {
 	std::puts("armv6-kernels: not an ARMv6 SIMD32 build; skipped");
@@ -236,6 +237,53 @@ void checkRegionRows(int w, int kind, int misalign)
 	CHECK(dk1 == dk2 && tiles1 == tiles2, "darkRow w=%d kind=%d mis=%d", w, kind, misalign);
 }
 
+/* n points (x | y << 16): a closed-ish 8-connected walk (a border), or
+ * scattered points, or points at the extremes of the coordinate range. */
+std::vector<std::uint32_t> randomPoints(std::size_t n, int kind)
+{
+	std::vector<std::uint32_t> pts(n + kPointsPadding);
+	std::uniform_int_distribution<int> u(0, 32767), step(-1, 1);
+	int x = u(rng), y = u(rng);
+	for (std::size_t i = 0; i < n; ++i) {
+		if (kind == 0) {
+			x = std::clamp(x + step(rng), 0, 32767);
+			y = std::clamp(y + step(rng), 0, 32767);
+		} else if (kind == 1) {
+			x = u(rng);
+			y = u(rng);
+		} else {
+			x = (rng() & 1) ? 32767 : 0;
+			y = (rng() & 1) ? 32767 : 0;
+		}
+		pts[i] = static_cast<std::uint32_t>(x) | static_cast<std::uint32_t>(y) << 16;
+	}
+	return pts;
+}
+
+void checkTraceKernels(std::size_t n, int kind)
+{
+	const auto pts = randomPoints(n, kind);
+	const OutlineExtremes a = outlineExtremesScalar(pts.data(), n), b = outlineExtremesV6(pts.data(), n);
+	CHECK(a.i0 == b.i0 && a.i1 == b.i1 && a.i2 == b.i2 && a.i3 == b.i3 && a.most == b.most && a.least == b.least,
+	      "outlineExtremes n=%zu kind=%d: (%zu %zu %zu %zu %ld %ld) vs (%zu %zu %zu %zu %ld %ld)", n, kind, a.i0,
+	      a.i1, a.i2, a.i3, static_cast<long>(a.most), static_cast<long>(a.least), b.i0, b.i1, b.i2, b.i3,
+	      static_cast<long>(b.most), static_cast<long>(b.least));
+	const PointsBox p = pointsBoxScalar(pts.data(), n), q = pointsBoxV6(pts.data(), n);
+	CHECK(p.minX == q.minX && p.maxX == q.maxX && p.minY == q.minY && p.maxY == q.maxY, "pointsBox n=%zu kind=%d",
+	      n, kind);
+}
+
+/* Label rows: word-aligned buffers (as the tracer's), or not. */
+void checkLabels(std::size_t n, int misalign)
+{
+	std::vector<std::uint8_t> edges(n + 8), l1(n + 8, 0xAB), l2(n + 8, 0xAB);
+	for (auto &e : edges)
+		e = static_cast<std::uint8_t>(rng() % 4 == 0 ? rng() & 3 : 0);
+	labelsFromEdgesScalar(edges.data() + misalign, n, l1.data() + misalign);
+	labelsFromEdgesV6(edges.data() + misalign, n, l2.data() + misalign);
+	CHECK(l1 == l2, "labelsFromEdges n=%zu misalign=%d", n, misalign);
+}
+
 /* The documented rule of the region map, pixel by pixel. */
 std::vector<std::uint8_t> slowRegionMap(const Gray &g, int minContrast, int &w, int &h)
 {
@@ -374,6 +422,18 @@ int main(int argc, char **argv)
 		}
 	}
 	std::printf("region map: %d constructed images\n", regionCases);
+
+	int traceCases = 0;
+	for (std::size_t n = 1; n <= 80; ++n)
+		for (int kind = 0; kind < 3; ++kind, ++traceCases)
+			checkTraceKernels(n, kind);
+	for (std::size_t n : { 255, 256, 1000, 4099, 32767, 32768, 40000 })
+		for (int kind = 0; kind < 3; ++kind, ++traceCases)
+			checkTraceKernels(n, kind);
+	for (std::size_t n : { 0, 1, 31, 32, 33, 63, 64, 100, 1000, 307200 })
+		for (int mis = 0; mis < 4; ++mis, ++traceCases)
+			checkLabels(n, mis);
+	std::printf("trace kernels: %d random cases\n", traceCases);
 
 	std::size_t files = 0, edges = 0, dark = 0;
 	for (int i = first; i < argc; ++i) {

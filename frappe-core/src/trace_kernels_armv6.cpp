@@ -1,0 +1,157 @@
+// SPDX-License-Identifier: MIT
+// The contour tracer's kernels for ARMv6 with the SIMD32 instructions (the
+// Pi Zero's ARM1176), beside their scalar references in trace_kernels.cpp;
+// tests/armv6 checks them against each other.
+//
+// A border point is (x | y << 16) with x, y < 2^15: two 16-bit lanes, so a
+// point minus a point is one SSUB16 (exact: the differences fit an int16),
+// dx^2 + dy^2 one SMUAD and a cross product one SMUSDX; the least and
+// greatest of both coordinates are USUB16 + SEL.
+#include "trace_kernels.h"
+
+#ifdef FRAPPE_HAVE_ARMV6_TRACE
+
+#include <arm_acle.h>
+
+#include <cstring>
+
+namespace frappe::detail {
+
+namespace {
+
+using u32 = std::uint32_t;
+
+inline u32 ssub16(u32 a, u32 b)
+{
+	return static_cast<u32>(__ssub16(static_cast<int16x2_t>(a), static_cast<int16x2_t>(b)));
+}
+
+/* Lane-wise least and greatest of unsigned 16-bit lanes. */
+inline u32 min16(u32 a, u32 b)
+{
+	u32 t, r;
+	__asm__("usub16 %[t], %[a], %[b]\n\tsel %[r], %[b], %[a]" : [t] "=&r"(t), [r] "=&r"(r) : [a] "r"(a), [b] "r"(b) : "cc");
+	return r;
+}
+
+inline u32 max16(u32 a, u32 b)
+{
+	u32 t, r;
+	__asm__("usub16 %[t], %[a], %[b]\n\tsel %[r], %[a], %[b]" : [t] "=&r"(t), [r] "=&r"(r) : [a] "r"(a), [b] "r"(b) : "cc");
+	return r;
+}
+
+} // namespace
+
+/* Eight words a step by LDM / STM (both buffers are vectors' data, word
+ * aligned): 19 instructions per 32 bytes where the compiler's word loop
+ * takes 40. r4-r11 are named: no frame pointer, also at -O0. */
+__attribute__((optimize("omit-frame-pointer"))) void labelsFromEdgesV6(const std::uint8_t *edges, std::size_t n,
+								       std::uint8_t *labels)
+{
+	std::size_t i = 0;
+	if (((reinterpret_cast<std::uintptr_t>(edges) | reinterpret_cast<std::uintptr_t>(labels)) & 3) == 0 && n >= 32) {
+		const std::uint8_t *src = edges;
+		std::uint8_t *dst = labels;
+		const std::uint8_t *const end = edges + (n & ~std::size_t{ 31 });
+		const u32 mask = 0x01010101u * kUnfollowed;
+		__asm__ volatile("1:\n\t"
+				 "ldmia   %[src]!, {r4, r5, r6, r7, r8, r9, r10, r11}\n\t"
+				 "and     r4, r4, %[m]\n\t"
+				 "and     r5, r5, %[m]\n\t"
+				 "and     r6, r6, %[m]\n\t"
+				 "and     r7, r7, %[m]\n\t"
+				 "and     r8, r8, %[m]\n\t"
+				 "and     r9, r9, %[m]\n\t"
+				 "and     r10, r10, %[m]\n\t"
+				 "and     r11, r11, %[m]\n\t"
+				 "stmia   %[dst]!, {r4, r5, r6, r7, r8, r9, r10, r11}\n\t"
+				 "cmp     %[src], %[end]\n\t"
+				 "bne     1b"
+				 : [src] "+r"(src), [dst] "+r"(dst)
+				 : [end] "r"(end), [m] "r"(mask)
+				 : "r4", "r5", "r6", "r7", "r8", "r9", "r10", "r11", "cc", "memory");
+		i = n & ~std::size_t{ 31 };
+	}
+	for (; i < n; ++i)
+		labels[i] = edges[i] & kUnfollowed;
+}
+
+OutlineExtremes outlineExtremesV6(const std::uint32_t *pts, std::size_t n)
+{
+	/* Below 2^15 points the sums fit an int32: the same sums, so the same
+	 * centroid, as the scalar form's int64 ones. */
+	if (n >= (std::size_t{ 1 } << 15))
+		return outlineExtremesScalar(pts, n);
+	std::int32_t sx = 0, sy = 0;
+	for (std::size_t i = 0; i < n; ++i) {
+		sx += static_cast<std::int32_t>(pts[i] & 0xFFFFu);
+		sy += static_cast<std::int32_t>(pts[i] >> 16);
+	}
+	/* The farthest point from the centroid: the scalar form's double
+	 * arithmetic, as it is (its result depends on the rounding). */
+	const double mx = static_cast<double>(sx) / static_cast<double>(n);
+	const double my = static_cast<double>(sy) / static_cast<double>(n);
+	OutlineExtremes e;
+	double bd = -1;
+	for (std::size_t i = 0; i < n; ++i) {
+		const double dx = static_cast<std::int32_t>(pts[i] & 0xFFFFu) - mx;
+		const double dy = static_cast<std::int32_t>(pts[i] >> 16) - my;
+		if (dx * dx + dy * dy > bd) {
+			bd = dx * dx + dy * dy;
+			e.i0 = i;
+		}
+	}
+	/* The rest on both lanes at once: d = p - p0, |d|^2 = SMUAD(d, d),
+	 * cross(p0, p2, p) = ex dy - ey dx = SMUSDX(e, d). */
+	const u32 p0 = pts[e.i0];
+	std::int32_t bd2 = -1;
+	std::size_t i2 = 0;
+	for (std::size_t i = 0; i < n; ++i) {
+		const u32 d = ssub16(pts[i], p0);
+		const std::int32_t d2 = __smuad(static_cast<int16x2_t>(d), static_cast<int16x2_t>(d));
+		if (d2 > bd2) {
+			bd2 = d2;
+			i2 = i;
+		}
+	}
+	e.i2 = i2;
+	const u32 ed = ssub16(pts[i2], p0);
+	std::int32_t most = 0, least = 0;
+	std::size_t i1 = 0, i3 = 0;
+	for (std::size_t i = 0; i < n; ++i) {
+		const std::int32_t c = __smusdx(static_cast<int16x2_t>(ed), static_cast<int16x2_t>(ssub16(pts[i], p0)));
+		if (c > most) {
+			most = c;
+			i1 = i;
+		} else if (c < least) {
+			least = c;
+			i3 = i;
+		}
+	}
+	e.i1 = i1;
+	e.i3 = i3;
+	e.most = most;
+	e.least = least;
+	return e;
+}
+
+PointsBox pointsBoxV6(const std::uint32_t *pts, std::size_t n)
+{
+	u32 lo = pts[0], hi = lo;
+	std::size_t i = 0;
+	for (; i + 2 <= n; i += 2) {
+		const u32 a = pts[i], b = pts[i + 1];
+		lo = min16(min16(lo, a), b);
+		hi = max16(max16(hi, a), b);
+	}
+	if (i < n) {
+		lo = min16(lo, pts[i]);
+		hi = max16(hi, pts[i]);
+	}
+	return { lo & 0xFFFFu, hi & 0xFFFFu, lo >> 16, hi >> 16 };
+}
+
+} // namespace frappe::detail
+
+#endif
