@@ -144,6 +144,45 @@ void tileExtremesScalar(const std::uint8_t *rows, std::ptrdiff_t stride, int n, 
 	}
 }
 
+void spreadTilesScalar(std::uint8_t *tileMin, std::uint8_t *tileMax, int tx, int ty, std::uint8_t *work)
+{
+	/* Across, through a copy with the end tiles repeated, then down,
+	 * keeping the row above aside. */
+	std::uint8_t *__restrict a = work, *__restrict b = work + tx + 2;
+	for (int j = 0; j < ty; ++j) {
+		std::uint8_t *__restrict tmin = tileMin + static_cast<std::size_t>(j) * tx;
+		std::uint8_t *__restrict tmax = tileMax + static_cast<std::size_t>(j) * tx;
+		std::memcpy(a + 1, tmin, tx);
+		std::memcpy(b + 1, tmax, tx);
+		a[0] = a[1];
+		a[tx + 1] = a[tx];
+		b[0] = b[1];
+		b[tx + 1] = b[tx];
+		for (int i = 0; i < tx; ++i) {
+			tmin[i] = std::min(std::min(a[i], a[i + 1]), a[i + 2]);
+			tmax[i] = std::max(std::max(b[i], b[i + 1]), b[i + 2]);
+		}
+	}
+	std::uint8_t *__restrict upMin = b + tx + 2, *__restrict upMax = upMin + tx;
+	for (int j = 0; j < ty; ++j) {
+		std::uint8_t *__restrict tmin = tileMin + static_cast<std::size_t>(j) * tx;
+		std::uint8_t *__restrict tmax = tileMax + static_cast<std::size_t>(j) * tx;
+		const std::uint8_t *__restrict dnMin = j + 1 < ty ? tmin + tx : tmin;
+		const std::uint8_t *__restrict dnMax = j + 1 < ty ? tmax + tx : tmax;
+		if (j == 0) {
+			std::memcpy(upMin, tmin, tx);
+			std::memcpy(upMax, tmax, tx);
+		}
+		for (int i = 0; i < tx; ++i) {
+			const std::uint8_t m = tmin[i], n = tmax[i];
+			tmin[i] = std::min(std::min(upMin[i], m), dnMin[i]);
+			tmax[i] = std::max(std::max(upMax[i], n), dnMax[i]);
+			upMin[i] = m;
+			upMax[i] = n;
+		}
+	}
+}
+
 bool darkRowTilesScalar(const std::uint8_t *d, const std::uint8_t *mid, int w, std::uint8_t *out,
 			std::uint8_t *tiles)
 {
@@ -213,8 +252,7 @@ void regionMap(const ImageView &src, float srcScale, int minContrast, TraceMap &
 	s.decimated.resize(static_cast<std::size_t>(w) * h);
 	s.tileMin.resize(nt);
 	s.tileMax.resize(nt);
-	s.lo.resize(std::max(w, tx + 2));
-	s.hi.resize(std::max(w, tx + 2));
+	s.lo.resize(w);
 	s.mid.resize(std::max(tx * T, 2 * tx));
 	std::uint8_t *dec = s.decimated.data();
 	for (int y = 0; y < h; ++y)
@@ -263,41 +301,13 @@ void regionMap(const ImageView &src, float srcScale, int minContrast, TraceMap &
 		extremePairs(l1max, l1max2, tx, s.tileMax.data() + static_cast<std::size_t>(j) * tx, false);
 	}
 #endif
-	/* Then over the 3 x 3 tiles around each: across, through a copy with
-	 * the end tiles repeated, then down, keeping the row above aside. */
-	std::uint8_t *__restrict a = s.lo.data(), *__restrict b = s.hi.data();
-	for (int j = 0; j < ty; ++j) {
-		std::uint8_t *__restrict tmin = s.tileMin.data() + static_cast<std::size_t>(j) * tx;
-		std::uint8_t *__restrict tmax = s.tileMax.data() + static_cast<std::size_t>(j) * tx;
-		std::memcpy(a + 1, tmin, tx);
-		std::memcpy(b + 1, tmax, tx);
-		a[0] = a[1];
-		a[tx + 1] = a[tx];
-		b[0] = b[1];
-		b[tx + 1] = b[tx];
-		for (int i = 0; i < tx; ++i) {
-			tmin[i] = std::min(std::min(a[i], a[i + 1]), a[i + 2]);
-			tmax[i] = std::max(std::max(b[i], b[i + 1]), b[i + 2]);
-		}
-	}
-	std::uint8_t *__restrict upMin = s.mid.data(), *__restrict upMax = s.mid.data() + tx;
-	for (int j = 0; j < ty; ++j) {
-		std::uint8_t *__restrict tmin = s.tileMin.data() + static_cast<std::size_t>(j) * tx;
-		std::uint8_t *__restrict tmax = s.tileMax.data() + static_cast<std::size_t>(j) * tx;
-		const std::uint8_t *__restrict dnMin = j + 1 < ty ? tmin + tx : tmin;
-		const std::uint8_t *__restrict dnMax = j + 1 < ty ? tmax + tx : tmax;
-		if (j == 0) {
-			std::memcpy(upMin, tmin, tx);
-			std::memcpy(upMax, tmax, tx);
-		}
-		for (int i = 0; i < tx; ++i) {
-			const std::uint8_t m = tmin[i], n = tmax[i];
-			tmin[i] = std::min(std::min(upMin[i], m), dnMin[i]);
-			tmax[i] = std::max(std::max(upMax[i], n), dnMax[i]);
-			upMin[i] = m;
-			upMax[i] = n;
-		}
-	}
+	/* Then over the 3 x 3 tiles around each. */
+	s.spread.resize(4 * static_cast<std::size_t>(tx) + 4);
+#ifdef FRAPPE_HAVE_ARMV6_REGION
+	spreadTilesV6(s.tileMin.data(), s.tileMax.data(), tx, ty, s.spread.data());
+#else
+	spreadTilesScalar(s.tileMin.data(), s.tileMax.data(), tx, ty, s.spread.data());
+#endif
 
 	std::fill(out.tiles.begin(), out.tiles.end(), 0);
 	std::fill_n(out.pixels.data(), w, 0);

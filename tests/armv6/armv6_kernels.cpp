@@ -237,6 +237,20 @@ void checkRegionRows(int w, int kind, int misalign)
 	CHECK(dk1 == dk2 && tiles1 == tiles2, "darkRow w=%d kind=%d mis=%d", w, kind, misalign);
 }
 
+/* The 3 x 3 spread of tx x ty tiles' extremes. */
+void checkSpread(int tx, int ty, int kind)
+{
+	const std::size_t n = static_cast<std::size_t>(tx) * ty;
+	std::vector<std::uint8_t> mn(n), mx(n);
+	fillRow(mn.data(), static_cast<int>(n), kind);
+	fillRow(mx.data(), static_cast<int>(n), (kind + 1) % 3);
+	auto mn2 = mn, mx2 = mx;
+	std::vector<std::uint8_t> w1(4 * static_cast<std::size_t>(tx) + 4), w2(w1.size());
+	spreadTilesScalar(mn.data(), mx.data(), tx, ty, w1.data());
+	spreadTilesV6(mn2.data(), mx2.data(), tx, ty, w2.data());
+	CHECK(mn == mn2 && mx == mx2, "spreadTiles %dx%d kind=%d", tx, ty, kind);
+}
+
 /* n points (x | y << 16): a closed-ish 8-connected walk (a border), or
  * scattered points, or points at the extremes of the coordinate range. */
 std::vector<std::uint32_t> randomPoints(std::size_t n, int kind)
@@ -407,7 +421,13 @@ int main(int argc, char **argv)
 	for (int w : { 127, 128, 129, 319, 320, 321, 641 })
 		for (int rep = 0; rep < (quick ? 3 : 12); ++rep, ++regionRows)
 			checkRegionRows(w, rep % 3, rep % 4);
-	std::printf("region rows: %d random cases\n", regionRows);
+	for (int tx = 1; tx <= 13; ++tx)
+		for (int ty = 1; ty <= 6; ++ty)
+			for (int kind = 0; kind < 3; ++kind, ++regionRows)
+				checkSpread(tx, ty, kind);
+	for (int kind = 0; kind < 3; ++kind, ++regionRows)
+		checkSpread(80, 60, kind);
+	std::printf("region rows and tile spreads: %d random cases\n", regionRows);
 	int regionCases = 0;
 	for (const auto &[w, h] : { std::pair{ 640, 480 }, std::pair{ 37, 23 }, std::pair{ 6, 6 }, std::pair{ 7, 5 },
 				   std::pair{ 5, 100 }, std::pair{ 101, 67 }, std::pair{ 250, 9 }, std::pair{ 161, 97 } }) {
