@@ -66,6 +66,10 @@ public:
 	/// Borders followed in the last call, for statistics.
 	int bordersFollowed() const { return borders_; }
 
+	/// Walks borders with the portable C++ loop even where an assembly
+	/// one exists (ARMv6): for the tests that compare the two.
+	void usePortableWalk(bool on) { portableWalk_ = on; }
+
 private:
 	struct Cluster {
 		std::int64_t sx, sy; ///< sums of member coordinates
@@ -121,6 +125,7 @@ private:
 	bool tooManyClusters_ = false;
 	int borders_ = 0;
 	int stride_ = 0;
+	bool portableWalk_ = false;
 	std::int64_t radius2Floor_ = 16; ///< floor(cluster_radius^2)
 };
 

@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "contour_trace.h"
 #include "frappe/edge_map.h"
 #include "front_end_rows.h"
 #include "region_map.h"
@@ -171,6 +172,44 @@ bool readPgm(const char *path, Gray &g)
 	return ok;
 }
 
+/* Calls every other accepted quad a marker, so that sealing runs too. */
+class EveryOtherProbe : public MarkerProbe
+{
+public:
+	bool isMarker(Quad &) override { return (n_++ & 1) != 0; }
+
+private:
+	int n_ = 0;
+};
+
+/* The tracer with the ARMv6 walk and with the portable one: the same
+ * quads, bit for bit, and as many borders; as an edge map and as a region
+ * map is traced, each with and without a probe. */
+void compareTracers(const TraceMap &map, const char *what)
+{
+	if (map.width < 3 || map.height < 3)
+		return;
+	for (int kind = 0; kind < 4; ++kind) {
+		TraceParams params;
+		if (kind & 1) {
+			params.min_clusters = 0;
+			params.max_winding = 2.0f;
+			params.min_side = 4.0f;
+		}
+		ContourTracer asmWalk, portable;
+		portable.usePortableWalk(true);
+		EveryOtherProbe probe1, probe2;
+		std::vector<Quad> q1, q2;
+		asmWalk.trace(map, params, q1, (kind & 2) ? &probe1 : nullptr);
+		portable.trace(map, params, q2, (kind & 2) ? &probe2 : nullptr);
+		bool same = q1.size() == q2.size() && asmWalk.bordersFollowed() == portable.bordersFollowed();
+		for (std::size_t i = 0; same && i < q1.size(); ++i)
+			same = std::memcmp(q1[i].corners.data(), q2[i].corners.data(), sizeof(q1[i].corners)) == 0;
+		CHECK(same, "%s: tracer kind %d: %zu quads, %d borders vs %zu, %d", what, kind, q1.size(),
+		      asmWalk.bordersFollowed(), q2.size(), portable.bordersFollowed());
+	}
+}
+
 std::size_t compareFrontEnds(const Gray &g, const FrontEndParams &params, float scale, const char *what)
 {
 	auto ref = makeCpuFrontEnd(1, scalarRowKernels());
@@ -189,6 +228,7 @@ std::size_t compareFrontEnds(const Gray &g, const FrontEndParams &params, float 
 	}
 	CHECK(diff == 0, "%s: %zu pixels differ", what, diff);
 	CHECK(e1.tiles == e2.tiles, "%s: tile masks differ", what);
+	compareTracers(e2, what);
 	return edges;
 }
 
@@ -351,6 +391,7 @@ std::size_t compareRegionMap(const Gray &g, int contrast, const char *what)
 			CHECK(false, "%s: region pixel (%zu, %zu): %d vs %d", what, i % w, i / w, map.pixels[i], want[i]);
 	}
 	CHECK(diff == 0, "%s: %zu region pixels differ", what, diff);
+	compareTracers(map, what);
 	for (int ty = 0; ty < map.tiles_y; ++ty)
 		for (int tx = 0; tx < map.tiles_x; ++tx) {
 			bool any = false;
@@ -442,6 +483,18 @@ int main(int argc, char **argv)
 		}
 	}
 	std::printf("region map: %d constructed images\n", regionCases);
+	{
+		TraceMap ring;
+		ring.resize(640, 480);
+		std::fill(ring.pixels.begin(), ring.pixels.end(), 0);
+		for (int y = 20; y < 460; ++y)
+			for (int x = 20; x < 620; ++x)
+				if (y < 22 || y >= 458 || x < 22 || x >= 618)
+					ring.pixels[static_cast<std::size_t>(y) * 640 + x] =
+						(x == 20 || x == 619) && (y == 20 || y == 459) ? 3 : 1;
+		std::fill(ring.tiles.begin(), ring.tiles.end(), 1);
+		compareTracers(ring, "a ring of 2000 pixels a border");
+	}
 
 	int traceCases = 0;
 	for (std::size_t n = 1; n <= 80; ++n)
