@@ -879,7 +879,12 @@ bool ContourTracer::acceptQuad(const TraceParams &params, int w, int h, Quad &qu
 	}
 	for (int i = 0; i < 4; ++i) {
 		const SideLine side = SideLine::between(q[i], q[(i + 1) & 3]);
-		if (std::popcount(sideCoverage(pts, n, side, tol)) < kBins * 7 / 16)
+#ifdef FRAPPE_HAVE_ARMV6_TRACE
+		const std::uint32_t covered = sideCoverageV6(pts, n, side, tol, w + h);
+#else
+		const std::uint32_t covered = sideCoverage(pts, n, side, tol);
+#endif
+		if (std::popcount(covered) < kBins * 7 / 16)
 			return false;
 	}
 	return true;

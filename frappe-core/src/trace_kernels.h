@@ -101,6 +101,9 @@ void labelsFromEdgesScalar(const std::uint8_t *edges, std::size_t n, std::uint8_
 void labelsFromEdgesV6(const std::uint8_t *edges, std::size_t n, std::uint8_t *labels);
 OutlineExtremes outlineExtremesV6(const std::uint32_t *pts, std::size_t n);
 PointsBox pointsBoxV6(const std::uint32_t *pts, std::size_t n);
+/// sideCoverage for points with x + y <= bound (the map's width plus
+/// height): most points are rejected in integers first.
+std::uint32_t sideCoverageV6(const std::uint32_t *pts, std::size_t n, const SideLine &side, float tol, int bound);
 #endif
 
 } // namespace frappe::detail

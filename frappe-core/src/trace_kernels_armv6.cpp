@@ -13,6 +13,8 @@
 
 #include <arm_acle.h>
 
+#include <cmath>
+#include <cstdlib>
 #include <cstring>
 
 namespace frappe::detail {
@@ -134,6 +136,46 @@ OutlineExtremes outlineExtremesV6(const std::uint32_t *pts, std::size_t n)
 	e.most = most;
 	e.least = least;
 	return e;
+}
+
+std::uint32_t sideCoverageV6(const std::uint32_t *pts, std::size_t n, const SideLine &side, float tol, int bound)
+{
+	/* A point far from the line is told in integers first, with SMLAD on
+	 * its two lanes: a = NX x + NY y - NC, the side's normal and offset
+	 * in Q14, truncated (NX = (int) (2^14 nx) ...: conversions, no libm).
+	 * Each is off by less than 1, so a is off by less than x + y + 1 <=
+	 * bound + 1 from 2^14 (nx x + ny y - nc); the float sum is off by at
+	 * most 4 * 2^-24 (|nx| x + |ny| y + |nc|) <= 2^-21 * 3 bound (with
+	 * |nx|, |ny| <= 1.5 and |nc| <= bound + 1) from the exact one, below
+	 * bound / 64 in Q14. So |a| > T = (int) (2^14 tol) + bound + bound / 64
+	 * + 4 means the float test rejects the point too. Only the others
+	 * take the scalar form's float arithmetic, which decides. */
+	const bool ok = bound >= 0 && bound <= (1 << 15) && std::abs(side.nx) <= 1.5f && std::abs(side.ny) <= 1.5f &&
+			std::abs(side.nc) <= static_cast<float>(bound + 1) && tol >= 0.0f && tol < 16384.0f;
+	if (!ok)
+		return sideCoverageScalar(pts, n, side, tol);
+	const std::int32_t nx = static_cast<std::int32_t>(side.nx * 16384.0f);
+	const std::int32_t ny = static_cast<std::int32_t>(side.ny * 16384.0f);
+	const std::int32_t nc = static_cast<std::int32_t>(side.nc * 16384.0f);
+	const u32 normal = static_cast<u32>(nx & 0xFFFF) | static_cast<u32>(ny) << 16;
+	const std::int32_t T = static_cast<std::int32_t>(tol * 16384.0f) + bound + bound / 64 + 4;
+	const u32 span = 2 * static_cast<u32>(T);
+	std::uint32_t covered = 0;
+	const std::uint32_t *const end = pts + n;
+	for (const std::uint32_t *p = pts; p != end; ++p) {
+		u32 v = *p;
+		const std::int32_t a = __smlad(static_cast<int16x2_t>(v), static_cast<int16x2_t>(normal), -nc);
+		if (static_cast<u32>(a + T) > span) /* a > T or a < -T */
+			continue;
+		__asm__("" : "+r"(v)); /* unpack only here, not before the test */
+		const float px = static_cast<float>(v & 0xFFFFu), py = static_cast<float>(v >> 16);
+		if (std::abs(side.nx * px + side.ny * py - side.nc) > tol)
+			continue;
+		const float t = side.ux * px + side.uy * py - side.t0;
+		if (t >= 0.0f && t < static_cast<float>(kSideBins))
+			covered |= 1u << static_cast<int>(t);
+	}
+	return covered;
 }
 
 PointsBox pointsBoxV6(const std::uint32_t *pts, std::size_t n)

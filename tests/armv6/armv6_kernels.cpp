@@ -327,6 +327,41 @@ void checkTraceKernels(std::size_t n, int kind)
 	      n, kind);
 }
 
+/* sideCoverage's integer pre-test: sides between random points of a w x h
+ * map, points strewn within a few pixels of the side's line (so that many
+ * lie near the tolerance) and anywhere. */
+void checkSideCoverage(int w, int h, int trials)
+{
+	std::uniform_real_distribution<float> ux(0.0f, static_cast<float>(w - 1)), uy(0.0f, static_cast<float>(h - 1));
+	std::uniform_real_distribution<float> ut(-0.2f, 1.2f), ud(-1.0f, 1.0f), utol(0.0f, 12.0f);
+	for (int k = 0; k < trials; ++k) {
+		const Point2f a{ ux(rng), uy(rng) }, b{ ux(rng), uy(rng) };
+		if (a.x == b.x && a.y == b.y)
+			continue;
+		const SideLine side = SideLine::between(a, b);
+		const float tol = (k & 3) ? 1.5f + 0.06f * utol(rng) * 5.0f : utol(rng);
+		const std::size_t n = 1 + rng() % 300;
+		std::vector<std::uint32_t> pts(n + kPointsPadding);
+		for (std::size_t i = 0; i < n; ++i) {
+			float x, y;
+			if (i % 5 == 4) {
+				x = ux(rng);
+				y = uy(rng);
+			} else {
+				const float t = ut(rng), d = (tol + 0.5f) * ud(rng);
+				x = a.x + t * (b.x - a.x) + d * side.nx;
+				y = a.y + t * (b.y - a.y) + d * side.ny;
+			}
+			const int xi = std::clamp(static_cast<int>(std::lround(x)), 0, w - 1);
+			const int yi = std::clamp(static_cast<int>(std::lround(y)), 0, h - 1);
+			pts[i] = static_cast<std::uint32_t>(xi) | static_cast<std::uint32_t>(yi) << 16;
+		}
+		const std::uint32_t want = sideCoverageScalar(pts.data(), n, side, tol);
+		const std::uint32_t got = sideCoverageV6(pts.data(), n, side, tol, w + h);
+		CHECK(want == got, "sideCoverage %dx%d trial %d: %08x vs %08x", w, h, k, want, got);
+	}
+}
+
 /* Label rows: word-aligned buffers (as the tracer's), or not. */
 void checkLabels(std::size_t n, int misalign)
 {
@@ -506,6 +541,11 @@ int main(int argc, char **argv)
 	for (std::size_t n : { 0, 1, 31, 32, 33, 63, 64, 100, 1000, 307200 })
 		for (int mis = 0; mis < 4; ++mis, ++traceCases)
 			checkLabels(n, mis);
+	for (const auto &[w, h] : { std::pair{ 640, 480 }, std::pair{ 320, 240 }, std::pair{ 7, 5 }, std::pair{ 1920, 1080 },
+				   std::pair{ 16000, 16000 }, std::pair{ 30000, 2767 } }) {
+		checkSideCoverage(w, h, quick ? 300 : 3000);
+		traceCases += quick ? 300 : 3000;
+	}
 	std::printf("trace kernels: %d random cases\n", traceCases);
 
 	std::size_t files = 0, edges = 0, dark = 0;
