@@ -119,6 +119,23 @@ void checkRows(const RowKernels &ref, const RowKernels &k, int w, int kind, int 
 		CHECK(mag[x] == 0x55555555, "gradientRow w=%d wrote past mag", w);
 }
 
+/* The tile marking of an edge row (both front ends call markTiles, so the
+ * front-end comparisons cannot tell it apart from its reference). */
+void checkMarkTiles(int w, int misalign)
+{
+	std::vector<std::uint8_t> row(w + 8, 0);
+	for (int x = 0; x < w; ++x)
+		row[misalign + x] = rng() % 23 == 0 ? static_cast<std::uint8_t>(1 + rng() % 3) : 0;
+	const int nt = (w + 15) / 16;
+	std::vector<std::uint8_t> t1(nt + 2), t2;
+	for (auto &t : t1)
+		t = static_cast<std::uint8_t>(rng() % 5 == 0);
+	t2 = t1;
+	markTilesScalar(row.data() + misalign, w, t1.data());
+	markTilesV6(row.data() + misalign, w, t2.data());
+	CHECK(t1 == t2, "markTiles w=%d misalign=%d", w, misalign);
+}
+
 struct Gray {
 	int w = 0, h = 0;
 	std::vector<std::uint8_t> px;
@@ -460,6 +477,13 @@ int main(int argc, char **argv)
 	for (int w : { 127, 128, 129, 320, 639, 640, 641, 1283 })
 		for (int rep = 0; rep < (quick ? 3 : 30); ++rep, ++rowCases)
 			checkRows(ref, k, w, rep % 3, rep % 4);
+	for (int w = 1; w <= 100; ++w)
+		for (int mis = 0; mis < 4; ++mis)
+			for (int rep = 0; rep < 4; ++rep, ++rowCases)
+				checkMarkTiles(w, mis);
+	for (int w : { 320, 640, 641, 1920 })
+		for (int rep = 0; rep < 20; ++rep, ++rowCases)
+			checkMarkTiles(w, rep % 4);
 	std::printf("rows: %d random cases\n", rowCases);
 
 	/* Thresholds: the defaults (edge 0.27, corner 0.19), none, tiny, huge,
