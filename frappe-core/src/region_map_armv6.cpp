@@ -14,6 +14,7 @@
 #include <arm_acle.h>
 
 #include <algorithm>
+#include <cstdint>
 #include <cstring>
 
 namespace frappe::detail {
@@ -102,6 +103,41 @@ void decimateRowV6(const std::uint8_t *r0, const std::uint8_t *r1, int w, std::u
 	/* The +2 of the rounding rides in the first UXTAB16's accumulator. */
 	const u32 kTwo = 0x00020002u, kMask = 0x00FF00FFu;
 	int x = 0;
+	if (w >= 4 && ((reinterpret_cast<std::uintptr_t>(r0) | reinterpret_cast<std::uintptr_t>(r1) |
+			reinterpret_cast<std::uintptr_t>(out)) & 3) == 0) {
+		/* Word-aligned rows (frames whose stride is a multiple of four):
+		 * each row's two words by one LDM, 18 instructions per four
+		 * outputs (the loop below: 21). The same arithmetic. */
+		const std::uint8_t *p0 = r0, *p1 = r1;
+		std::uint8_t *po = out;
+		const std::uint8_t *const end = r0 + 2 * (w & ~3);
+		register u32 a0 __asm__("r4"), a1 __asm__("r5"), b0 __asm__("r6"), b1 __asm__("r7");
+		u32 t, u;
+		__asm__ volatile("1:\n\t"
+				 "ldmia   %[p0]!, {%[a0], %[a1]}\n\t"
+				 "ldmia   %[p1]!, {%[b0], %[b1]}\n\t"
+				 "uxtab16 %[t], %[k], %[a0]\n\t"
+				 "uxtab16 %[t], %[t], %[a0], ror #8\n\t"
+				 "uxtab16 %[t], %[t], %[b0]\n\t"
+				 "uxtab16 %[t], %[t], %[b0], ror #8\n\t"
+				 "uxtab16 %[u], %[k], %[a1]\n\t"
+				 "uxtab16 %[u], %[u], %[a1], ror #8\n\t"
+				 "uxtab16 %[u], %[u], %[b1]\n\t"
+				 "uxtab16 %[u], %[u], %[b1], ror #8\n\t"
+				 "pkhbt   %[a0], %[t], %[u], lsl #16\n\t"
+				 "pkhtb   %[a1], %[u], %[t], asr #16\n\t"
+				 "and     %[a0], %[m], %[a0], lsr #2\n\t"
+				 "and     %[a1], %[m], %[a1], lsr #2\n\t"
+				 "orr     %[a0], %[a0], %[a1], lsl #8\n\t"
+				 "str     %[a0], [%[po]], #4\n\t"
+				 "cmp     %[p0], %[end]\n\t"
+				 "bne     1b"
+				 : [p0] "+r"(p0), [p1] "+r"(p1), [po] "+r"(po), [a0] "=&r"(a0), [a1] "=&r"(a1),
+				   [b0] "=&r"(b0), [b1] "=&r"(b1), [t] "=&r"(t), [u] "=&r"(u)
+				 : [end] "r"(end), [k] "r"(kTwo), [m] "r"(kMask)
+				 : "cc", "memory");
+		x = w & ~3;
+	}
 	for (; x + 4 <= w; x += 4) {
 		const u32 a0 = load32(r0 + 2 * x), a1 = load32(r0 + 2 * x + 4);
 		const u32 b0 = load32(r1 + 2 * x), b1 = load32(r1 + 2 * x + 4);
@@ -204,6 +240,43 @@ void darkRowV6(const std::uint8_t *d, const std::uint8_t *mid, int w, std::uint8
 	const std::uint8_t *pd = d, *pm = mid;
 	std::uint8_t *po = out, *pt = tiles;
 	const std::uint8_t *const end = d + (w & ~(ET - 1));
+	if (pd != end && ((reinterpret_cast<std::uintptr_t>(d) | reinterpret_cast<std::uintptr_t>(mid) |
+			   reinterpret_cast<std::uintptr_t>(out)) & 3) == 0) {
+		/* Word-aligned rows: two words a step by LDM / STM, and the dark
+		 * bit as the sign of UHSUB8 (d - mid halved keeps the borrow in
+		 * bit 7), moved to bit 0: 21 instructions a tile of 16 (the
+		 * loop below: 37). */
+		register u32 d0 __asm__("r4"), d1 __asm__("r5"), m0 __asm__("r6"), m1 __asm__("r7");
+		u32 acc;
+		__asm__ volatile(".syntax unified\n\t"
+				 "1:\n\t"
+				 "ldmia   %[pd]!, {%[d0], %[d1]}\n\t"
+				 "ldmia   %[pm]!, {%[m0], %[m1]}\n\t"
+				 "uhsub8  %[m0], %[d0], %[m0]\n\t"
+				 "uhsub8  %[m1], %[d1], %[m1]\n\t"
+				 "and     %[m0], %[ones], %[m0], lsr #7\n\t"
+				 "and     %[m1], %[ones], %[m1], lsr #7\n\t"
+				 "stmia   %[po]!, {%[m0], %[m1]}\n\t"
+				 "orr     %[acc], %[m0], %[m1]\n\t"
+				 "ldmia   %[pd]!, {%[d0], %[d1]}\n\t"
+				 "ldmia   %[pm]!, {%[m0], %[m1]}\n\t"
+				 "uhsub8  %[m0], %[d0], %[m0]\n\t"
+				 "uhsub8  %[m1], %[d1], %[m1]\n\t"
+				 "and     %[m0], %[ones], %[m0], lsr #7\n\t"
+				 "and     %[m1], %[ones], %[m1], lsr #7\n\t"
+				 "stmia   %[po]!, {%[m0], %[m1]}\n\t"
+				 "orr     %[acc], %[acc], %[m0]\n\t"
+				 "orrs    %[acc], %[acc], %[m1]\n\t"
+				 "it      ne\n\t"
+				 "strbne  %[ones], [%[pt]]\n\t" /* its low byte is kEdge */
+				 "add     %[pt], %[pt], #1\n\t"
+				 "cmp     %[pd], %[end]\n\t"
+				 "bne     1b"
+				 : [pd] "+r"(pd), [pm] "+r"(pm), [po] "+r"(po), [pt] "+r"(pt), [d0] "=&r"(d0),
+				   [d1] "=&r"(d1), [m0] "=&r"(m0), [m1] "=&r"(m1), [acc] "=&r"(acc)
+				 : [end] "r"(end), [ones] "r"(ones)
+				 : "cc", "memory");
+	}
 	for (; pd != end; pd += ET, pm += ET, po += ET, ++pt) {
 		const u32 o0 = darkWord(load32(pd), load32(pm), ones);
 		const u32 o1 = darkWord(load32(pd + 4), load32(pm + 4), ones);
