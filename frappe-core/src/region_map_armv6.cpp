@@ -161,7 +161,37 @@ void tileExtremesV6(const std::uint8_t *rows, std::ptrdiff_t stride, int n, int 
 	const std::uint8_t *r3 = rows + static_cast<std::ptrdiff_t>(std::min(3, n - 1)) * stride;
 	const int full = w / kRegionTile;
 	static_assert(kRegionTile == 4, "a tile's row is one word");
-	for (int i = 0; i < full; ++i) {
+	int i = 0;
+	if (full >= 2) {
+		/* Two tiles a step: down each, then across both at once, their
+		 * halves paired by PKHBT / PKHTB: (A0 A1 B0 B1) against (A2 A3
+		 * B2 B3), then each byte against the next. Pointers, so that
+		 * GCC keeps everything in registers. */
+		const std::uint8_t *p0 = r0, *p1 = r1, *p2 = r2, *p3 = r3;
+		std::uint8_t *pmin = tmin, *pmax = tmax;
+		const std::uint8_t *const end = r0 + 4 * (full & ~1);
+		for (; p0 != end; p0 += 8, p1 += 8, p2 += 8, p3 += 8, pmin += 2, pmax += 2) {
+			u32 mnA, mxA, mnB, mxB, mn23, mx23;
+			minMax8(load32(p0), load32(p1), mnA, mxA);
+			minMax8(load32(p2), load32(p3), mn23, mx23);
+			mnA = min8(mnA, mn23);
+			mxA = max8(mxA, mx23);
+			minMax8(load32(p0 + 4), load32(p1 + 4), mnB, mxB);
+			minMax8(load32(p2 + 4), load32(p3 + 4), mn23, mx23);
+			mnB = min8(mnB, mn23);
+			mxB = max8(mxB, mx23);
+			u32 mn = min8(pkhbt16(mnA, mnB), pkhtb16(mnB, mnA));
+			u32 mx = max8(pkhbt16(mxA, mxB), pkhtb16(mxB, mxA));
+			mn = min8(mn, mn >> 8);
+			mx = max8(mx, mx >> 8);
+			pmin[0] = static_cast<std::uint8_t>(mn);
+			pmin[1] = static_cast<std::uint8_t>(mn >> 16);
+			pmax[0] = static_cast<std::uint8_t>(mx);
+			pmax[1] = static_cast<std::uint8_t>(mx >> 16);
+		}
+		i = full & ~1;
+	}
+	for (; i < full; ++i) {
 		const int x = 4 * i;
 		u32 mn01, mx01, mn23, mx23;
 		minMax8(load32(r0 + x), load32(r1 + x), mn01, mx01);
