@@ -94,6 +94,19 @@ struct RowStepTable {
 };
 constexpr RowStepTable kRowStep;
 
+/* The neighbour mask (bit d for direction d) of a neighbourIndex. */
+struct MaskOfIndex {
+	std::uint8_t mask[512];
+	constexpr MaskOfIndex() : mask{}
+	{
+		constexpr int kBit[8] = { 1, 0, 3, 6, 7, 8, 5, 2 }; /* as RowStepTable */
+		for (int idx = 0; idx < 512; ++idx)
+			for (int d = 0; d < 8; ++d)
+				mask[idx] = static_cast<std::uint8_t>(mask[idx] | ((idx >> kBit[d]) & 1) << d);
+	}
+};
+[[maybe_unused]] constexpr MaskOfIndex kMaskOfIndex;
+
 inline std::uint32_t load32(const std::uint8_t *p)
 {
 	std::uint32_t v;
@@ -599,6 +612,12 @@ void ContourTracer::clusterCorners()
  * pixel the scan came from. Keeps its pixels and, apart, its corner pixels. */
 void ContourTracer::follow(int x0, int y0, int fromDir, const TraceMap &edges)
 {
+#ifdef FRAPPE_HAVE_ARMV6_TRACE
+	if (!portableWalk_ && !useMasks_) {
+		followV6(x0, y0, fromDir, edges);
+		return;
+	}
+#endif
 	std::uint8_t *const L = labels_.data();
 	const std::ptrdiff_t w = stride_;
 	/* The edge map's corner bit of a label pointer (same layout), 0 or 1. */
@@ -706,39 +725,6 @@ void ContourTracer::follow(int x0, int y0, int fromDir, const TraceMap &edges)
 	std::uint8_t *p = p0;
 	/* The table row for the direction back to the previous pixel. */
 	std::uint32_t row = static_cast<std::uint32_t>(d1) << 9;
-#ifdef FRAPPE_HAVE_ARMV6_TRACE
-	if (!portableWalk_) {
-		/* The same steps in assembly (frappe_armv6_follow), which
-		 * returns at p1 and when the points are full; the rest of such
-		 * a step is done here, as below. */
-		FollowAsm a{ p, xy, out, cornerOut, row, table, static_cast<std::int32_t>(-w - 1),
-			     static_cast<std::int32_t>(w - 1), static_cast<std::int32_t>(toEdge), p1, outEnd,
-			     0x00070707u };
-		for (;;) {
-			frappe_armv6_follow(&a);
-			out = a.out;
-			cornerOut = a.cout;
-			if (out == outEnd) [[unlikely]] {
-				if (points_.size() > maxSteps)
-					break;
-				grow();
-				a.out = out;
-				a.cout = cornerOut;
-				a.outEnd = outEnd;
-			}
-			const std::int32_t step = static_cast<std::int32_t>(a.s);
-			std::uint8_t *const next = a.p + (step >> 12);
-			if (a.p == p1 && next == p0)
-				break;
-			a.s = static_cast<std::uint32_t>(step) & 0xE00u;
-			a.xy += static_cast<std::uint32_t>(kDxyBack[a.s >> 9]);
-			a.p = next;
-		}
-		steps_ = static_cast<int>(out - points_.data());
-		cornerCount_ = static_cast<int>(cornerOut - corners_.data());
-		return;
-	}
-#endif
 	for (;;) {
 		/* 3.3: counter-clockwise from the pixel after `back`; the entry
 		 * holds the pointer offset of the move, so the next pixel is one
@@ -765,6 +751,70 @@ void ContourTracer::follow(int x0, int y0, int fromDir, const TraceMap &edges)
 	steps_ = static_cast<int>(out - points_.data());
 	cornerCount_ = static_cast<int>(cornerOut - corners_.data());
 }
+
+#ifdef FRAPPE_HAVE_ARMV6_TRACE
+/* follow() on ARMv6: the same border, walked by frappe_armv6_follow, with
+ * the first move found from the neighbourhood index (kMaskOfIndex) rather
+ * than eight byte tests, and no more set-up than the walk needs: a border
+ * is 34 steps on average, so its set-up counts. */
+void ContourTracer::followV6(int x0, int y0, int fromDir, const TraceMap &edges)
+{
+	std::uint8_t *const L = labels_.data();
+	const std::ptrdiff_t w = stride_;
+	if (points_.size() < 1024) {
+		points_.resize(1024);
+		corners_.resize(1024);
+	}
+	std::uint32_t *out = points_.data(), *outEnd = out + points_.size() - kPointsPadding;
+	std::uint32_t *cornerOut = corners_.data();
+	const std::uint32_t xy = static_cast<std::uint32_t>(x0) | static_cast<std::uint32_t>(y0) << 16;
+	std::uint8_t *const p0 = L + y0 * w + x0;
+	const std::int32_t toEdge = static_cast<std::int32_t>(reinterpret_cast<std::uintptr_t>(edges.pixels.data()) -
+							      reinterpret_cast<std::uintptr_t>(L));
+	const unsigned mask0 = kMaskOfIndex.mask[neighbourIndex(p0, w)];
+	if (mask0 == 0) {
+		*p0 = kFollowedRightBg; /* isolated pixel */
+		*out++ = xy;
+		*cornerOut = xy;
+		cornerOut += (p0[toEdge] >> 1) & 1;
+		steps_ = 1;
+		cornerCount_ = static_cast<int>(cornerOut - corners_.data());
+		return;
+	}
+	const auto turned = static_cast<std::uint8_t>(mask0 << (7 - fromDir) | mask0 >> (fromDir + 1));
+	const int d1 = (fromDir - std::countl_zero(turned)) & 7;
+	const std::uint8_t *const p1 = p0 + kDx[d1] + kDy[d1] * w;
+	const std::size_t maxSteps = 4 * labels_.size();
+	FollowAsm a{ p0, xy, out, cornerOut, static_cast<std::uint32_t>(d1) << 9, stepTable_.data() + kStepTableAt,
+		     static_cast<std::int32_t>(-w - 1), static_cast<std::int32_t>(w - 1), toEdge, p1, outEnd,
+		     0x00070707u };
+	/* The walk returns at p1 and when the points are full, after storing
+	 * the point; the rest of such a step is done here, as follow() does. */
+	for (;;) {
+		frappe_armv6_follow(&a);
+		if (a.out == outEnd) [[unlikely]] {
+			if (points_.size() > maxSteps)
+				break;
+			const std::size_t n = points_.size(), nc = static_cast<std::size_t>(a.cout - corners_.data());
+			points_.resize(2 * n);
+			corners_.resize(2 * n);
+			outEnd = points_.data() + points_.size() - kPointsPadding;
+			a.out = points_.data() + (n - kPointsPadding);
+			a.cout = corners_.data() + nc;
+			a.outEnd = outEnd;
+		}
+		const std::int32_t step = static_cast<std::int32_t>(a.s);
+		std::uint8_t *const next = a.p + (step >> 12);
+		if (a.p == p1 && next == p0)
+			break;
+		a.s = static_cast<std::uint32_t>(step) & 0xE00u;
+		a.xy += static_cast<std::uint32_t>(kDxyBack[a.s >> 9]);
+		a.p = next;
+	}
+	steps_ = static_cast<int>(a.out - points_.data());
+	cornerCount_ = static_cast<int>(a.cout - corners_.data());
+}
+#endif
 
 /* The paper's rule is "exactly four corner clusters". Noise adds clusters
  * part-way along a side, so with more than four the four spanning the

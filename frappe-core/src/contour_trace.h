@@ -78,6 +78,7 @@ private:
 	};
 	void buildStepTables(int w);
 	void follow(int x, int y, int fromDir, const TraceMap &edges);
+	void followV6(int x, int y, int fromDir, const TraceMap &edges); ///< ARMv6 builds only
 	void clusterCorners();
 	/// The last border's bounding box spans `span` both ways, and its
 	/// length is at most maxWinding times the perimeter of the box.
