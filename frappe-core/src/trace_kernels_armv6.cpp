@@ -85,10 +85,33 @@ OutlineExtremes outlineExtremesV6(const std::uint32_t *pts, std::size_t n)
 	 * centroid, as the scalar form's int64 ones. */
 	if (n >= (std::size_t{ 1 } << 15))
 		return outlineExtremesScalar(pts, n);
+	/* Four points a step by LDM (the points are a u32 array): UXTAH adds
+	 * the low lane, an ADD with LSR the high one. */
 	std::int32_t sx = 0, sy = 0;
-	for (std::size_t i = 0; i < n; ++i) {
-		sx += static_cast<std::int32_t>(pts[i] & 0xFFFFu);
-		sy += static_cast<std::int32_t>(pts[i] >> 16);
+	const std::uint32_t *const end4 = pts + (n & ~std::size_t{ 3 });
+	register u32 q0 __asm__("r4"), q1 __asm__("r5"), q2 __asm__("r6"), q3 __asm__("r7");
+	if (end4 != pts) {
+		const std::uint32_t *p = pts;
+		__asm__("1:\n\t"
+			"ldmia   %[p]!, {%[q0], %[q1], %[q2], %[q3]}\n\t"
+			"uxtah   %[sx], %[sx], %[q0]\n\t"
+			"add     %[sy], %[sy], %[q0], lsr #16\n\t"
+			"uxtah   %[sx], %[sx], %[q1]\n\t"
+			"add     %[sy], %[sy], %[q1], lsr #16\n\t"
+			"uxtah   %[sx], %[sx], %[q2]\n\t"
+			"add     %[sy], %[sy], %[q2], lsr #16\n\t"
+			"uxtah   %[sx], %[sx], %[q3]\n\t"
+			"add     %[sy], %[sy], %[q3], lsr #16\n\t"
+			"cmp     %[p], %[end]\n\t"
+			"bne     1b"
+			: [p] "+r"(p), [sx] "+r"(sx), [sy] "+r"(sy), [q0] "=&r"(q0), [q1] "=&r"(q1), [q2] "=&r"(q2),
+			  [q3] "=&r"(q3)
+			: [end] "r"(end4)
+			: "cc", "memory");
+	}
+	for (const std::uint32_t *p = end4; p != pts + n; ++p) {
+		sx += static_cast<std::int32_t>(*p & 0xFFFFu);
+		sy += static_cast<std::int32_t>(*p >> 16);
 	}
 	/* The farthest point from the centroid: the scalar form's double
 	 * arithmetic, as it is (its result depends on the rounding). */
@@ -108,15 +131,41 @@ OutlineExtremes outlineExtremesV6(const std::uint32_t *pts, std::size_t n)
 	 * cross(p0, p2, p) = ex dy - ey dx = SMUSDX(e, d). */
 	const u32 p0 = pts[e.i0];
 	std::int32_t bd2 = -1;
-	std::size_t i2 = 0;
-	for (std::size_t i = 0; i < n; ++i) {
-		const u32 d = ssub16(pts[i], p0);
+	/* The farthest from p0, four points a step by LDM; the best is kept
+	 * as the address of its point (the LDM base minus its offset). */
+	const std::uint32_t *best = pts;
+	if (end4 != pts) {
+		const std::uint32_t *p = pts;
+		u32 t;
+		__asm__(".syntax unified\n\t"
+			"1:\n\t"
+			"ldmia   %[p]!, {%[q0], %[q1], %[q2], %[q3]}\n\t"
+#define FRAPPE_FARTHEST(Q, OFF)                                              \
+			"ssub16  %[t], %[" Q "], %[p0]\n\t"                    \
+			"smuad   %[t], %[t], %[t]\n\t"                           \
+			"cmp     %[t], %[bd]\n\t"                                \
+			"itt     gt\n\t"                                         \
+			"movgt   %[bd], %[t]\n\t"                                \
+			"subgt   %[best], %[p], #" OFF "\n\t"
+			FRAPPE_FARTHEST("q0", "16") FRAPPE_FARTHEST("q1", "12")
+			FRAPPE_FARTHEST("q2", "8") FRAPPE_FARTHEST("q3", "4")
+#undef FRAPPE_FARTHEST
+			"cmp     %[p], %[end]\n\t"
+			"bne     1b"
+			: [p] "+r"(p), [bd] "+r"(bd2), [best] "+r"(best), [t] "=&r"(t), [q0] "=&r"(q0), [q1] "=&r"(q1),
+			  [q2] "=&r"(q2), [q3] "=&r"(q3)
+			: [end] "r"(end4), [p0] "r"(p0)
+			: "cc", "memory");
+	}
+	for (const std::uint32_t *p = end4; p != pts + n; ++p) {
+		const u32 d = ssub16(*p, p0);
 		const std::int32_t d2 = __smuad(static_cast<int16x2_t>(d), static_cast<int16x2_t>(d));
 		if (d2 > bd2) {
 			bd2 = d2;
-			i2 = i;
+			best = p;
 		}
 	}
+	const std::size_t i2 = static_cast<std::size_t>(best - pts);
 	e.i2 = i2;
 	const u32 ed = ssub16(pts[i2], p0);
 	std::int32_t most = 0, least = 0;
@@ -182,6 +231,29 @@ PointsBox pointsBoxV6(const std::uint32_t *pts, std::size_t n)
 {
 	u32 lo = pts[0], hi = lo;
 	std::size_t i = 0;
+	if (n >= 4) {
+		/* Four points a step by LDM. */
+		const std::uint32_t *p = pts;
+		const std::uint32_t *const end = pts + (n & ~std::size_t{ 3 });
+		register u32 q0 __asm__("r4"), q1 __asm__("r5"), q2 __asm__("r6"), q3 __asm__("r7");
+		u32 t;
+		__asm__("1:\n\t"
+			"ldmia   %[p]!, {%[q0], %[q1], %[q2], %[q3]}\n\t"
+#define FRAPPE_BOX(Q)                                                        \
+			"usub16  %[t], %[" Q "], %[lo]\n\t"                    \
+			"sel     %[lo], %[lo], %[" Q "]\n\t"                   \
+			"usub16  %[t], %[" Q "], %[hi]\n\t"                    \
+			"sel     %[hi], %[" Q "], %[hi]\n\t"
+			FRAPPE_BOX("q0") FRAPPE_BOX("q1") FRAPPE_BOX("q2") FRAPPE_BOX("q3")
+#undef FRAPPE_BOX
+			"cmp     %[p], %[end]\n\t"
+			"bne     1b"
+			: [p] "+r"(p), [lo] "+r"(lo), [hi] "+r"(hi), [t] "=&r"(t), [q0] "=&r"(q0), [q1] "=&r"(q1),
+			  [q2] "=&r"(q2), [q3] "=&r"(q3)
+			: [end] "r"(end)
+			: "cc", "memory");
+		i = n & ~std::size_t{ 3 };
+	}
 	for (; i + 2 <= n; i += 2) {
 		const u32 a = pts[i], b = pts[i + 1];
 		lo = min16(min16(lo, a), b);
