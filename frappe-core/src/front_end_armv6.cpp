@@ -777,7 +777,7 @@ bool edgeRowV6(const GradRows &rows, int w, const FrontEndParams &params, std::u
 /* A tile's sixteen bytes by one LDM (edge rows are word aligned when the
  * width is a multiple of four): 8 instructions a tile, GCC's loop 14. The
  * occupancy bytes are 0 or 1, so storing 1 is ORing. */
-void markTilesV6(const std::uint8_t *edgeRow, int w, std::uint8_t *tileRow)
+__attribute__((optimize("omit-frame-pointer"))) void markTilesV6(const std::uint8_t *edgeRow, int w, std::uint8_t *tileRow)
 {
 	const int tiles = w / EdgeMap::kTile;
 	if (tiles == 0 || (reinterpret_cast<std::uintptr_t>(edgeRow) & 3) != 0) {

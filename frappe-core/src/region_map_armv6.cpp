@@ -19,6 +19,10 @@
 
 namespace frappe::detail {
 
+/* Functions whose inline asm names r4-r7 (LDM lists must ascend) keep no
+ * frame pointer, which is r7 in Thumb code and r11 in ARM code, also at
+ * -O0 (the attribute on each). */
+
 namespace {
 
 using u32 = std::uint32_t;
@@ -98,7 +102,7 @@ inline u32 darkWord(u32 d, u32 m, u32 ones)
 
 } // namespace
 
-void decimateRowV6(const std::uint8_t *r0, const std::uint8_t *r1, int w, std::uint8_t *out)
+__attribute__((optimize("omit-frame-pointer"))) void decimateRowV6(const std::uint8_t *r0, const std::uint8_t *r1, int w, std::uint8_t *out)
 {
 	/* The +2 of the rounding rides in the first UXTAB16's accumulator. */
 	const u32 kTwo = 0x00020002u, kMask = 0x00FF00FFu;
@@ -261,7 +265,7 @@ void spreadTilesV6(std::uint8_t *tileMin, std::uint8_t *tileMax, int tx, int ty,
 	}
 }
 
-void darkRowV6(const std::uint8_t *d, const std::uint8_t *mid, int w, std::uint8_t *out, std::uint8_t *tiles)
+__attribute__((optimize("omit-frame-pointer"))) void darkRowV6(const std::uint8_t *d, const std::uint8_t *mid, int w, std::uint8_t *out, std::uint8_t *tiles)
 {
 	constexpr int ET = TraceMap::kTile;
 	static_assert(ET == 16 && TraceMap::kEdge == 1);

@@ -19,6 +19,10 @@
 
 namespace frappe::detail {
 
+/* Functions whose inline asm names r4-r7 (LDM lists must ascend) keep no
+ * frame pointer, which is r7 in Thumb code and r11 in ARM code, also at
+ * -O0 (the attribute on each). */
+
 namespace {
 
 using u32 = std::uint32_t;
@@ -79,7 +83,7 @@ __attribute__((optimize("omit-frame-pointer"))) void labelsFromEdgesV6(const std
 		labels[i] = edges[i] & kUnfollowed;
 }
 
-OutlineExtremes outlineExtremesV6(const std::uint32_t *pts, std::size_t n)
+__attribute__((optimize("omit-frame-pointer"))) OutlineExtremes outlineExtremesV6(const std::uint32_t *pts, std::size_t n)
 {
 	/* Below 2^15 points the sums fit an int32: the same sums, so the same
 	 * centroid, as the scalar form's int64 ones. */
@@ -227,7 +231,7 @@ std::uint32_t sideCoverageV6(const std::uint32_t *pts, std::size_t n, const Side
 	return covered;
 }
 
-PointsBox pointsBoxV6(const std::uint32_t *pts, std::size_t n)
+__attribute__((optimize("omit-frame-pointer"))) PointsBox pointsBoxV6(const std::uint32_t *pts, std::size_t n)
 {
 	u32 lo = pts[0], hi = lo;
 	std::size_t i = 0;
