@@ -15,6 +15,9 @@
 #   --dictionary NAME  default aruco_mip_36h12
 #   --max N            only the first N images
 #   --no-opencv        count frappe only
+#   --region-contrast C  Config::region_contrast for frappe (0: no region map
+#                      and no region candidates; default: the Config default)
+#   --out DIR          where the results go (default: BUILD/arm-count)
 #   --build DIR        cross build dir (default: build-armel in the checkout)
 #   --setup            install missing host packages with apt-get (root) instead of stopping
 #   --jobs N           ninja -j (default 2)
@@ -28,7 +31,7 @@ set -euo pipefail
 
 SRC=$(cd "$(dirname "$0")/.." && pwd)
 HERE=$SRC/scripts/arm
-LIST="" IMAGES="" DICT=aruco_mip_36h12 MAX=0 OPENCV=1 BUILD="" SETUP=0 JOBS=2
+LIST="" IMAGES="" DICT=aruco_mip_36h12 MAX=0 OPENCV=1 BUILD="" SETUP=0 JOBS=2 REGION="" OUT=""
 while [ $# -gt 0 ]; do
 	case "$1" in
 	--list) LIST=$2; shift 2;;
@@ -36,6 +39,8 @@ while [ $# -gt 0 ]; do
 	--dictionary) DICT=$2; shift 2;;
 	--max) MAX=$2; shift 2;;
 	--no-opencv) OPENCV=0; shift;;
+	--region-contrast) REGION=$2; shift 2;;
+	--out) OUT=$2; shift 2;;
 	--build) BUILD=$2; shift 2;;
 	--setup) SETUP=1; shift;;
 	--jobs) JOBS=$2; shift 2;;
@@ -47,7 +52,9 @@ BUILD=${BUILD:-$SRC/build-armel}
 CACHE=${FRAPPE_ARM_CACHE:-${XDG_CACHE_HOME:-$HOME/.cache}/frappe-arm}
 SYSROOT=${SYSROOT:-$CACHE/sysroot-armel}
 TRIPLET=arm-linux-gnueabi
-OUT=$BUILD/arm-count
+OUT=${OUT:-$BUILD/arm-count}
+mkdir -p "$OUT"
+OUT=$(cd "$OUT" && pwd)
 t0=$(date +%s)
 step() { echo "== [$(( $(date +%s) - t0 )) s] $*" >&2; }
 die() { echo "arm-count: $1" >&2; exit "${2:-1}"; }
@@ -80,6 +87,7 @@ fi
 if [ -n "$need_pkgs" ]; then
 	if [ "$SETUP" = 1 ] && [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null; then
 		step "apt-get install$need_pkgs"
+		mkdir -p "$(dirname "$CACHE")" # the log sits beside the cache, which may not exist yet
 		export DEBIAN_FRONTEND=noninteractive
 		{ apt-get update -q && apt-get install -y -q --no-install-recommends $need_pkgs; } >"$CACHE.apt.log" 2>&1 ||
 			die "apt-get install$need_pkgs failed (log: $CACHE.apt.log)" 3
@@ -181,6 +189,7 @@ n=$(grep -cv '^\s*\(#\|$\)' "$LIST" || true)
 step "counting $n images under qemu-arm -cpu arm1176 (OpenCV: $([ "$OPENCV" = 1 ] && echo yes || echo no))"
 args=(--list "$LIST" --dictionary "$DICT" --max "$MAX" --out-frappe "$OUT/frappe.jsonl")
 [ "$OPENCV" = 1 ] && args+=(--out-opencv "$OUT/opencv.jsonl") || args+=(--no-opencv)
+[ -n "$REGION" ] && args+=(--region-contrast "$REGION")
 # relative paths in the list are relative to the current directory (the contract)
 ( qemu-arm -cpu arm1176 -L "$SYSROOT" -d plugin -plugin "$PLUGIN,out=$OUT/count.log" \
 	"$OUT/frappe-count" "${args[@]}" > "$OUT/driver.txt" 2> "$OUT/qemu.log" ) ||

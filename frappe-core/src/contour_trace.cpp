@@ -19,6 +19,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <cstddef>
 #include <cstring>
 #include <span>
 
@@ -36,6 +37,15 @@ constexpr int kDx[8] = { 1, 1, 0, -1, -1, -1, 0, 1 };
 constexpr int kDy[8] = { 0, -1, -1, -1, 0, 1, 1, 1 };
 /* Where the walk's window of neighbour masks holds direction d's. */
 constexpr int kWindowByte[8] = { 4, 2, 1, 0, 3, 5, 6, 7 };
+
+/* xy steps per direction back (the move is the opposite direction). */
+constexpr std::int32_t kDxyBack[8] = { -kDx[0] - kDy[0] * 65536, -kDx[1] - kDy[1] * 65536,
+				       -kDx[2] - kDy[2] * 65536, -kDx[3] - kDy[3] * 65536,
+				       -kDx[4] - kDy[4] * 65536, -kDx[5] - kDy[5] * 65536,
+				       -kDx[6] - kDy[6] * 65536, -kDx[7] - kDy[7] * 65536 };
+/* stepTable_ holds kDxyBack first, then the steps: the ARMv6 walk reaches
+ * both from one base register. */
+constexpr std::size_t kStepTableAt = 8;
 
 /* Step 3.3 of Suzuki's algorithm as a table: for the direction `back` to the
  * previous border pixel and the mask of non-zero neighbours (bit d for
@@ -84,6 +94,19 @@ struct RowStepTable {
 };
 constexpr RowStepTable kRowStep;
 
+/* The neighbour mask (bit d for direction d) of a neighbourIndex. */
+struct MaskOfIndex {
+	std::uint8_t mask[512];
+	constexpr MaskOfIndex() : mask{}
+	{
+		constexpr int kBit[8] = { 1, 0, 3, 6, 7, 8, 5, 2 }; /* as RowStepTable */
+		for (int idx = 0; idx < 512; ++idx)
+			for (int d = 0; d < 8; ++d)
+				mask[idx] = static_cast<std::uint8_t>(mask[idx] | ((idx >> kBit[d]) & 1) << d);
+	}
+};
+[[maybe_unused]] constexpr MaskOfIndex kMaskOfIndex;
+
 inline std::uint32_t load32(const std::uint8_t *p)
 {
 	std::uint32_t v;
@@ -124,6 +147,28 @@ inline std::uint32_t borderStarts4(const std::uint8_t *p, std::uint32_t here)
 	return here & ~((load32(p - 1) | here >> 3) & (load32(p + 1) | here >> 4)) & 0x01010101u;
 }
 
+/* From x (x + 8 <= x1), the first pixel of the first group of eight with a
+ * possible border start (see borderStarts4), or the first pixel left over
+ * when fewer than eight remain before x1. Through pointers, and both halves
+ * of a group tested without a branch between them: the compiler keeps the
+ * loop in registers (7 instructions a group of empty pixels on ARMv6). */
+inline int nextStart(const std::uint8_t *row, int x, int x1)
+{
+	const std::uint8_t *p = row + x;
+	const std::uint8_t *const last = row + x1 - 8;
+	for (; p <= last; p += 8) {
+		const std::uint32_t h0 = load32(p), h1 = load32(p + 4);
+		if ((h0 | h1) == 0)
+			continue;
+		const std::uint32_t s0 = borderStarts4(p, h0), s1 = borderStarts4(p + 4, h1);
+		if ((s0 | s1) == 0)
+			continue;
+		const int at = static_cast<int>(p - row);
+		return s0 ? at + (std::countr_zero(s0) >> 3) : at + 4 + (std::countr_zero(s1) >> 3);
+	}
+	return static_cast<int>(p - row);
+}
+
 float cross(Point2f o, Point2f a, Point2f b)
 {
 	return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x);
@@ -152,6 +197,83 @@ float dist2(Point2f a, Point2f b)
 	return dx * dx + dy * dy;
 }
 
+#ifdef FRAPPE_HAVE_ARMV6_TRACE
+/* The 32-bit walk of follow() in ARM assembly: GCC's code for it spilled
+ * three values and built the index's mask and multiply from four BICs and
+ * three shifted ADDs, 38 instructions a step; this takes 28. It runs steps
+ * until the one at p1 or the one that fills the points, which it returns
+ * after storing the point and before moving on: p, xy, out, cout and s
+ * (then the step's table entry) are written back. */
+struct FollowAsm {
+	std::uint8_t *p;		  ///< 0: the current pixel's label
+	std::uint32_t xy;		  ///< 4: its coordinates, x | y << 16
+	std::uint32_t *out, *cout;	  ///< 8, 12: where its point and corner go
+	std::uint32_t s;		  ///< 16: in: the table row (back << 9); out: the entry
+	const std::int32_t *table;	  ///< 20: the step table (kDxyBack at table - 8)
+	std::int32_t up, down;		  ///< 24, 28: -w - 1, w - 1
+	std::int32_t toEdge;		  ///< 32: edge map minus labels (bytes)
+	const std::uint8_t *p1;		  ///< 36
+	const std::uint32_t *outEnd;	  ///< 40
+	std::uint32_t mask;		  ///< 44: 0x00070707
+};
+static_assert(offsetof(FollowAsm, mask) == 44);
+extern "C" void frappe_armv6_follow(FollowAsm *a);
+
+/* r1 p, r2 xy, r3 out, r4 cout, r5 row / entry, r6 table, r7 up, r8 down,
+ * r9 toEdge, r10 p1, r11 outEnd, r12 mask; r0, lr temporaries. The index
+ * as neighbourIndex: the multiply by 2^7 (1 + 2^11 + 2^22) as two ADDs
+ * and a shift. */
+__asm__(R"(
+	.text
+	.arm
+	.syntax unified
+	.p2align 2
+	.type frappe_armv6_follow, %function
+frappe_armv6_follow:
+	push    {r0, r4-r11, lr}
+	ldm     r0, {r1-r12}
+	b       .Lfw_body
+.Lfw_step:
+	add     r1, r1, r5, asr #12     @ p = next
+	and     r5, r5, #0xE00          @ the next row: direction back
+	add     lr, r6, r5, lsr #7
+	ldr     lr, [lr, #-32]          @ kDxyBack[back]
+	add     r2, r2, lr
+.Lfw_body:
+	ldr     lr, [r1, r7]            @ row above, columns x-1 .. x+2
+	ldr     r0, [r1, #-1]
+	orr     lr, lr, r0, lsl #1
+	ldr     r0, [r1, r8]            @ row below
+	orr     lr, lr, r0, lsl #2
+	and     lr, lr, r12
+	add     r0, lr, lr, lsl #11
+	add     lr, lr, r0, lsl #11
+	lsl     lr, lr, #7
+	orr     lr, r5, lr, lsr #23     @ row | neighbourhood index
+	ldr     r5, [r6, lr, lsl #2]    @ the step
+	ldrb    r0, [r1]
+	and     lr, r5, #24
+	orr     r0, r0, lr
+	strb    r0, [r1]                @ mark the pixel
+	str     r2, [r3], #4            @ its point
+	str     r2, [r4]                @ and, kept if it is a corner,
+	ldrb    r0, [r1, r9]
+	and     r0, r0, #2
+	add     r4, r4, r0, lsl #1      @ its corner
+	cmp     r3, r11
+	cmpne   r1, r10
+	bne     .Lfw_step
+	pop     {r0}
+	stm     r0, {r1-r5}
+	pop     {r4-r11, pc}
+	.size frappe_armv6_follow, .-frappe_armv6_follow
+)"
+#if defined(__thumb__)
+	"\t.thumb\n"
+#endif
+);
+#endif
+
 } // namespace
 
 void ContourTracer::buildStepTables(int w)
@@ -177,13 +299,14 @@ void ContourTracer::buildStepTables(int w)
 	 * offset, the direction back from the pixel it reaches (which selects
 	 * the next row of the table), and the label mark of the pixel it
 	 * leaves. */
-	stepTable_.resize(8 * 512);
+	stepTable_.resize(kStepTableAt + 8 * 512);
+	std::copy(kDxyBack, kDxyBack + 8, stepTable_.begin());
 	for (int back = 0; back < 8; ++back)
 		for (int idx = 0; idx < 512; ++idx) {
 			const int e = kRowStep.entry[back][idx];
 			const int d = e & 7;
 			const auto offset = static_cast<std::uint32_t>(kDx[d] + kDy[d] * w);
-			stepTable_[static_cast<std::size_t>(back) * 512 + idx] = static_cast<std::int32_t>(
+			stepTable_[kStepTableAt + static_cast<std::size_t>(back) * 512 + idx] = static_cast<std::int32_t>(
 				offset << 12 | static_cast<std::uint32_t>((d + 4) & 7) << 9 |
 				((e & 8) ? kMarkRightBg : kMarkFollowed));
 		}
@@ -318,21 +441,9 @@ void ContourTracer::trace(const TraceMap &edges, const TraceParams &params, std:
 				 * shifts are library calls here). */
 				if constexpr (std::endian::native == std::endian::little) {
 					if (x + 8 <= x1) {
-						const std::uint32_t h0 = load32(row + x), h1 = load32(row + x + 4);
-						if ((h0 | h1) == 0) {
-							x += 7;
-							continue;
-						}
-						std::uint32_t s4 = borderStarts4(row + x, h0);
-						if (s4 == 0) {
-							s4 = borderStarts4(row + x + 4, h1);
-							if (s4 == 0) {
-								x += 7;
-								continue;
-							}
-							x += 4;
-						}
-						x += std::countr_zero(s4) >> 3;
+						x = nextStart(row, x, x1);
+						if (x >= x1)
+							break;
 					}
 				}
 				tryStart(row, x, y);
@@ -501,6 +612,12 @@ void ContourTracer::clusterCorners()
  * pixel the scan came from. Keeps its pixels and, apart, its corner pixels. */
 void ContourTracer::follow(int x0, int y0, int fromDir, const TraceMap &edges)
 {
+#ifdef FRAPPE_HAVE_ARMV6_TRACE
+	if (!portableWalk_ && !useMasks_) {
+		followV6(x0, y0, fromDir, edges);
+		return;
+	}
+#endif
 	std::uint8_t *const L = labels_.data();
 	const std::ptrdiff_t w = stride_;
 	/* The edge map's corner bit of a label pointer (same layout), 0 or 1. */
@@ -559,11 +676,6 @@ void ContourTracer::follow(int x0, int y0, int fromDir, const TraceMap &edges)
 	const auto turned = static_cast<std::uint8_t>(mask0 << (7 - fromDir) | mask0 >> (fromDir + 1));
 	const int d1 = (fromDir - std::countl_zero(turned)) & 7;
 	const std::uint8_t *const p1 = p0 + off[d1];
-	/* xy steps per direction back (the move is the opposite direction). */
-	static constexpr std::int32_t kDxyBack[8] = { -kDx[0] - kDy[0] * 65536, -kDx[1] - kDy[1] * 65536,
-						      -kDx[2] - kDy[2] * 65536, -kDx[3] - kDy[3] * 65536,
-						      -kDx[4] - kDy[4] * 65536, -kDx[5] - kDy[5] * 65536,
-						      -kDx[6] - kDy[6] * 65536, -kDx[7] - kDy[7] * 65536 };
 	if (useMasks_) {
 		/* Each pixel's neighbourhood is one byte of masks_. The masks of
 		 * the current pixel's eight neighbours are loaded (three words)
@@ -608,7 +720,7 @@ void ContourTracer::follow(int x0, int y0, int fromDir, const TraceMap &edges)
 		cornerCount_ = static_cast<int>(cornerOut - corners_.data());
 		return;
 	}
-	const std::int32_t *const table = stepTable_.data();
+	const std::int32_t *const table = stepTable_.data() + kStepTableAt;
 	const std::size_t maxSteps = 4 * labels_.size();
 	std::uint8_t *p = p0;
 	/* The table row for the direction back to the previous pixel. */
@@ -639,6 +751,70 @@ void ContourTracer::follow(int x0, int y0, int fromDir, const TraceMap &edges)
 	steps_ = static_cast<int>(out - points_.data());
 	cornerCount_ = static_cast<int>(cornerOut - corners_.data());
 }
+
+#ifdef FRAPPE_HAVE_ARMV6_TRACE
+/* follow() on ARMv6: the same border, walked by frappe_armv6_follow, with
+ * the first move found from the neighbourhood index (kMaskOfIndex) rather
+ * than eight byte tests, and no more set-up than the walk needs: a border
+ * is 34 steps on average, so its set-up counts. */
+void ContourTracer::followV6(int x0, int y0, int fromDir, const TraceMap &edges)
+{
+	std::uint8_t *const L = labels_.data();
+	const std::ptrdiff_t w = stride_;
+	if (points_.size() < 1024) {
+		points_.resize(1024);
+		corners_.resize(1024);
+	}
+	std::uint32_t *out = points_.data(), *outEnd = out + points_.size() - kPointsPadding;
+	std::uint32_t *cornerOut = corners_.data();
+	const std::uint32_t xy = static_cast<std::uint32_t>(x0) | static_cast<std::uint32_t>(y0) << 16;
+	std::uint8_t *const p0 = L + y0 * w + x0;
+	const std::int32_t toEdge = static_cast<std::int32_t>(reinterpret_cast<std::uintptr_t>(edges.pixels.data()) -
+							      reinterpret_cast<std::uintptr_t>(L));
+	const unsigned mask0 = kMaskOfIndex.mask[neighbourIndex(p0, w)];
+	if (mask0 == 0) {
+		*p0 = kFollowedRightBg; /* isolated pixel */
+		*out++ = xy;
+		*cornerOut = xy;
+		cornerOut += (p0[toEdge] >> 1) & 1;
+		steps_ = 1;
+		cornerCount_ = static_cast<int>(cornerOut - corners_.data());
+		return;
+	}
+	const auto turned = static_cast<std::uint8_t>(mask0 << (7 - fromDir) | mask0 >> (fromDir + 1));
+	const int d1 = (fromDir - std::countl_zero(turned)) & 7;
+	const std::uint8_t *const p1 = p0 + kDx[d1] + kDy[d1] * w;
+	const std::size_t maxSteps = 4 * labels_.size();
+	FollowAsm a{ p0, xy, out, cornerOut, static_cast<std::uint32_t>(d1) << 9, stepTable_.data() + kStepTableAt,
+		     static_cast<std::int32_t>(-w - 1), static_cast<std::int32_t>(w - 1), toEdge, p1, outEnd,
+		     0x00070707u };
+	/* The walk returns at p1 and when the points are full, after storing
+	 * the point; the rest of such a step is done here, as follow() does. */
+	for (;;) {
+		frappe_armv6_follow(&a);
+		if (a.out == outEnd) [[unlikely]] {
+			if (points_.size() > maxSteps)
+				break;
+			const std::size_t n = points_.size(), nc = static_cast<std::size_t>(a.cout - corners_.data());
+			points_.resize(2 * n);
+			corners_.resize(2 * n);
+			outEnd = points_.data() + points_.size() - kPointsPadding;
+			a.out = points_.data() + (n - kPointsPadding);
+			a.cout = corners_.data() + nc;
+			a.outEnd = outEnd;
+		}
+		const std::int32_t step = static_cast<std::int32_t>(a.s);
+		std::uint8_t *const next = a.p + (step >> 12);
+		if (a.p == p1 && next == p0)
+			break;
+		a.s = static_cast<std::uint32_t>(step) & 0xE00u;
+		a.xy += static_cast<std::uint32_t>(kDxyBack[a.s >> 9]);
+		a.p = next;
+	}
+	steps_ = static_cast<int>(a.out - points_.data());
+	cornerCount_ = static_cast<int>(a.cout - corners_.data());
+}
+#endif
 
 /* The paper's rule is "exactly four corner clusters". Noise adds clusters
  * part-way along a side, so with more than four the four spanning the
@@ -753,7 +929,12 @@ bool ContourTracer::acceptQuad(const TraceParams &params, int w, int h, Quad &qu
 	}
 	for (int i = 0; i < 4; ++i) {
 		const SideLine side = SideLine::between(q[i], q[(i + 1) & 3]);
-		if (std::popcount(sideCoverage(pts, n, side, tol)) < kBins * 7 / 16)
+#ifdef FRAPPE_HAVE_ARMV6_TRACE
+		const std::uint32_t covered = sideCoverageV6(pts, n, side, tol, w + h);
+#else
+		const std::uint32_t covered = sideCoverage(pts, n, side, tol);
+#endif
+		if (std::popcount(covered) < kBins * 7 / 16)
 			return false;
 	}
 	return true;

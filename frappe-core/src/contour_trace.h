@@ -73,6 +73,10 @@ public:
 	/// Borders followed in the last call, for statistics.
 	int bordersFollowed() const { return borders_; }
 
+	/// Walks borders with the portable C++ loop even where an assembly
+	/// one exists (ARMv6): for the tests that compare the two.
+	void usePortableWalk(bool on) { portableWalk_ = on; }
+
 private:
 	struct Cluster {
 		std::int64_t sx, sy; ///< sums of member coordinates
@@ -81,6 +85,7 @@ private:
 	};
 	void buildStepTables(int w);
 	void follow(int x, int y, int fromDir, const TraceMap &edges);
+	void followV6(int x, int y, int fromDir, const TraceMap &edges); ///< ARMv6 builds only
 	void clusterCorners();
 	/// The last border's bounding box spans `span` both ways, and its
 	/// length is at most maxWinding times the perimeter of the box.
@@ -128,6 +133,7 @@ private:
 	bool tooManyClusters_ = false;
 	int borders_ = 0;
 	int stride_ = 0;
+	bool portableWalk_ = false;
 	std::int64_t radius2Floor_ = 16; ///< floor(cluster_radius^2)
 };
 

@@ -140,6 +140,15 @@ bool edgeSpan(const GradRows &rows, int x0, int x1, const FrontEndParams &params
 
 void markTiles(const std::uint8_t *edgeRow, int w, std::uint8_t *tileRow)
 {
+#ifdef FRAPPE_HAVE_ARMV6_KERNELS
+	markTilesV6(edgeRow, w, tileRow);
+#else
+	markTilesScalar(edgeRow, w, tileRow);
+#endif
+}
+
+void markTilesScalar(const std::uint8_t *edgeRow, int w, std::uint8_t *tileRow)
+{
 	int x0 = 0, t = 0;
 	for (; x0 + EdgeMap::kTile <= w; x0 += EdgeMap::kTile, ++t) {
 		std::uint64_t a, b;

@@ -71,6 +71,8 @@ bool edgeSpan(const GradRows &rows, int x0, int x1, const FrontEndParams &params
 
 /// ORs each 16-pixel run of an edge row into its tile's occupancy byte.
 void markTiles(const std::uint8_t *edgeRow, int w, std::uint8_t *tileRow);
+/// markTiles' portable form, the reference of the ARMv6 one.
+void markTilesScalar(const std::uint8_t *edgeRow, int w, std::uint8_t *tileRow);
 
 /// One band of the front end: edge rows y0 .. y1-1 (1 <= y0, y1 <= h-1).
 struct BandJob {
@@ -108,6 +110,8 @@ const RowKernels &bestRowKernels();
 /// but their own row layouts: the smoothed rows lane-split (below), and the
 /// gradient row's (gx, gy) as int16 pairs in `gx` (`gy` unused).
 const RowKernels &armv6RowKernels();
+/// markTiles by LDM where the row is word aligned (front_end_armv6.cpp).
+void markTilesV6(const std::uint8_t *edgeRow, int w, std::uint8_t *tileRow);
 /// Where the ARMv6 smoothing stores pixel x of a row: as a uint16, per four
 /// pixels 4k .. 4k+3 the words (p0, p2), (p1, p3).
 inline std::size_t armv6SmoothedOffset(int x)

@@ -129,6 +129,70 @@ bool darkRowScalar(const std::uint8_t *d, const std::uint8_t *mid, int w, std::u
 	return any != 0;
 }
 
+void tileExtremesScalar(const std::uint8_t *rows, std::ptrdiff_t stride, int n, int w, std::uint8_t *tmin,
+			std::uint8_t *tmax)
+{
+	for (int i = 0; i * kRegionTile < w; ++i) {
+		std::uint8_t lo = 255, hi = 0;
+		for (int y = 0; y < n; ++y)
+			for (int x = i * kRegionTile; x < std::min(w, (i + 1) * kRegionTile); ++x) {
+				lo = std::min(lo, rows[y * stride + x]);
+				hi = std::max(hi, rows[y * stride + x]);
+			}
+		tmin[i] = lo;
+		tmax[i] = hi;
+	}
+}
+
+void spreadTilesScalar(std::uint8_t *tileMin, std::uint8_t *tileMax, int tx, int ty, std::uint8_t *work)
+{
+	/* Across, through a copy with the end tiles repeated, then down,
+	 * keeping the row above aside. */
+	std::uint8_t *__restrict a = work, *__restrict b = work + tx + 2;
+	for (int j = 0; j < ty; ++j) {
+		std::uint8_t *__restrict tmin = tileMin + static_cast<std::size_t>(j) * tx;
+		std::uint8_t *__restrict tmax = tileMax + static_cast<std::size_t>(j) * tx;
+		std::memcpy(a + 1, tmin, tx);
+		std::memcpy(b + 1, tmax, tx);
+		a[0] = a[1];
+		a[tx + 1] = a[tx];
+		b[0] = b[1];
+		b[tx + 1] = b[tx];
+		for (int i = 0; i < tx; ++i) {
+			tmin[i] = std::min(std::min(a[i], a[i + 1]), a[i + 2]);
+			tmax[i] = std::max(std::max(b[i], b[i + 1]), b[i + 2]);
+		}
+	}
+	std::uint8_t *__restrict upMin = b + tx + 2, *__restrict upMax = upMin + tx;
+	for (int j = 0; j < ty; ++j) {
+		std::uint8_t *__restrict tmin = tileMin + static_cast<std::size_t>(j) * tx;
+		std::uint8_t *__restrict tmax = tileMax + static_cast<std::size_t>(j) * tx;
+		const std::uint8_t *__restrict dnMin = j + 1 < ty ? tmin + tx : tmin;
+		const std::uint8_t *__restrict dnMax = j + 1 < ty ? tmax + tx : tmax;
+		if (j == 0) {
+			std::memcpy(upMin, tmin, tx);
+			std::memcpy(upMax, tmax, tx);
+		}
+		for (int i = 0; i < tx; ++i) {
+			const std::uint8_t m = tmin[i], n = tmax[i];
+			tmin[i] = std::min(std::min(upMin[i], m), dnMin[i]);
+			tmax[i] = std::max(std::max(upMax[i], n), dnMax[i]);
+			upMin[i] = m;
+			upMax[i] = n;
+		}
+	}
+}
+
+bool darkRowTilesScalar(const std::uint8_t *d, const std::uint8_t *mid, int w, std::uint8_t *out,
+			std::uint8_t *tiles)
+{
+	if (!darkRowScalar(d, mid, w, out))
+		return false;
+	for (int x = 0; x < w; ++x)
+		tiles[x / TraceMap::kTile] |= out[x];
+	return true;
+}
+
 #ifdef FRAPPE_HAVE_HWY
 HWY_EXPORT(DecimateRow);
 HWY_EXPORT(DarkRow);
@@ -155,7 +219,11 @@ bool darkRow(const std::uint8_t *d, const std::uint8_t *mid, int w, std::uint8_t
 #else
 void decimateRow(const std::uint8_t *r0, const std::uint8_t *r1, int w, std::uint8_t *out)
 {
+#ifdef FRAPPE_HAVE_ARMV6_REGION
+	decimateRowV6(r0, r1, w, out);
+#else
 	decimateRowScalar(r0, r1, w, out);
+#endif
 }
 
 void extremePairs(const std::uint8_t *a0, const std::uint8_t *a1, int w, std::uint8_t *out, bool least)
@@ -184,13 +252,20 @@ void regionMap(const ImageView &src, float srcScale, int minContrast, TraceMap &
 	s.decimated.resize(static_cast<std::size_t>(w) * h);
 	s.tileMin.resize(nt);
 	s.tileMax.resize(nt);
-	s.lo.resize(std::max(w, tx + 2));
-	s.hi.resize(std::max(w, tx + 2));
+	s.lo.resize(w);
 	s.mid.resize(std::max(tx * T, 2 * tx));
 	std::uint8_t *dec = s.decimated.data();
 	for (int y = 0; y < h; ++y)
 		decimateRow(src.row(2 * y), src.row(2 * y + 1), w, dec + static_cast<std::size_t>(y) * w);
 
+#ifdef FRAPPE_HAVE_ARMV6_REGION
+	/* Each tile's darkest and brightest in one pass over its rows: a
+	 * tile's row is one word. */
+	for (int j = 0; j < ty; ++j)
+		tileExtremesV6(dec + static_cast<std::size_t>(T * j) * w, w, std::min(T, h - T * j), w,
+			       s.tileMin.data() + static_cast<std::size_t>(j) * tx,
+			       s.tileMax.data() + static_cast<std::size_t>(j) * tx);
+#else
 	/* Each tile's darkest and brightest, by two halvings of the
 	 * decimated image: extremes of 2 x 2 pixels, then of 2 x 2 of those.
 	 * A row or column left over at the bottom or right (odd sizes) is
@@ -225,50 +300,25 @@ void regionMap(const ImageView &src, float srcScale, int minContrast, TraceMap &
 		extremePairs(l1min, l1min2, tx, s.tileMin.data() + static_cast<std::size_t>(j) * tx, true);
 		extremePairs(l1max, l1max2, tx, s.tileMax.data() + static_cast<std::size_t>(j) * tx, false);
 	}
-	/* Then over the 3 x 3 tiles around each: across, through a copy with
-	 * the end tiles repeated, then down, keeping the row above aside. */
-	std::uint8_t *__restrict a = s.lo.data(), *__restrict b = s.hi.data();
-	for (int j = 0; j < ty; ++j) {
-		std::uint8_t *__restrict tmin = s.tileMin.data() + static_cast<std::size_t>(j) * tx;
-		std::uint8_t *__restrict tmax = s.tileMax.data() + static_cast<std::size_t>(j) * tx;
-		std::memcpy(a + 1, tmin, tx);
-		std::memcpy(b + 1, tmax, tx);
-		a[0] = a[1];
-		a[tx + 1] = a[tx];
-		b[0] = b[1];
-		b[tx + 1] = b[tx];
-		for (int i = 0; i < tx; ++i) {
-			tmin[i] = std::min(std::min(a[i], a[i + 1]), a[i + 2]);
-			tmax[i] = std::max(std::max(b[i], b[i + 1]), b[i + 2]);
-		}
-	}
-	std::uint8_t *__restrict upMin = s.mid.data(), *__restrict upMax = s.mid.data() + tx;
-	for (int j = 0; j < ty; ++j) {
-		std::uint8_t *__restrict tmin = s.tileMin.data() + static_cast<std::size_t>(j) * tx;
-		std::uint8_t *__restrict tmax = s.tileMax.data() + static_cast<std::size_t>(j) * tx;
-		const std::uint8_t *__restrict dnMin = j + 1 < ty ? tmin + tx : tmin;
-		const std::uint8_t *__restrict dnMax = j + 1 < ty ? tmax + tx : tmax;
-		if (j == 0) {
-			std::memcpy(upMin, tmin, tx);
-			std::memcpy(upMax, tmax, tx);
-		}
-		for (int i = 0; i < tx; ++i) {
-			const std::uint8_t m = tmin[i], n = tmax[i];
-			tmin[i] = std::min(std::min(upMin[i], m), dnMin[i]);
-			tmax[i] = std::max(std::max(upMax[i], n), dnMax[i]);
-			upMin[i] = m;
-			upMax[i] = n;
-		}
-	}
+#endif
+	/* Then over the 3 x 3 tiles around each. */
+	s.spread.resize(4 * static_cast<std::size_t>(tx) + 4);
+#ifdef FRAPPE_HAVE_ARMV6_REGION
+	spreadTilesV6(s.tileMin.data(), s.tileMax.data(), tx, ty, s.spread.data());
+#else
+	spreadTilesScalar(s.tileMin.data(), s.tileMax.data(), tx, ty, s.spread.data());
+#endif
 
 	std::fill(out.tiles.begin(), out.tiles.end(), 0);
 	std::fill_n(out.pixels.data(), w, 0);
 	std::fill_n(out.pixels.data() + static_cast<std::size_t>(h - 1) * w, w, 0);
 	constexpr int ET = TraceMap::kTile;
 	std::uint8_t *mid = s.mid.data();
+#ifndef FRAPPE_HAVE_ARMV6_REGION
 	std::uint8_t *acc = s.lo.data(); /* the OR of a tile row's dark rows */
 	bool accAny = false;
 	std::fill_n(acc, w, 0);
+#endif
 	for (int j = 0; j < ty; ++j) {
 		/* The threshold of each tile of this row: the midpoint, rounded
 		 * up, of the extremes around it, or 0 (no pixel is dark) where
@@ -284,6 +334,11 @@ void regionMap(const ImageView &src, float srcScale, int minContrast, TraceMap &
 		mid[0] = mid[w - 1] = 0; /* the outermost columns are never dark */
 		for (int y = std::max(1, j * T); y < std::min(h - 1, (j + 1) * T); ++y) {
 			std::uint8_t *o = out.pixels.data() + static_cast<std::size_t>(y) * w;
+#ifdef FRAPPE_HAVE_ARMV6_REGION
+			/* Each row marks its tiles itself: no row of ORs. */
+			darkRowV6(dec + static_cast<std::size_t>(y) * w, mid, w, o,
+				  out.tiles.data() + static_cast<std::size_t>(y / ET) * out.tiles_x);
+#else
 			if (darkRow(dec + static_cast<std::size_t>(y) * w, mid, w, o)) {
 				for (int x = 0; x < w; ++x)
 					acc[x] |= o[x];
@@ -300,6 +355,7 @@ void regionMap(const ImageView &src, float srcScale, int minContrast, TraceMap &
 				std::fill_n(acc, w, 0);
 				accAny = false;
 			}
+#endif
 		}
 	}
 }

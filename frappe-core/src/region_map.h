@@ -5,6 +5,7 @@
 // vectorised where Highway is built in, beside their scalar references.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -19,7 +20,7 @@ constexpr int kRegionTile = 4;
 /// Working rows of regionMap(), kept between frames.
 struct RegionScratch {
 	std::vector<std::uint8_t> decimated; ///< the half-resolution image
-	std::vector<std::uint8_t> tileMin, tileMax, lo, hi, mid, level;
+	std::vector<std::uint8_t> tileMin, tileMax, lo, mid, level, spread;
 };
 
 /// Fills `out` with the dark pixels of `src` at half its resolution;
@@ -40,5 +41,31 @@ bool darkRow(const std::uint8_t *d, const std::uint8_t *mid, int w, std::uint8_t
 void decimateRowScalar(const std::uint8_t *r0, const std::uint8_t *r1, int w, std::uint8_t *out);
 void extremePairsScalar(const std::uint8_t *a0, const std::uint8_t *a1, int w, std::uint8_t *out, bool least);
 bool darkRowScalar(const std::uint8_t *d, const std::uint8_t *mid, int w, std::uint8_t *out);
+
+/// One row of tiles in one pass, the form the ARMv6 kernels take: tmin[i]
+/// and tmax[i] = the least and greatest of columns [4i, min(4i + 4, w)) of
+/// the n rows (1 <= n <= 4) at `rows`, `stride` bytes apart.
+void tileExtremesScalar(const std::uint8_t *rows, std::ptrdiff_t stride, int n, int w, std::uint8_t *tmin,
+			std::uint8_t *tmax);
+/// Each of the tx x ty tiles' extremes becomes the least (greatest) over
+/// the 3 x 3 tiles around it that exist, in place. work: 4 tx + 4 bytes.
+void spreadTilesScalar(std::uint8_t *tileMin, std::uint8_t *tileMax, int tx, int ty, std::uint8_t *work);
+/// darkRowScalar, and tiles[x / 16] = kEdge for every x where out[x] is
+/// (other tile bytes left as they are).
+bool darkRowTilesScalar(const std::uint8_t *d, const std::uint8_t *mid, int w, std::uint8_t *out,
+			std::uint8_t *tiles);
+
+#if defined(__ARM_FEATURE_SIMD32) && defined(__ARMEL__) && !defined(FRAPPE_HAVE_HWY)
+#define FRAPPE_HAVE_ARMV6_REGION 1
+/// ARMv6 SIMD32 forms of decimateRowScalar, tileExtremesScalar,
+/// spreadTilesScalar and darkRowTilesScalar (region_map_armv6.cpp), byte
+/// for byte the same.
+void decimateRowV6(const std::uint8_t *r0, const std::uint8_t *r1, int w, std::uint8_t *out);
+void tileExtremesV6(const std::uint8_t *rows, std::ptrdiff_t stride, int n, int w, std::uint8_t *tmin,
+		    std::uint8_t *tmax);
+/// darkRowV6 returns nothing: the tiles say whether any pixel is dark.
+void spreadTilesV6(std::uint8_t *tileMin, std::uint8_t *tileMax, int tx, int ty, std::uint8_t *work);
+void darkRowV6(const std::uint8_t *d, const std::uint8_t *mid, int w, std::uint8_t *out, std::uint8_t *tiles);
+#endif
 
 } // namespace frappe::detail

@@ -386,6 +386,12 @@ OutlineExtremes outlineExtremesScalar(const std::uint32_t *pts, std::size_t n)
 	return e;
 }
 
+void labelsFromEdgesScalar(const std::uint8_t *edges, std::size_t n, std::uint8_t *labels)
+{
+	for (std::size_t i = 0; i < n; ++i)
+		labels[i] = edges[i] & kUnfollowed;
+}
+
 PointsBox pointsBoxScalar(const std::uint32_t *pts, std::size_t n)
 {
 	std::uint32_t lo = pts[0], hi = lo, minX = lo & 0xFFFFu, maxX = minX;
@@ -437,12 +443,13 @@ void borderStartBits(const std::uint8_t *labels, int x0, int x1, std::uint64_t *
 	HWY_DYNAMIC_DISPATCH(BorderStartBits)(labels, x0, x1, bits);
 }
 #else
-/* A plain loop over local pointers, which the compiler vectorises where it
- * can. */
 void labelsFromEdges(const std::uint8_t *edges, std::size_t n, std::uint8_t *labels)
 {
-	for (std::size_t i = 0; i < n; ++i)
-		labels[i] = edges[i] & kUnfollowed;
+#ifdef FRAPPE_HAVE_ARMV6_TRACE
+	labelsFromEdgesV6(edges, n, labels);
+#else
+	labelsFromEdgesScalar(edges, n, labels); /* the compiler's word loop */
+#endif
 }
 
 void neighbourMasks(const std::uint8_t *row, std::ptrdiff_t stride, int x0, int x1, std::uint8_t *out)
@@ -462,12 +469,20 @@ std::uint32_t sideCoverage(const std::uint32_t *pts, std::size_t n, const SideLi
 
 OutlineExtremes outlineExtremes(const std::uint32_t *pts, std::size_t n)
 {
+#ifdef FRAPPE_HAVE_ARMV6_TRACE
+	return outlineExtremesV6(pts, n);
+#else
 	return outlineExtremesScalar(pts, n);
+#endif
 }
 
 PointsBox pointsBox(const std::uint32_t *pts, std::size_t n)
 {
+#ifdef FRAPPE_HAVE_ARMV6_TRACE
+	return pointsBoxV6(pts, n);
+#else
 	return pointsBoxScalar(pts, n);
+#endif
 }
 #endif
 

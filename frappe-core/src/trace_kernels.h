@@ -92,5 +92,18 @@ void borderStartBitsScalar(const std::uint8_t *labels, int x0, int x1, std::uint
 std::uint32_t sideCoverageScalar(const std::uint32_t *pts, std::size_t n, const SideLine &side, float tol);
 OutlineExtremes outlineExtremesScalar(const std::uint32_t *pts, std::size_t n);
 PointsBox pointsBoxScalar(const std::uint32_t *pts, std::size_t n);
+void labelsFromEdgesScalar(const std::uint8_t *edges, std::size_t n, std::uint8_t *labels);
+
+#if defined(__ARM_FEATURE_SIMD32) && defined(__ARM_FEATURE_DSP) && defined(__ARMEL__) && !defined(FRAPPE_HAVE_HWY)
+#define FRAPPE_HAVE_ARMV6_TRACE 1
+/// ARMv6 SIMD32 forms (trace_kernels_armv6.cpp), the scalar ones' results
+/// exactly; the only ones used on such a build.
+void labelsFromEdgesV6(const std::uint8_t *edges, std::size_t n, std::uint8_t *labels);
+OutlineExtremes outlineExtremesV6(const std::uint32_t *pts, std::size_t n);
+PointsBox pointsBoxV6(const std::uint32_t *pts, std::size_t n);
+/// sideCoverage for points with x + y <= bound (the map's width plus
+/// height): most points are rejected in integers first.
+std::uint32_t sideCoverageV6(const std::uint32_t *pts, std::size_t n, const SideLine &side, float tol, int bound);
+#endif
 
 } // namespace frappe::detail

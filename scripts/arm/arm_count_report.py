@@ -17,7 +17,7 @@ from collections import defaultdict
 
 CLASSES = ["alu", "mul", "media_simd32", "branch", "load", "store", "ldm", "stm",
            "vfp", "vfp_ldst", "thumb16", "other"]
-STAGES = ["adaptive_scale", "front_end", "trace", "refine", "warp", "decode", "detector", "other"]
+STAGES = ["adaptive_scale", "front_end", "region_map", "trace", "refine", "warp", "decode", "detector", "other"]
 
 
 def percentile(v, p):
@@ -100,9 +100,11 @@ def stage_of(obj, name):
     base = re.sub(r"^src_", "", obj.replace(".cpp.o", "").replace(".o", ""))
     if base.startswith("front_end"):
         return "front_end"
+    if base.startswith("region_map"):
+        return "region_map"
     if base == "adaptive_scale":
         return "adaptive_scale"
-    if base in ("contour_trace", "trace_kernels"):
+    if base == "contour_trace" or base.startswith("trace_kernels"):
         return "trace"
     if base == "corner_refine":
         return "refine"
@@ -113,7 +115,7 @@ def stage_of(obj, name):
         if "warpMarker" in name:
             return "warp"
         return "decode"
-    if base in ("homography", "warp_kernels"):
+    if base == "homography" or base.startswith("warp_kernels"):
         return "warp"
     if base in ("dictionary", "dictionaries"):
         return "decode"
@@ -163,9 +165,30 @@ def main():
         binfo[b] = (dem, obj, stage_of(obj, dem))
     binfo[0] = ("[library code before any call site]", "?", "other")
 
+    # A marker seen twice in a row (an older plugin fired again where the
+    # marker function straddles a page): the second one's deltas belong to
+    # the interval that ends at the next marker.
+    merged = []
+    carry = None
+    for m in marks:
+        label, total, cls, bk = m
+        if carry is not None:
+            cls = [x + y for x, y in zip(cls, carry[2])]
+            bk = dict(bk)
+            for b, (s_, l_) in carry[3].items():
+                o = bk.get(b, (0, 0))
+                bk[b] = (o[0] + s_, o[1] + l_)
+            carry = None
+        if merged and merged[-1][0] == label and label != "exit":
+            carry = [label, total, cls, bk]
+            continue
+        merged.append([label, total, cls, bk])
+    if len(merged) != len(marks):
+        print(f"warning: {len(marks) - len(merged)} repeated markers merged", file=sys.stderr)
+    marks = merged
+
     # split the marks into frames
     frames = []   # dict per frame
-    i = 0
     cur = None
     for label, total, cls, bk in marks:
         if label == "frappe_begin":
@@ -177,6 +200,9 @@ def main():
             cur["be"] = (cls, bk)
         elif label == "opencv_end" and cur is not None:
             cur["cv"] = (cls, bk)
+    incomplete = [k for k, fr in enumerate(frames) if fr["fe"] is None or fr["be"] is None]
+    if incomplete:
+        sys.exit(f"arm_count_report: frames {incomplete[:5]} lack their front/back markers")
     if len(frames) != len(sizes):
         print(f"warning: {len(frames)} counted frames but {len(sizes)} images in the driver output",
               file=sys.stderr)

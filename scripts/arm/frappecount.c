@@ -195,7 +195,6 @@ static void tb_trans(qemu_plugin_id_t id, struct qemu_plugin_tb *tb)
 {
     size_t n = qemu_plugin_tb_n_insns(tb);
     size_t lib_insns = 0;
-    const char *prev_sym = NULL;
     for (size_t k = 0; k < n; k++) {
         struct qemu_plugin_insn *insn = qemu_plugin_tb_get_insn(tb, k);
         const char *s = qemu_plugin_insn_symbol(insn);
@@ -214,7 +213,6 @@ static void tb_trans(qemu_plugin_id_t id, struct qemu_plugin_tb *tb)
          * __udivsi3, ...): counted to the caller */
         if (!s || !*s || (s[0] == '_' && s[1] == '_')) {
             lib_insns++;
-            prev_sym = NULL;
             continue;
         }
         uint32_t b = bucket_of(s, va);
@@ -224,11 +222,15 @@ static void tb_trans(qemu_plugin_id_t id, struct qemu_plugin_tb *tb)
             qemu_plugin_register_vcpu_insn_exec_cb(insn, on_call, QEMU_PLUGIN_CB_NO_REGS,
                                                    (void *)(uintptr_t)b);
         }
-        if (strncmp(s, MARK_PREFIX, strlen(MARK_PREFIX)) == 0 && (k == 0 || prev_sym != s)) {
+        /* Only at the marker's entry: a TB ends at a page boundary, so a
+         * marker that straddles one is also met at the start of a second
+         * TB (k == 0) in its middle, and would fire twice per call. The
+         * first TB of a marker always starts at its entry (it is entered
+         * by a call), so its lowest address seen is the entry. */
+        if (strncmp(s, MARK_PREFIX, strlen(MARK_PREFIX)) == 0 && va == buckets[b].entry) {
             qemu_plugin_register_vcpu_insn_exec_cb(insn, on_mark, QEMU_PLUGIN_CB_NO_REGS,
                                                    (void *)(s + strlen(MARK_PREFIX)));
         }
-        prev_sym = s;
     }
     if (lib_insns) {
         qemu_plugin_register_vcpu_tb_exec_cb(tb, on_lib_tb, QEMU_PLUGIN_CB_NO_REGS,

@@ -11,7 +11,10 @@
 //
 //   frappe-count --list LIST.txt [--dictionary aruco_mip_36h12] [--max N]
 //                [--no-opencv] [--out-frappe F.jsonl] [--out-opencv O.jsonl]
+//                [--region-contrast C]
 //
+// --region-contrast sets Config::region_contrast (0 turns the region map and
+// its candidates off), to measure what that path costs.
 // frappe runs as Detector::detect() does, split into its two public halves
 // (runFrontEnd, then runBackEnd) with a marker between them. OpenCV gets the
 // same setup as tests/bench/frappe_bench.cpp: the dictionary as a custom
@@ -161,6 +164,7 @@ int main(int argc, char **argv)
 	std::string dictName = "aruco_mip_36h12", list, outF, outO;
 	int maxImages = 0;
 	bool useOpencv = true;
+	float regionContrast = -1.0f; /* < 0: the Config default */
 	for (int i = 1; i < argc; ++i) {
 		const std::string a = argv[i];
 		auto value = [&]() -> std::string {
@@ -182,9 +186,11 @@ int main(int argc, char **argv)
 			outF = value();
 		else if (a == "--out-opencv")
 			outO = value();
+		else if (a == "--region-contrast")
+			regionContrast = std::stof(value());
 		else {
 			std::cerr << "usage: frappe-count --list L [--dictionary D] [--max N] [--no-opencv] "
-				     "[--out-frappe F] [--out-opencv O]\n";
+				     "[--out-frappe F] [--out-opencv O] [--region-contrast C]\n";
 			return 2;
 		}
 	}
@@ -228,6 +234,8 @@ int main(int argc, char **argv)
 	frappe::Config cfg;
 	cfg.dictionary = dictName;
 	cfg.threads = 1;
+	if (regionContrast >= 0.0f)
+		cfg.region_contrast = regionContrast;
 	frappe::Detector det(cfg);
 	std::ofstream fo, oo;
 	if (!outF.empty())

@@ -88,6 +88,47 @@ TEST(RegionMap, RowKernelsMatchTheirScalarReferences)
 	});
 }
 
+/* The one-pass references of the ARMv6 kernels (tests/armv6 compares the
+ * kernels with them): a tile's extremes over its rows and columns that
+ * exist, and the dark row marking its 16-pixel tiles. */
+TEST(RegionMap, OnePassReferences)
+{
+	std::mt19937 rng(5);
+	for (int w : { 1, 3, 4, 5, 8, 17, 33, 320 })
+		for (int n = 1; n <= 4; ++n) {
+			const int stride = w + 3;
+			const auto rows = randomBytes(static_cast<std::size_t>(4) * stride, rng);
+			const int tx = (w + 3) / 4;
+			std::vector<std::uint8_t> mn(tx + 1, 0xAA), mx(tx + 1, 0xAA);
+			detail::tileExtremesScalar(rows.data(), stride, n, w, mn.data(), mx.data());
+			for (int i = 0; i < tx; ++i) {
+				int lo = 255, hi = 0;
+				for (int y = 0; y < n; ++y)
+					for (int x = 4 * i; x < std::min(w, 4 * i + 4); ++x) {
+						lo = std::min<int>(lo, rows[y * stride + x]);
+						hi = std::max<int>(hi, rows[y * stride + x]);
+					}
+				EXPECT_EQ(mn[i], lo) << "w " << w << " n " << n << " tile " << i;
+				EXPECT_EQ(mx[i], hi) << "w " << w << " n " << n << " tile " << i;
+			}
+			EXPECT_EQ(mn[tx], 0xAA);
+			EXPECT_EQ(mx[tx], 0xAA);
+
+			const auto d = randomBytes(w, rng), mid = randomBytes(w, rng);
+			const int nt = (w + 15) / 16;
+			std::vector<std::uint8_t> tiles(nt), want(w), got(w);
+			for (auto &t : tiles)
+				t = static_cast<std::uint8_t>(rng() & 1);
+			auto wantTiles = tiles;
+			const bool anyWant = detail::darkRowScalar(d.data(), mid.data(), w, want.data());
+			for (int x = 0; x < w; ++x)
+				wantTiles[x / 16] |= want[x];
+			EXPECT_EQ(detail::darkRowTilesScalar(d.data(), mid.data(), w, got.data(), tiles.data()), anyWant);
+			EXPECT_EQ(got, want);
+			EXPECT_EQ(tiles, wantTiles);
+		}
+}
+
 TEST(RegionMap, FollowsTheDocumentedRuleAtOddSizesAndStrides)
 {
 	onEveryTarget([](const char *target) {
