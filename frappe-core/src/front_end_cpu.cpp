@@ -75,8 +75,7 @@ public:
 	bool makesRegionMap() const override { return true; }
 
 private:
-	void runBand(const ImageView &src, const FrontEndParams &params, EdgeMap &out,
-		     int y0, int y1, detail::RowScratch &scratch);
+	void runBand(const detail::BandJob &job);
 
 	int threads_;
 	const detail::RowKernels &kernels_;
@@ -126,24 +125,33 @@ void CpuFrontEnd::run(const ImageView &image, float scale, const FrontEndParams 
 		y0 = std::max(1, t0 * EdgeMap::kTile);
 		y1 = std::min(h - 1, t1 * EdgeMap::kTile);
 	};
-	if (bands == 1) {
-		runBand(src, params, out, 1, h - 1, scratch_[0]);
-	} else {
-		auto band = [&](int b) {
-			int y0, y1;
-			bandRows(b, y0, y1);
-			runBand(src, params, out, y0, y1, scratch_[b]);
-		};
+	/* The region map's 2x2 means are made by the bands, which read the
+	 * frame's rows anyway: its rows of tile row t0 .. t1-1 are means rows
+	 * 8 t0 .. 8 t1-1. */
+	const bool regions = detail::makesRegionMap(w, h, params.region_contrast);
+	if (regions)
+		regionScratch_.decimated.resize(static_cast<std::size_t>(w / 2) * (h / 2));
+	auto band = [&](int b) {
+		int y0, y1;
+		bandRows(b, y0, y1);
+		detail::BandJob job{ src, &params, &out, y0, y1, &scratch_[b] };
+		if (regions) {
+			job.half = regionScratch_.decimated.data();
+			job.hy0 = tileRows * b / bands * (EdgeMap::kTile / 2);
+			job.hy1 = b + 1 == bands ? h / 2 : tileRows * (b + 1) / bands * (EdgeMap::kTile / 2);
+		}
+		runBand(job);
+	};
+	if (bands == 1)
+		band(0);
+	else
 		pool_.run(bands, band);
-	}
-	detail::regionMap(src, out.scale, params.region_contrast, out.regions, regionScratch_);
+	detail::regionMapFromMeans(w, h, out.scale, params.region_contrast, out.regions, regionScratch_);
 }
 
-/* Edge rows y0 .. y1-1 (1 <= y0, y1 <= h-1). */
-void CpuFrontEnd::runBand(const ImageView &src, const FrontEndParams &params, EdgeMap &out,
-			  int y0, int y1, detail::RowScratch &s)
+/* Edge rows y0 .. y1-1 (1 <= y0, y1 <= h-1), and the means rows of the job. */
+void CpuFrontEnd::runBand(const detail::BandJob &job)
 {
-	const detail::BandJob job{ src, &params, &out, y0, y1, &s };
 	if (kernels_.band)
 		kernels_.band(job);
 	else

@@ -10,6 +10,7 @@
 
 #include "frappe/edge_map.h"
 #include "frappe/image.h"
+#include "region_map.h"
 
 namespace frappe::detail {
 
@@ -75,12 +76,17 @@ void markTiles(const std::uint8_t *edgeRow, int w, std::uint8_t *tileRow);
 void markTilesScalar(const std::uint8_t *edgeRow, int w, std::uint8_t *tileRow);
 
 /// One band of the front end: edge rows y0 .. y1-1 (1 <= y0, y1 <= h-1).
+/// With `half`, also rows hy0 .. hy1-1 of the frame's 2x2 means (the region
+/// map's first step, decimateRow), w / 2 a row, made as the band reads the
+/// frame's rows anyway.
 struct BandJob {
 	ImageView src;
 	const FrontEndParams *params;
 	EdgeMap *out;
 	int y0, y1;
 	RowScratch *scratch;
+	std::uint8_t *half = nullptr;
+	int hy0 = 0, hy1 = 0;
 };
 
 /// The row kernels one front end uses: the portable scalar ones above (or
@@ -149,10 +155,14 @@ void runBandRows(const Kernels &k, const BandJob &job)
 			k.gradient(smoothed(r - 1), smoothed(r), smoothed(r + 1), w, s.gx[i].data(),
 				   s.gy[i].data(), s.mag[i].data(), s.separable.data());
 	};
-	/* Rows beyond the frame replicate its first and last row. */
+	/* Rows beyond the frame replicate its first and last row. The 2x2
+	 * means of rows r-1 and r while they are in cache. */
 	auto smoothRow = [&](int r) {
 		k.smooth(src.row(std::max(r - 1, 0)), src.row(r), src.row(std::min(r + 1, h - 1)), w,
 			 smoothed(r), s.columns.data());
+		const int hy = (r - 1) >> 1;
+		if (job.half && (r & 1) && hy >= job.hy0 && hy < job.hy1)
+			decimateRow(src.row(r - 1), src.row(r), w / 2, job.half + static_cast<std::size_t>(hy) * (w / 2));
 	};
 	for (int r = std::max(0, y0 - 2); r <= std::min(h - 1, y0 + 1); ++r)
 		smoothRow(r);

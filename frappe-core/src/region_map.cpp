@@ -96,6 +96,64 @@ bool DarkRow(const std::uint8_t *d, const std::uint8_t *mid, int w, std::uint8_t
 	return found;
 }
 
+/* spreadTilesScalar's two passes with whole vectors of tiles; the tail of
+ * each row as the scalar form does it. */
+void SpreadTiles(std::uint8_t *tileMin, std::uint8_t *tileMax, int tx, int ty, std::uint8_t *work)
+{
+	const hn::ScalableTag<std::uint8_t> d;
+	const int N = static_cast<int>(hn::Lanes(d));
+	std::uint8_t *HWY_RESTRICT a = work, *HWY_RESTRICT b = work + tx + 2;
+	/* Across, through a copy with the end tiles repeated. */
+	for (int j = 0; j < ty; ++j) {
+		std::uint8_t *HWY_RESTRICT tmin = tileMin + static_cast<std::size_t>(j) * tx;
+		std::uint8_t *HWY_RESTRICT tmax = tileMax + static_cast<std::size_t>(j) * tx;
+		std::memcpy(a + 1, tmin, tx);
+		std::memcpy(b + 1, tmax, tx);
+		a[0] = a[1];
+		a[tx + 1] = a[tx];
+		b[0] = b[1];
+		b[tx + 1] = b[tx];
+		int i = 0;
+		for (; i + N <= tx; i += N) {
+			hn::StoreU(hn::Min(hn::Min(hn::LoadU(d, a + i), hn::LoadU(d, a + i + 1)), hn::LoadU(d, a + i + 2)), d,
+				   tmin + i);
+			hn::StoreU(hn::Max(hn::Max(hn::LoadU(d, b + i), hn::LoadU(d, b + i + 1)), hn::LoadU(d, b + i + 2)), d,
+				   tmax + i);
+		}
+		for (; i < tx; ++i) {
+			tmin[i] = std::min(std::min(a[i], a[i + 1]), a[i + 2]);
+			tmax[i] = std::max(std::max(b[i], b[i + 1]), b[i + 2]);
+		}
+	}
+	/* Then down, keeping the row above as it was. */
+	std::uint8_t *HWY_RESTRICT upMin = b + tx + 2, *HWY_RESTRICT upMax = upMin + tx;
+	for (int j = 0; j < ty; ++j) {
+		std::uint8_t *HWY_RESTRICT tmin = tileMin + static_cast<std::size_t>(j) * tx;
+		std::uint8_t *HWY_RESTRICT tmax = tileMax + static_cast<std::size_t>(j) * tx;
+		const std::uint8_t *dnMin = j + 1 < ty ? tmin + tx : tmin;
+		const std::uint8_t *dnMax = j + 1 < ty ? tmax + tx : tmax;
+		if (j == 0) {
+			std::memcpy(upMin, tmin, tx);
+			std::memcpy(upMax, tmax, tx);
+		}
+		int i = 0;
+		for (; i + N <= tx; i += N) {
+			const auto m = hn::LoadU(d, tmin + i), n = hn::LoadU(d, tmax + i);
+			hn::StoreU(hn::Min(hn::Min(hn::LoadU(d, upMin + i), m), hn::LoadU(d, dnMin + i)), d, tmin + i);
+			hn::StoreU(hn::Max(hn::Max(hn::LoadU(d, upMax + i), n), hn::LoadU(d, dnMax + i)), d, tmax + i);
+			hn::StoreU(m, d, upMin + i);
+			hn::StoreU(n, d, upMax + i);
+		}
+		for (; i < tx; ++i) {
+			const std::uint8_t m = tmin[i], n = tmax[i];
+			tmin[i] = std::min(std::min(upMin[i], m), dnMin[i]);
+			tmax[i] = std::max(std::max(upMax[i], n), dnMax[i]);
+			upMin[i] = m;
+			upMax[i] = n;
+		}
+	}
+}
+
 } // namespace HWY_NAMESPACE
 } // namespace frappe::detail
 HWY_AFTER_NAMESPACE();
@@ -194,6 +252,7 @@ bool darkRowTilesScalar(const std::uint8_t *d, const std::uint8_t *mid, int w, s
 }
 
 #ifdef FRAPPE_HAVE_HWY
+HWY_EXPORT(SpreadTiles);
 HWY_EXPORT(DecimateRow);
 HWY_EXPORT(DarkRow);
 HWY_EXPORT(MinPairs);
@@ -210,6 +269,11 @@ void extremePairs(const std::uint8_t *a0, const std::uint8_t *a1, int w, std::ui
 void decimateRow(const std::uint8_t *r0, const std::uint8_t *r1, int w, std::uint8_t *out)
 {
 	HWY_DYNAMIC_DISPATCH(DecimateRow)(r0, r1, w, out);
+}
+
+void spreadTiles(std::uint8_t *tileMin, std::uint8_t *tileMax, int tx, int ty, std::uint8_t *work)
+{
+	HWY_DYNAMIC_DISPATCH(SpreadTiles)(tileMin, tileMax, tx, ty, work);
 }
 
 bool darkRow(const std::uint8_t *d, const std::uint8_t *mid, int w, std::uint8_t *out)
@@ -240,7 +304,21 @@ bool darkRow(const std::uint8_t *d, const std::uint8_t *mid, int w, std::uint8_t
 void regionMap(const ImageView &src, float srcScale, int minContrast, TraceMap &out, RegionScratch &s)
 {
 	const int w = src.width / 2, h = src.height / 2;
-	if (minContrast <= 0 || w < 3 || h < 3) {
+	if (!makesRegionMap(src.width, src.height, minContrast)) {
+		out.resize(0, 0);
+		return;
+	}
+	s.decimated.resize(static_cast<std::size_t>(w) * h);
+	std::uint8_t *dec = s.decimated.data();
+	for (int y = 0; y < h; ++y)
+		decimateRow(src.row(2 * y), src.row(2 * y + 1), w, dec + static_cast<std::size_t>(y) * w);
+	regionMapFromMeans(src.width, src.height, srcScale, minContrast, out, s);
+}
+
+void regionMapFromMeans(int width, int height, float srcScale, int minContrast, TraceMap &out, RegionScratch &s)
+{
+	const int w = width / 2, h = height / 2;
+	if (!makesRegionMap(width, height, minContrast)) {
 		out.resize(0, 0);
 		return;
 	}
@@ -249,14 +327,11 @@ void regionMap(const ImageView &src, float srcScale, int minContrast, TraceMap &
 	constexpr int T = kRegionTile;
 	const int tx = (w + T - 1) / T, ty = (h + T - 1) / T;
 	const std::size_t nt = static_cast<std::size_t>(tx) * ty;
-	s.decimated.resize(static_cast<std::size_t>(w) * h);
 	s.tileMin.resize(nt);
 	s.tileMax.resize(nt);
 	s.lo.resize(w);
 	s.mid.resize(std::max(tx * T, 2 * tx));
-	std::uint8_t *dec = s.decimated.data();
-	for (int y = 0; y < h; ++y)
-		decimateRow(src.row(2 * y), src.row(2 * y + 1), w, dec + static_cast<std::size_t>(y) * w);
+	const std::uint8_t *dec = s.decimated.data();
 
 #ifdef FRAPPE_HAVE_ARMV6_REGION
 	/* Each tile's darkest and brightest in one pass over its rows: a
@@ -305,6 +380,8 @@ void regionMap(const ImageView &src, float srcScale, int minContrast, TraceMap &
 	s.spread.resize(4 * static_cast<std::size_t>(tx) + 4);
 #ifdef FRAPPE_HAVE_ARMV6_REGION
 	spreadTilesV6(s.tileMin.data(), s.tileMax.data(), tx, ty, s.spread.data());
+#elif defined(FRAPPE_HAVE_HWY)
+	spreadTiles(s.tileMin.data(), s.tileMax.data(), tx, ty, s.spread.data());
 #else
 	spreadTilesScalar(s.tileMin.data(), s.tileMax.data(), tx, ty, s.spread.data());
 #endif

@@ -28,6 +28,18 @@ struct RegionScratch {
 /// 0 or `src` is too small for a 3 x 3 map.
 void regionMap(const ImageView &src, float srcScale, int minContrast, TraceMap &out, RegionScratch &scratch);
 
+/// Whether regionMap() makes a map of a src.width x src.height frame.
+inline bool makesRegionMap(int width, int height, int minContrast)
+{
+	return minContrast > 0 && width / 2 >= 3 && height / 2 >= 3;
+}
+
+/// regionMap() from the frame's 2x2 means already made (scratch.decimated,
+/// width / 2 x height / 2, as decimateRow makes them): the CPU front end
+/// makes them as it reads the frame's rows.
+void regionMapFromMeans(int width, int height, float srcScale, int minContrast, TraceMap &out,
+			RegionScratch &scratch);
+
 /// out[x] = the rounded mean of r0[2x], r0[2x + 1], r1[2x], r1[2x + 1] for
 /// x in [0, w).
 void decimateRow(const std::uint8_t *r0, const std::uint8_t *r1, int w, std::uint8_t *out);
@@ -50,6 +62,10 @@ void tileExtremesScalar(const std::uint8_t *rows, std::ptrdiff_t stride, int n, 
 /// Each of the tx x ty tiles' extremes becomes the least (greatest) over
 /// the 3 x 3 tiles around it that exist, in place. work: 4 tx + 4 bytes.
 void spreadTilesScalar(std::uint8_t *tileMin, std::uint8_t *tileMax, int tx, int ty, std::uint8_t *work);
+#ifdef FRAPPE_HAVE_HWY
+/// spreadTilesScalar, vectorised (Highway's best target).
+void spreadTiles(std::uint8_t *tileMin, std::uint8_t *tileMax, int tx, int ty, std::uint8_t *work);
+#endif
 /// darkRowScalar, and tiles[x / 16] = kEdge for every x where out[x] is
 /// (other tile bytes left as they are).
 bool darkRowTilesScalar(const std::uint8_t *d, const std::uint8_t *mid, int w, std::uint8_t *out,

@@ -13,6 +13,7 @@
 #include "every_target.h"
 #include "frappe/frappe.h"
 #include "frappe/render.h"
+#include "front_end_rows.h"
 #include "region_map.h"
 #include "scene.h"
 
@@ -85,6 +86,19 @@ TEST(RegionMap, RowKernelsMatchTheirScalarReferences)
 			const std::vector<std::uint8_t> zeros(w, 0);
 			EXPECT_FALSE(detail::darkRow(a0.data(), zeros.data(), w, got.data())) << target;
 		}
+#ifdef FRAPPE_HAVE_HWY
+		/* The 3 x 3 spread of the tile extremes, rows of every length. */
+		for (auto [tx, ty] : { std::pair{ 1, 1 }, { 2, 3 }, { 15, 4 }, { 16, 2 }, { 17, 5 }, { 63, 3 }, { 80, 60 }, { 131, 7 } }) {
+			const std::size_t nt = static_cast<std::size_t>(tx) * ty;
+			auto mn = randomBytes(nt, rng), mx = randomBytes(nt, rng);
+			auto mn2 = mn, mx2 = mx;
+			std::vector<std::uint8_t> work(4 * static_cast<std::size_t>(tx) + 4);
+			detail::spreadTiles(mn.data(), mx.data(), tx, ty, work.data());
+			detail::spreadTilesScalar(mn2.data(), mx2.data(), tx, ty, work.data());
+			EXPECT_EQ(mn, mn2) << target << " spread min " << tx << "x" << ty;
+			EXPECT_EQ(mx, mx2) << target << " spread max " << tx << "x" << ty;
+		}
+#endif
 	});
 }
 
@@ -160,6 +174,41 @@ TEST(RegionMap, FollowsTheDocumentedRuleAtOddSizesAndStrides)
 			}
 		}
 	});
+}
+
+/* The CPU front end makes the map's 2x2 means in its bands, as it reads the
+ * frame: the same map as regionMap() at every size and stride, with one band
+ * or several, and of the scaled frame when it scales. */
+TEST(RegionMap, FrontEndBandsMakeTheSameMap)
+{
+	std::mt19937 rng(5);
+	for (auto [W, H, pad] : { std::tuple{ 640, 480, 0 }, { 37, 29, 5 }, { 6, 6, 0 }, { 101, 67, 3 }, { 250, 49, 1 } }) {
+		Image img(W, H, 0, pad);
+		for (int y = 0; y < H; ++y)
+			for (int x = 0; x < W; ++x)
+				img.at(x, y) = static_cast<std::uint8_t>(((x / 7 + y / 5) * 53 + rng() % 40) & 0xFF);
+		for (int threads : { 1, 2, 3 })
+			for (float scale : { 1.0f, 0.6f }) {
+				FrontEndParams params;
+				params.region_contrast = 40;
+				EdgeMap edges;
+				makeCpuFrontEnd(threads)->run(img.view(), scale, params, edges);
+				/* The reference, from the frame the front end traced. */
+				Image src(edges.width, edges.height, 0);
+				if (scale < 1.0f)
+					detail::scaleNearest(img.view(), edges.width, edges.height, src.pixels.data());
+				else
+					src = img;
+				TraceMap want;
+				detail::RegionScratch scratch;
+				detail::regionMap(src.view(), edges.scale, 40, want, scratch);
+				EXPECT_EQ(edges.regions.width, want.width) << W << "x" << H;
+				EXPECT_EQ(edges.regions.pixels, want.pixels)
+					<< W << "x" << H << " threads " << threads << " scale " << scale;
+				EXPECT_EQ(edges.regions.tiles, want.tiles) << W << "x" << H;
+				EXPECT_FLOAT_EQ(edges.regions.scale, want.scale);
+			}
+	}
 }
 
 TEST(RegionMap, EmptyWhenOffOrTooSmall)
