@@ -52,6 +52,49 @@ bool warpToGridScalar(const ImageView &image, const std::array<Point2f, 4> &corn
 	return warpWith(warpSamplesScalar, image, corners, side, out);
 }
 
+bool warpCellCentres(const ImageView &image, const std::array<Point2f, 4> &corners, int bits, float sharpening,
+		     WarpedMarker &out, float *reference)
+{
+	const auto H = Homography::fromUnitSquare(corners);
+	if (!H)
+		return false;
+	const int cells = bits + 2, side = cells + 2;
+	/* The quad grown by a cell on every side: its grid of side x side
+	 * samples puts one at the centre of every cell, ring included. */
+	const double m = 1.0 / cells;
+	const std::array<Point2f, 4> grown = { H->map(-m, -m), H->map(1 + m, -m), H->map(1 + m, 1 + m),
+					       H->map(-m, 1 + m) };
+	WarpedMarker grid;
+	if (!warpToGrid(image, grown, side, grid))
+		return false;
+	out.side = cells;
+	/* The grey level between the black border and the ring around it. */
+	float border = 0.0f, ring = 0.0f;
+	for (int c = 0; c < side; ++c) {
+		ring += grid.at(c, 0) + grid.at(c, side - 1);
+		if (c > 0 && c < side - 1)
+			ring += grid.at(0, c) + grid.at(side - 1, c);
+	}
+	for (int c = 1; c < side - 1; ++c) {
+		border += grid.at(c, 1) + grid.at(c, side - 2);
+		if (c > 1 && c < side - 2)
+			border += grid.at(1, c) + grid.at(side - 2, c);
+	}
+	const float ringMean = ring / static_cast<float>(4 * (side - 1));
+	const float borderMean = border / static_cast<float>(4 * (cells - 1));
+	if (reference)
+		*reference = 0.5f * (ringMean + borderMean);
+	for (int y = 0; y < cells; ++y) {
+		for (int x = 0; x < cells; ++x) {
+			const float c = grid.at(x + 1, y + 1);
+			const float around =
+				grid.at(x, y + 1) + grid.at(x + 2, y + 1) + grid.at(x + 1, y) + grid.at(x + 1, y + 2);
+			out.samples[static_cast<std::size_t>(y) * cells + x] = c + sharpening * (4.0f * c - around);
+		}
+	}
+	return true;
+}
+
 bool insetQuad(const ImageView &image, std::array<Point2f, 4> &corners, int bits,
 	       WarpedMarker &out)
 {

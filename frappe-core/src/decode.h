@@ -38,6 +38,19 @@ bool warpMarker(const ImageView &image, const std::array<Point2f, 4> &corners, i
 bool insetQuad(const ImageView &image, std::array<Point2f, 4> &corners, int bits,
 	       WarpedMarker &out);
 
+/// Reads a marker's cells at their centres, one sample each, from a grid
+/// that also covers the ring of cells around the marker, and sharpens each
+/// centre against its four neighbours: c + sharpening (4 c - sum of the
+/// four). Where blur reaches a quarter of a cell (small cells, or blurred
+/// ones) warpMarker's samples a quarter cell from the cell's edges take in
+/// the neighbours; the centres less so, and the sharpening takes back what
+/// blur spread over the neighbouring cells. `out` holds one value per cell
+/// (side bits + 2), for binarise and readMarker; `reference`, when given,
+/// the grey level halfway between the mean of the border cells and that of
+/// the ring outside them. False when the quad is degenerate.
+bool warpCellCentres(const ImageView &image, const std::array<Point2f, 4> &corners, int bits, float sharpening,
+		     WarpedMarker &out, float *reference = nullptr);
+
 /// The bits of a warped marker, read as in the dictionary files with the
 /// grid's top-left cell first.
 struct Binarised {

@@ -100,6 +100,14 @@ bool surroundsDecoded(const std::array<Point2f, 4> &q, float area, int probeRead
 	return false;
 }
 
+/* Cells under 4 px along some side of the quad: there warpMarker's
+ * samples, a quarter cell from the cell's edges, lie within a pixel of the
+ * neighbouring cells, and blur of a pixel mixes them in. */
+bool smallCells(const std::array<Point2f, 4> &q, int bits)
+{
+	return !sidesAtLeast(q, 4.0f * static_cast<float>(bits + 2));
+}
+
 /* A point of the traced (possibly scaled) frame in full-resolution pixels;
  * pixel centres are at integers in both. */
 Point2f toFullResolution(Point2f p, float scale)
@@ -408,6 +416,7 @@ void Detector::Impl::finish(const ImageView &image, Slot &slot)
 				b = detail::binarise(*samples, bits);
 			decodeMs += msSince(t);
 		}
+		bool readable = true;
 		if (!refined || b.border_errors >= whiteFrame) {
 			/* No dark frame inside the outline, or a white one: this may be
 			 * the outline of the quiet zone (the marker's own outline merged
@@ -417,32 +426,55 @@ void Detector::Impl::finish(const ImageView &image, Slot &slot)
 			q.corners = outline;
 			const bool inset = detail::insetQuad(image, q.corners, bits, warped);
 			refineMs += msSince(t);
-			if (!inset || !sidesAtLeast(q.corners, config.min_marker_side))
-				continue;
-			++res.candidates;
-			t = Clock::now();
-			samples = &warped;
-			b = detail::binarise(warped, bits);
-			decodeMs += msSince(t);
+			readable = inset && sidesAtLeast(q.corners, config.min_marker_side);
+			if (readable) {
+				++res.candidates;
+				t = Clock::now();
+				samples = &warped;
+				b = detail::binarise(warped, bits);
+				decodeMs += msSince(t);
+			}
 		}
 		t = Clock::now();
 		detail::MarkerRead read;
-		if (b.contrast >= 10.0f && b.border_errors <= borderAllowance)
-			read = detail::readMarker(image, q.corners, *codes, policy, *samples, b);
-		decodeMs += msSince(t);
-		if (!read.ok() && refined && b.border_errors < whiteFrame) {
-			/* Refinement can pull a small, blurred marker's sides onto its
-			 * code's edges; the traced outline may still read. */
-			t = Clock::now();
-			if (detail::warpMarker(image, outline, bits, warped)) {
-				const detail::Binarised bt = detail::binarise(warped, bits);
-				if (bt.contrast >= 10.0f && bt.border_errors <= borderAllowance) {
-					read = detail::readMarker(image, outline, *codes, policy, warped, bt);
-					if (read.ok())
-						q.corners = outline;
-				}
+		if (readable && smallCells(q.corners, bits)) {
+			/* Quarter-cell samples of small cells lie within a pixel of
+			 * their neighbours: read the cells at their centres, at the
+			 * refined corners, else at the traced ones. */
+			if (sidesAtLeast(q.corners, config.min_marker_side))
+				read = detail::readCellCentres(image, q.corners, *codes, policy, warped);
+			if (!read.ok() && refined && sidesAtLeast(outline, config.min_marker_side)) {
+				read = detail::readCellCentres(image, outline, *codes, policy, warped);
+				if (read.ok())
+					q.corners = outline;
 			}
 			decodeMs += msSince(t);
+		} else if (readable) {
+			if (b.contrast >= 10.0f && b.border_errors <= borderAllowance)
+				read = detail::readMarker(image, q.corners, *codes, policy, *samples, b);
+			decodeMs += msSince(t);
+			if (!read.ok() && refined && b.border_errors < whiteFrame) {
+				/* Refinement can pull a blurred marker's sides onto its
+				 * code's edges; the traced outline may still read. */
+				t = Clock::now();
+				if (detail::warpMarker(image, outline, bits, warped)) {
+					const detail::Binarised bt = detail::binarise(warped, bits);
+					if (bt.contrast >= 10.0f && bt.border_errors <= borderAllowance) {
+						read = detail::readMarker(image, outline, *codes, policy, warped, bt);
+						if (read.ok())
+							q.corners = outline;
+					}
+				}
+				decodeMs += msSince(t);
+			}
+			if (!read.ok()) {
+				/* Blur of about a cell (a blurred marker, or a small one
+				 * upsampled) reaches the quarter-cell samples of cells of
+				 * any size. */
+				t = Clock::now();
+				read = detail::readCellCentres(image, q.corners, *codes, policy, warped);
+				decodeMs += msSince(t);
+			}
 		}
 		if (!read.ok())
 			continue;

@@ -23,9 +23,36 @@ constexpr float kStraddle = 0.15f;
  * coin toss between two ids. */
 constexpr int kAmbiguityGap = 2;
 
+/* AprilTag's sharpening of the cell centres (decode_sharpening): enough to
+ * take back what a blur of about a cell spreads into the neighbours. */
+constexpr float kSharpening = 0.25f;
+
+/* A candidate's payload must span at least this many grey levels (the
+ * detector's rule for every read). */
+constexpr float kMinContrast = 10.0f;
+
 /* A read that a random pattern would match with at most this chance is
  * strong evidence on its own (a 6x6 code read exactly: 1e-8). */
 constexpr double kStrongRead = 1e-4;
+
+/* A centre read is believed only when a random pattern would match some
+ * code on its clearly read cells with at most this chance: a tenth, as
+ * every other check must also pass. Reads of the cells of another family's
+ * marker, sampled on the wrong grid, leave a quarter or more. */
+constexpr double kWeakReadChance = 0.1;
+
+/* The chance that a random pattern matches some code of `dict`, in some
+ * rotation, on `clear` given cells within `errors` of them (the other
+ * cells free): 4 codes C(clear, <= errors) / 2^clear. */
+double clearCellsChance(const Dictionary &dict, int clear, int errors)
+{
+	double within = 0.0, choose = 1.0;
+	for (int i = 0; i <= errors && i <= clear; ++i) {
+		within += choose;
+		choose = choose * (clear - i) / (i + 1);
+	}
+	return 4.0 * dict.size() * within / std::ldexp(1.0, clear);
+}
 
 } // namespace
 
@@ -216,7 +243,19 @@ MarkerRead readMarker(const ImageView &image, const std::array<Point2f, 4> &corn
 		return out;
 	}
 	const Scrutiny scrutiny = scrutinyFor(dict, out.decoded.hamming);
-	if (!cellsAgree(cells, dict.bits, scrutiny)) {
+	CellRead agreement = cells;
+	if (w.side < 2 * (dict.bits + 2) && scrutiny == Scrutiny::Strict) {
+		/* One sample per cell (warpCellCentres) cannot straddle; a code
+		 * that chance reads often must still sit on real cells, as judged
+		 * by samples a quarter cell from their edges. */
+		WarpedMarker quarters;
+		if (!warpMarker(image, corners, dict.bits, quarters)) {
+			out.rejection = Rejection::CellsDisagree;
+			return out;
+		}
+		agreement = readCells(quarters, dict.bits, binarise(quarters, dict.bits), policy.weakMargin);
+	}
+	if (!cellsAgree(agreement, dict.bits, scrutiny)) {
 		out.rejection = Rejection::CellsDisagree;
 		return out;
 	}
@@ -226,6 +265,31 @@ MarkerRead readMarker(const ImageView &image, const std::array<Point2f, 4> &corn
 	}
 	out.rejection = Rejection::None;
 	return out;
+}
+
+MarkerRead readCellCentres(const ImageView &image, const std::array<Point2f, 4> &corners, const CodeBook &codes,
+			   const DecodePolicy &policy, WarpedMarker &scratch)
+{
+	const int bits = codes.dictionary().bits;
+	float reference = 0.0f;
+	if (!warpCellCentres(image, corners, bits, kSharpening, scratch, &reference))
+		return {};
+	const Binarised b = binarise(scratch, bits);
+	const float lo = b.threshold - 0.5f * b.contrast, hi = b.threshold + 0.5f * b.contrast;
+	if (b.contrast < kMinContrast || !borderIsBlack(b, bits) || !(lo < reference && hi > reference))
+		return {};
+	MarkerRead r = readMarker(image, corners, codes, policy, scratch, b);
+	if (!r.ok())
+		return r;
+	/* Sharpened centres of blurred cells read weakly more often than the
+	 * quarter-cell samples of large ones; the clearly read cells alone
+	 * must still single out a code. */
+	const Dictionary &dict = codes.dictionary();
+	const std::uint64_t weak = readCells(scratch, bits, b, policy.weakMargin).weak;
+	const int clear = bits * bits - std::popcount(weak);
+	if (clearCellsChance(dict, clear, clearErrors(dict, b.code, weak, r.decoded)) > kWeakReadChance)
+		r.rejection = Rejection::WeakRead;
+	return r;
 }
 
 } // namespace frappe::detail

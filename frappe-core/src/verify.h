@@ -112,6 +112,7 @@ enum class Rejection {
 	TooManyClearErrors,
 	CellsDisagree,
 	NoQuietZone,
+	WeakRead, ///< readCellCentres: too few cells read clearly to single out the code
 };
 
 /// A candidate read as a marker, or the reason it is not one.
@@ -123,8 +124,20 @@ struct MarkerRead {
 };
 
 /// Decodes a binarised candidate and runs every check on it, the cheapest
-/// first; `corners` are the quad `w` was warped from.
+/// first; `corners` are the quad `w` was warped from. When `w` holds one
+/// sample per cell (warpCellCentres), the cells' agreement of a read under
+/// strict scrutiny is judged from a warpMarker grid of the same quad.
 MarkerRead readMarker(const ImageView &image, const std::array<Point2f, 4> &corners, const CodeBook &codes,
 		      const DecodePolicy &policy, const WarpedMarker &w, const Binarised &b);
+
+/// Reads a candidate whose cells are small at their centres, sharpened
+/// against their neighbours (warpCellCentres, into `scratch`), and runs
+/// readMarker's checks on that read. Also rejects a read whose payload does
+/// not reach both sides of the grey level halfway between the black border
+/// and the ring outside it (a dark square or patch of texture around
+/// noise), and one whose clearly read cells alone would match some code by
+/// chance too often (WeakRead).
+MarkerRead readCellCentres(const ImageView &image, const std::array<Point2f, 4> &corners, const CodeBook &codes,
+			   const DecodePolicy &policy, WarpedMarker &scratch);
 
 } // namespace frappe::detail

@@ -4,6 +4,7 @@
 // rendered upright on whole pixels, quads placed by hand.
 #include <bit>
 #include <cmath>
+#include <random>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -439,4 +440,63 @@ TEST(ReadMarker, MarginOfDetectedMarkers)
 	ASSERT_EQ(soft.markers.size(), 1u);
 	EXPECT_LT(soft.markers[0].margin, sharp.markers[0].margin);
 	EXPECT_GE(soft.markers[0].margin, 0.0f);
+}
+
+/* ---- small cells, read at their centres ---- */
+
+/* A small, blurred marker reads at its cell centres; a black square of the
+ * same size, whose inside is noise, does not (its payload never reaches the
+ * level between the border and the white around it). */
+TEST(ReadCellCentres, SmallMarkerYesDarkSquareNo)
+{
+	const Dictionary &d = *findDictionary("aruco_mip_36h12");
+	const detail::CodeBook book(d);
+	const detail::DecodePolicy policy{ 2, 5, 0.3f };
+	const Quad q = square(20.5f, 20.5f, 17.0f); /* 8 cells of 2.1 px */
+	Image img(60, 60, 220);
+	RenderOptions opt;
+	opt.black = 30;
+	opt.white = 220;
+	renderMarker(img.mut(), d, 77, q, opt);
+	frappe::test::blur(img, 0.7f);
+	detail::WarpedMarker w;
+	const detail::MarkerRead r = detail::readCellCentres(img.view(), q, book, policy, w);
+	ASSERT_TRUE(r.ok()) << static_cast<int>(r.rejection);
+	EXPECT_EQ(r.decoded.id, 77);
+
+	std::mt19937 rng(5);
+	for (int k = 0; k < 20; ++k) {
+		Image dark(60, 60, 220);
+		for (int y = 21; y < 38; ++y)
+			for (int x = 21; x < 38; ++x)
+				dark.at(x, y) = 30;
+		frappe::test::addNoise(dark, 3.0f, rng);
+		EXPECT_FALSE(detail::readCellCentres(dark.view(), q, book, policy, w).ok()) << k;
+	}
+}
+
+/* Markers of another family, small, read at their own outline by a 4x4
+ * dictionary: the grid does not sit on their cells. One of all 4x4
+ * patterns in sixteen is a 4x4_1000 code; the checks for a read that chance makes
+ * often (the cells' agreement on a quarter-cell grid, the clearly read
+ * cells) must turn almost all of them away. */
+TEST(ReadCellCentres, AnotherFamilyOnTheWrongGrid)
+{
+	const Dictionary &mip = *findDictionary("aruco_mip_36h12");
+	const Dictionary &d = *findDictionary("4x4_1000");
+	const detail::CodeBook book(d);
+	const detail::DecodePolicy policy{ d.defaultMaxHamming(), d.weakMaxHamming(), 0.3f };
+	const Quad q = square(20.5f, 20.5f, 18.0f);
+	int read = 0;
+	for (int id = 0; id < 100; ++id) {
+		Image img(60, 60, 220);
+		RenderOptions opt;
+		opt.black = 30;
+		opt.white = 220;
+		renderMarker(img.mut(), mip, id, q, opt);
+		frappe::test::blur(img, 0.6f);
+		detail::WarpedMarker w;
+		read += detail::readCellCentres(img.view(), q, book, policy, w).ok();
+	}
+	EXPECT_LE(read, 2);
 }
