@@ -27,18 +27,19 @@ class Floor:
 # Frappe at defaults, single thread, on each synthetic subset with its own
 # dictionary (frappe-detect, the contract's command).
 SETS = {
-    'synth/images':             Floor(sens=(0.91, 0.93), fp=(0, 0), mae=(0.20, 0.20)),
-    'synth/apriltag36h11':      Floor(sens=(0.94, 0.95), fp=(0, 0), mae=(0.20, 0.20)),
+    'synth/images':             Floor(sens=(0.93, 0.93), fp=(0, 0), mae=(0.20, 0.20)),
+    'synth/apriltag36h11':      Floor(sens=(0.95, 0.95), fp=(0, 0), mae=(0.20, 0.20)),
     # Corners under motion blur of 8-12 px stay 1-2 px off (a fifth of the
     # markers give a third of the error): the refinement window (detector.cpp,
-    # refineQuad) spans 7 px, not a whole blurred edge.
-    'synth/blur':               Floor(sens=(0.65, 0.66), fp=(0, 0), mae=(0.36, 0.35), large=(0.97, 0.95)),
-    'synth/blur-apriltag36h11': Floor(sens=(0.64, 0.64), fp=(0, 0), large=(0.97, 0.95)),
+    # refineQuad) spans 7 px, not a whole blurred edge. The cell-centre read
+    # (verify.cpp) reads more of those markers: 0.350 -> 0.360 px.
+    'synth/blur':               Floor(sens=(0.68, 0.66), fp=(0, 0), mae=(0.37, 0.35), large=(0.97, 0.95)),
+    'synth/blur-apriltag36h11': Floor(sens=(0.68, 0.64), fp=(0, 0), large=(0.97, 0.95)),
     # Markers needing a corrected bit: the 4x4 families and 16h5 correct
     # none by default now (as OpenCV's defaults), for no wrong ids.
-    'synth/4x4_50':             Floor(sens=(0.95, 0.98), fp=(0, 0)),
-    'synth/6x6_250':            Floor(sens=(0.91, 0.93), fp=(0, 0)),
-    'synth/apriltag_16h5':      Floor(sens=(0.96, 0.98), fp=(0, 0)),
+    'synth/4x4_50':             Floor(sens=(0.98, 0.98), fp=(0, 0)),
+    'synth/6x6_250':            Floor(sens=(0.94, 0.93), fp=(0, 0)),
+    'synth/apriltag_16h5':      Floor(sens=(0.97, 0.98), fp=(0, 0)),
     'synth/seq01':              Floor(sens=(0.97, 0.97), fp=(2, 2)),
     'synth/seq02':              Floor(sens=(0.97, 0.97), fp=(2, 2)),
 }
@@ -75,13 +76,13 @@ WRONG_IDS_PER_300 = {
 RESOLUTION_POINTS = 2
 RESOLUTION = {
     #                            2x linear  2x nearest  3x linear  3x nearest
-    'synth/images':             (0.90,      0.90,       0.90,      0.90),
-    'synth/apriltag36h11':      (0.94,      0.94,       0.93,      0.94),
-    'synth/blur':               (0.64,      0.63,       0.63,      0.64),
-    'synth/blur-apriltag36h11': (0.62,      0.62,       0.62,      0.62),
-    'synth/4x4_50':             (0.94,      0.95,       0.95,      0.95),
-    'synth/6x6_250':            (0.90,      0.91,       0.90,      0.90),
-    'synth/apriltag_16h5':      (0.95,      0.95,       0.94,      0.95),
+    'synth/images':             (0.93,      0.92,       0.92,      0.92),
+    'synth/apriltag36h11':      (0.95,      0.95,       0.95,      0.95),
+    'synth/blur':               (0.67,      0.66,       0.65,      0.66),
+    'synth/blur-apriltag36h11': (0.66,      0.66,       0.64,      0.66),
+    'synth/4x4_50':             (0.98,      0.97,       0.97,      0.96),
+    'synth/6x6_250':            (0.93,      0.93,       0.93,      0.92),
+    'synth/apriltag_16h5':      (0.96,      0.96,       0.96,      0.95),
     'synth/seq01':              (None,      None,       None,      None),
     'synth/seq02':              (None,      None,       None,      None),
 }
