@@ -302,6 +302,7 @@ int main(int argc, char **argv)
 {
 	std::string dictName = "aruco_mip_36h12", list, outF, outO, outA;
 	int repeat = 5, threads = 1;
+	float regionContrast = frappe::Config{}.region_contrast;
 	bool extras = true;
 	for (int i = 1; i < argc; ++i) {
 		const std::string a = argv[i];
@@ -326,11 +327,13 @@ int main(int argc, char **argv)
 			outO = value();
 		else if (a == "--out-apriltag")
 			outA = value();
+		else if (a == "--region-contrast")
+			regionContrast = std::stof(value());
 		else if (a == "--no-extras")
 			extras = false;
 		else {
 			std::cerr << "usage: frappe-bench --dictionary D --list L [--repeat N] [--threads T] "
-				     "[--out-frappe F] [--out-opencv O] [--out-apriltag PREFIX] [--no-extras]\n";
+				     "[--out-frappe F] [--out-opencv O] [--out-apriltag PREFIX] [--region-contrast C] [--no-extras]\n";
 			return 2;
 		}
 	}
@@ -364,6 +367,7 @@ int main(int argc, char **argv)
 	frappe::Config cfg;
 	cfg.dictionary = dictName;
 	cfg.threads = threads;
+	cfg.region_contrast = regionContrast;
 	frappe::Detector frappeDet(cfg);
 	const auto cvDict = opencvDictionary(*dict, std::min(5, frappeDet.maxHamming()));
 	auto params = cv::aruco::DetectorParameters::create();
@@ -465,7 +469,12 @@ int main(int argc, char **argv)
 	for (int s = 0; s < frappe::kStageCount; ++s)
 		std::printf(" %s %.1f%%", std::string(frappe::stageName(static_cast<frappe::Stage>(s))).c_str(),
 			    100.0 * stageSum[s] / std::max(1e-9, totalSum));
-	std::printf("\n");
+	std::printf("\nfrappe stage means, ms:");
+	const double runs = static_cast<double>(tF.size());
+	for (int s = 0; s < frappe::kStageCount; ++s)
+		std::printf(" %s %.4f", std::string(frappe::stageName(static_cast<frappe::Stage>(s))).c_str(),
+			    stageSum[s] / std::max(1.0, runs));
+	std::printf(" (all %.4f)\n", totalSum / std::max(1.0, runs));
 
 	if (extras) {
 		reportThroughput(cfg, images, std::max(2, repeat));
