@@ -108,6 +108,30 @@ bool smallCells(const std::array<Point2f, 4> &q, int bits)
 	return !sidesAtLeast(q, 4.0f * static_cast<float>(bits + 2));
 }
 
+/* Candidates are read on frames of block means when their cells are this
+ * large (full-resolution pixels) or more: a block of f x f pixels for cells
+ * of f kReadCell .. (f + 1) kReadCell, up to kMaxReadBlock. Corner
+ * refinement's windows and the reads' sampling are sized for cells of a few
+ * pixels; on larger ones (a marker close to the camera, a high-resolution
+ * frame) blur spans more pixels than the windows, and the same scene read
+ * at 3x its resolution lost markers and placed corners twice as far off.
+ * Read at their own scale, candidates of any size are read alike. */
+constexpr float kReadCell = 6.0f;
+constexpr int kMaxReadBlock = 8;
+
+/* The block (1: the frame itself) a candidate with this traced outline is
+ * read at. */
+int readBlock(const std::array<Point2f, 4> &outline, int bits)
+{
+	float side2 = INFINITY;
+	for (int i = 0; i < 4; ++i) {
+		const float dx = outline[i].x - outline[(i + 1) & 3].x, dy = outline[i].y - outline[(i + 1) & 3].y;
+		side2 = std::min(side2, dx * dx + dy * dy);
+	}
+	const float cell = std::sqrt(side2) / static_cast<float>(bits + 2);
+	return std::clamp(static_cast<int>(cell / kReadCell), 1, kMaxReadBlock);
+}
+
 /* A point of the traced (possibly scaled) frame in full-resolution pixels;
  * pixel centres are at integers in both. */
 Point2f toFullResolution(Point2f p, float scale)
@@ -209,6 +233,23 @@ struct Detector::Impl {
 	std::vector<detail::Quad> regionQuads;
 	detail::RegionScratch regionScratch; /* for a front end without a region map */
 	detail::WarpedMarker warped;
+	/* Candidates with large cells are read on f x f block means of the
+	 * frame (f = 2 .. kMaxReadBlock, readBlock()): a patch around the
+	 * candidate, or the whole frame once patches would read more than it
+	 * (kept for the frame's other candidates of that f). Sized at the first
+	 * frame of a size, so later frames allocate nothing. */
+	struct BlockView {
+		ImageView view;
+		int ox = 0, oy = 0; /* the frame pixel at the top left of block (0, 0) */
+	};
+	std::array<std::uint64_t, kMaxReadBlock + 1> blockFrameOf{}; /* finishedFrames it was made for */
+	std::array<std::size_t, kMaxReadBlock + 1> blockFrameAt{};
+	std::vector<std::uint8_t> blockFrames, blockPatch;
+	std::size_t blockPatchRead = 0; /* frame pixels the frame's patches read */
+	int blockSizedW = 0, blockSizedH = 0;
+	detail::RegionScratch blockScratch;
+	std::uint64_t finishedFrames = 0;
+	BlockView blockView(const ImageView &image, int f, const std::array<Point2f, 4> &outline);
 	/* With a batch warper (runFinish() only): per candidate its traced
 	 * outline, whether it refined, and its place in the warped batch (-1
 	 * when not warped); per warped candidate its corners and samples. */
@@ -222,7 +263,7 @@ struct Detector::Impl {
 	void checkImage(const ImageView &image) const;
 	void trace(Slot &slot);
 	void finish(const ImageView &image, Slot &slot);
-	bool refineQuad(const ImageView &image, const Slot &slot, detail::Quad &q, float search) const;
+	bool refineQuad(const ImageView &image, const Slot &slot, detail::Quad &q, float search, int block) const;
 	void refineAndWarpAll(const ImageView &image, Slot &slot, float search, double &refineMs, double &warpMs);
 	Slot &slotAt(int slot)
 	{
@@ -298,15 +339,78 @@ void Detector::Impl::trace(Slot &slot)
  * the border's outer edge, away from the code's, and unlike the default one
  * it stays unbiased on strongly blurred edges (blur set: corner error 0.40
  * -> 0.35 px). It can fail to measure a side where the default one does
- * not (large blurred markers upsampled 3x): then the default one. */
-bool Detector::Impl::refineQuad(const ImageView &image, const Slot &slot, detail::Quad &q, float search) const
+ * not (large blurred markers upsampled 3x): then the default one. `image`
+ * is the frame or a block frame of `block` x `block` means (finish()). */
+bool Detector::Impl::refineQuad(const ImageView &image, const Slot &slot, detail::Quad &q, float search,
+				 int block) const
 {
 	if (q.fromRegion)
-		search = std::max(search, 2.0f / slot.edges.regions.scale);
+		search = std::max(search, 2.0f / slot.edges.regions.scale / static_cast<float>(block));
 	const float wideCell = 6.0f * static_cast<float>(dict->bits + 2);
 	if (sidesAtLeast(q.corners, wideCell) && detail::refineCorners(image, q.corners, search, kBlurWindow))
 		return true;
 	return detail::refineCorners(image, q.corners, search);
+}
+
+Detector::Impl::BlockView Detector::Impl::blockView(const ImageView &image, int f,
+						   const std::array<Point2f, 4> &outline)
+{
+	const std::size_t frameArea = static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height);
+	if (image.width != blockSizedW || image.height != blockSizedH) {
+		blockSizedW = image.width;
+		blockSizedH = image.height;
+		blockFrameOf.fill(0);
+		std::size_t all = 0;
+		for (int g = 2; g <= kMaxReadBlock; ++g) {
+			blockFrameAt[static_cast<std::size_t>(g)] = all;
+			all += static_cast<std::size_t>(image.width / g) * static_cast<std::size_t>(image.height / g);
+		}
+		blockFrames.resize(all);
+		blockPatch.reserve(frameArea / 4);
+		blockScratch.sums.reserve(static_cast<std::size_t>(image.width));
+	}
+	const int W = image.width / f, H = image.height / f;
+	BlockView b;
+	/* The patch: the outline's box and, around it, a cell (the reads' ring
+	 * outside the border) and what refinement reads across a side (its
+	 * search and profile: at most 13 block pixels), in whole blocks. */
+	float x0 = outline[0].x, x1 = x0, y0 = outline[0].y, y1 = y0;
+	for (const Point2f &p : outline) {
+		x0 = std::min(x0, p.x);
+		x1 = std::max(x1, p.x);
+		y0 = std::min(y0, p.y);
+		y1 = std::max(y1, p.y);
+	}
+	const float margin =
+		static_cast<float>(f) * 14.0f + std::max(x1 - x0, y1 - y0) / static_cast<float>(dict->bits + 2);
+	const float ff = static_cast<float>(f);
+	const int bx0 = std::clamp(static_cast<int>(std::floor((x0 - margin) / ff)), 0, W);
+	const int by0 = std::clamp(static_cast<int>(std::floor((y0 - margin) / ff)), 0, H);
+	const int bx1 = std::clamp(static_cast<int>(std::ceil((x1 + margin) / ff)) + 1, bx0, W);
+	const int by1 = std::clamp(static_cast<int>(std::ceil((y1 + margin) / ff)) + 1, by0, H);
+	const std::size_t read = static_cast<std::size_t>(bx1 - bx0) * static_cast<std::size_t>(by1 - by0) *
+				 static_cast<std::size_t>(f * f);
+	const auto fi = static_cast<std::size_t>(f);
+	std::uint8_t *frame = blockFrames.data() + blockFrameAt[fi];
+	if (blockFrameOf[fi] != finishedFrames && blockPatchRead + read <= frameArea) {
+		blockPatchRead += read;
+		const int w = bx1 - bx0, h = by1 - by0;
+		blockPatch.resize(static_cast<std::size_t>(w) * static_cast<std::size_t>(h));
+		const ImageView sub(image.row(by0 * f) + bx0 * f, w * f, h * f, image.stride);
+		if (w > 0 && h > 0)
+			detail::blockMeans(sub, f, blockPatch.data(), blockScratch);
+		b.view = ImageView(blockPatch.data(), w, h, w);
+		b.ox = bx0 * f;
+		b.oy = by0 * f;
+		return b;
+	}
+	if (blockFrameOf[fi] != finishedFrames) {
+		if (W > 0 && H > 0)
+			detail::blockMeans(image, f, frame, blockScratch);
+		blockFrameOf[fi] = finishedFrames;
+	}
+	b.view = ImageView(frame, W, H, W);
+	return b;
 }
 
 /* Batch mode: every candidate refined, then all warped in one call. */
@@ -322,8 +426,11 @@ void Detector::Impl::refineAndWarpAll(const ImageView &image, Slot &slot, float 
 	for (std::size_t k = 0; k < n; ++k) {
 		std::array<Point2f, 4> &corners = slot.quads[k].corners;
 		batch.outlines[k] = corners;
-		batch.refined[k] = refineQuad(image, slot, slot.quads[k], search);
 		batch.place[k] = -1;
+		batch.refined[k] = 0;
+		if (readBlock(corners, dict->bits) > 1)
+			continue; /* read on a block frame by finish() */
+		batch.refined[k] = refineQuad(image, slot, slot.quads[k], search, 1);
 		if (batch.refined[k] && sidesAtLeast(corners, config.min_marker_side)) {
 			batch.place[k] = static_cast<int>(batch.quads.size());
 			batch.quads.push_back(corners);
@@ -346,8 +453,12 @@ void Detector::Impl::finish(const ImageView &image, Slot &slot)
 	res.markers.clear();
 	res.candidates = 0;
 	auto t = Clock::now();
+	++finishedFrames; /* block frames made before are stale */
+	blockPatchRead = 0;
 
-	const float search = 2.5f / scale;
+	/* The traced outline lies within 2.5 traced pixels of the marker's. */
+	constexpr float kSearch = 2.5f;
+	const float search = kSearch / scale;
 	const int bits = dict->bits;
 	const int borderAllowance = detail::allowedBorderErrors(bits);
 	const int whiteFrame = 3 * bits + 3; /* three quarters of the 4(n+1) border cells */
@@ -385,30 +496,49 @@ void Detector::Impl::finish(const ImageView &image, Slot &slot)
 	for (std::size_t k = 0; k < slot.quads.size(); ++k) {
 		detail::Quad &q = slot.quads[k];
 		t = Clock::now();
-		const std::array<Point2f, 4> outline = batched ? batch.outlines[k] : q.corners;
-		if (surroundsDecoded(outline, quadArea(outline), q.probeRead, bits, res.markers)) {
+		const std::array<Point2f, 4> tracedOutline = batched ? batch.outlines[k] : q.corners;
+		if (surroundsDecoded(tracedOutline, quadArea(tracedOutline), q.probeRead, bits, res.markers)) {
 			refineMs += msSince(t);
 			continue;
 		}
 		const int traced = q.probeRead;
-		if (isClutter(q, outline)) {
+		if (isClutter(q, tracedOutline)) {
 			refineMs += msSince(t);
 			continue;
 		}
-		bool refined = batched ? batch.refined[k] != 0
-			       : traced < whiteFrame && refineQuad(image, slot, q, search);
+		/* Large cells are read on a frame of f x f block means, in its
+		 * pixels (readBlock()), with at least the frame's search: blur
+		 * spreads a large marker's edges over as many of them as a small
+		 * one's over the frame's. The corners come back at the end. */
+		const int f = readBlock(tracedOutline, bits);
+		const bool inBatch = batched && f == 1;
+		const BlockView block = f == 1 ? BlockView{ image } : blockView(image, f, tracedOutline);
+		const ImageView &img = block.view;
+		const Point2f origin{ static_cast<float>(block.ox), static_cast<float>(block.oy) };
+		const float minSide = config.min_marker_side / static_cast<float>(f);
+		std::array<Point2f, 4> outline = tracedOutline;
+		if (f > 1) {
+			for (int i = 0; i < 4; ++i) {
+				outline[i] = toFullResolution({ outline[i].x - origin.x, outline[i].y - origin.y },
+							      static_cast<float>(f));
+				q.corners[i] = outline[i];
+			}
+		}
+		bool refined = inBatch ? batch.refined[k] != 0
+				       : traced < whiteFrame &&
+						 refineQuad(img, slot, q, std::max(search / static_cast<float>(f), kSearch), f);
 		refineMs += msSince(t);
 		detail::Binarised b;
 		const detail::WarpedMarker *samples = &warped;
-		if (refined && sidesAtLeast(q.corners, config.min_marker_side)) {
+		if (refined && sidesAtLeast(q.corners, minSide)) {
 			++res.candidates;
 			t = Clock::now();
-			if (batched) {
+			if (inBatch) {
 				const int j = batch.place[k];
 				refined = batch.warpedOk[static_cast<std::size_t>(j)] != 0;
 				samples = &batch.samples[static_cast<std::size_t>(j)];
 			} else {
-				refined = detail::warpMarker(image, q.corners, bits, warped);
+				refined = detail::warpMarker(img, q.corners, bits, warped);
 			}
 			warpMs += msSince(t);
 			t = Clock::now();
@@ -424,9 +554,9 @@ void Detector::Impl::finish(const ImageView &image, Slot &slot)
 			 * marker would lie one cell inside. */
 			t = Clock::now();
 			q.corners = outline;
-			const bool inset = detail::insetQuad(image, q.corners, bits, warped);
+			const bool inset = detail::insetQuad(img, q.corners, bits, warped);
 			refineMs += msSince(t);
-			readable = inset && sidesAtLeast(q.corners, config.min_marker_side);
+			readable = inset && sidesAtLeast(q.corners, minSide);
 			if (readable) {
 				++res.candidates;
 				t = Clock::now();
@@ -441,26 +571,26 @@ void Detector::Impl::finish(const ImageView &image, Slot &slot)
 			/* Quarter-cell samples of small cells lie within a pixel of
 			 * their neighbours: read the cells at their centres, at the
 			 * refined corners, else at the traced ones. */
-			if (sidesAtLeast(q.corners, config.min_marker_side))
-				read = detail::readCellCentres(image, q.corners, *codes, policy, warped);
-			if (!read.ok() && refined && sidesAtLeast(outline, config.min_marker_side)) {
-				read = detail::readCellCentres(image, outline, *codes, policy, warped);
+			if (sidesAtLeast(q.corners, minSide))
+				read = detail::readCellCentres(img, q.corners, *codes, policy, warped);
+			if (!read.ok() && refined && sidesAtLeast(outline, minSide)) {
+				read = detail::readCellCentres(img, outline, *codes, policy, warped);
 				if (read.ok())
 					q.corners = outline;
 			}
 			decodeMs += msSince(t);
 		} else if (readable) {
 			if (b.contrast >= 10.0f && b.border_errors <= borderAllowance)
-				read = detail::readMarker(image, q.corners, *codes, policy, *samples, b);
+				read = detail::readMarker(img, q.corners, *codes, policy, *samples, b);
 			decodeMs += msSince(t);
 			if (!read.ok() && refined && b.border_errors < whiteFrame) {
 				/* Refinement can pull a blurred marker's sides onto its
 				 * code's edges; the traced outline may still read. */
 				t = Clock::now();
-				if (detail::warpMarker(image, outline, bits, warped)) {
+				if (detail::warpMarker(img, outline, bits, warped)) {
 					const detail::Binarised bt = detail::binarise(warped, bits);
 					if (bt.contrast >= 10.0f && bt.border_errors <= borderAllowance) {
-						read = detail::readMarker(image, outline, *codes, policy, warped, bt);
+						read = detail::readMarker(img, outline, *codes, policy, warped, bt);
 						if (read.ok())
 							q.corners = outline;
 					}
@@ -472,12 +602,18 @@ void Detector::Impl::finish(const ImageView &image, Slot &slot)
 				 * upsampled) reaches the quarter-cell samples of cells of
 				 * any size. */
 				t = Clock::now();
-				read = detail::readCellCentres(image, q.corners, *codes, policy, warped);
+				read = detail::readCellCentres(img, q.corners, *codes, policy, warped);
 				decodeMs += msSince(t);
 			}
 		}
 		if (!read.ok())
 			continue;
+		if (f > 1) {
+			for (Point2f &p : q.corners) {
+				p = toFullResolution(p, 1.0f / static_cast<float>(f));
+				p = { p.x + origin.x, p.y + origin.y };
+			}
+		}
 
 		const detail::Decoded &d = read.decoded;
 		Marker m;

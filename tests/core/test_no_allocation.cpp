@@ -44,21 +44,29 @@ TEST_P(NoAllocation, SecondFrameOfTheSameSizeAllocatesNothing)
 		renderMarker(a.mut(), dict, k, squarePose(80.0f + 100.0f * k, 150.0f, 60.0f, 20.0f * k, 30.0f));
 		renderMarker(b.mut(), dict, 10 + k, squarePose(80.0f + 100.0f * k, 330.0f, 70.0f, -15.0f * k, 20.0f));
 	}
+	/* Large markers: read on frames of block means (2 x 2 and 4 x 4). */
+	Image c(640, 480, 100);
+	renderMarker(c.mut(), dict, 20, squarePose(170.0f, 240.0f, 200.0f, 10.0f, 20.0f));
+	renderMarker(c.mut(), dict, 21, squarePose(470.0f, 240.0f, 130.0f, -10.0f, 25.0f));
 	addNoise(a, 3.0f, rng);
 	addNoise(b, 3.0f, rng);
+	addNoise(c, 3.0f, rng);
 	Config config;
 	config.threads = GetParam(); /* bands on persistent workers */
 	Detector det(config);
 	/* Warm up on both frames: buffers grow to what these scenes need. */
 	det.detect(a.view());
 	det.detect(b.view());
+	det.detect(c.view());
 
 	const long before = gAllocations.load();
 	const std::size_t na = det.detect(a.view()).markers.size();
 	const std::size_t nb = det.detect(b.view()).markers.size();
+	const std::size_t nc = det.detect(c.view()).markers.size();
 	const long after = gAllocations.load();
 	EXPECT_EQ(na, 6u);
 	EXPECT_EQ(nb, 6u);
+	EXPECT_EQ(nc, 2u);
 	EXPECT_EQ(after - before, 0) << "detect() allocated on a frame of a size it had seen";
 }
 

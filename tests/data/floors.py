@@ -78,8 +78,8 @@ RESOLUTION = {
     #                            2x linear  2x nearest  3x linear  3x nearest
     'synth/images':             (0.93,      0.92,       0.92,      0.92),
     'synth/apriltag36h11':      (0.95,      0.95,       0.95,      0.95),
-    'synth/blur':               (0.67,      0.66,       0.65,      0.66),
-    'synth/blur-apriltag36h11': (0.66,      0.66,       0.64,      0.66),
+    'synth/blur':               (0.67,      0.66,       0.66,      0.66),
+    'synth/blur-apriltag36h11': (0.66,      0.66,       0.65,      0.66),
     'synth/4x4_50':             (0.98,      0.97,       0.97,      0.96),
     'synth/6x6_250':            (0.93,      0.93,       0.93,      0.92),
     'synth/apriltag_16h5':      (0.96,      0.96,       0.96,      0.95),
