@@ -108,28 +108,37 @@ bool smallCells(const std::array<Point2f, 4> &q, int bits)
 	return !sidesAtLeast(q, 4.0f * static_cast<float>(bits + 2));
 }
 
-/* Candidates are read on frames of block means when their cells are this
- * large (full-resolution pixels) or more: a block of f x f pixels for cells
- * of f kReadCell .. (f + 1) kReadCell, up to kMaxReadBlock. Corner
- * refinement's windows and the reads' sampling are sized for cells of a few
- * pixels; on larger ones (a marker close to the camera, a high-resolution
- * frame) blur spans more pixels than the windows, and the same scene read
- * at 3x its resolution lost markers and placed corners twice as far off.
- * Read at their own scale, candidates of any size are read alike. */
+/* Candidates with cells of 2 kReadCell pixels or more are read on the frame
+ * halved into blocks of f = 2, 4 or 8 pixels (the largest with cells of
+ * kReadCell or more there). Corner refinement's windows and the reads' sampling are sized for
+ * cells of a few pixels; on larger ones (a marker close to the camera, a
+ * frame of high resolution) blur spans more pixels than the windows, and
+ * the same scenes read at 3x their resolution lost markers and placed
+ * corners 2-3 times as far off. Read at their own scale, candidates of any
+ * size are read alike. */
 constexpr float kReadCell = 6.0f;
 constexpr int kMaxReadBlock = 8;
+
+/* The shortest side of a quad's four. */
+float shortestSide(const std::array<Point2f, 4> &q)
+{
+	float side2 = INFINITY;
+	for (int i = 0; i < 4; ++i) {
+		const float dx = q[i].x - q[(i + 1) & 3].x, dy = q[i].y - q[(i + 1) & 3].y;
+		side2 = std::min(side2, dx * dx + dy * dy);
+	}
+	return std::sqrt(side2);
+}
 
 /* The block (1: the frame itself) a candidate with this traced outline is
  * read at. */
 int readBlock(const std::array<Point2f, 4> &outline, int bits)
 {
-	float side2 = INFINITY;
-	for (int i = 0; i < 4; ++i) {
-		const float dx = outline[i].x - outline[(i + 1) & 3].x, dy = outline[i].y - outline[(i + 1) & 3].y;
-		side2 = std::min(side2, dx * dx + dy * dy);
-	}
-	const float cell = std::sqrt(side2) / static_cast<float>(bits + 2);
-	return std::clamp(static_cast<int>(cell / kReadCell), 1, kMaxReadBlock);
+	const float cell = shortestSide(outline) / static_cast<float>(bits + 2);
+	int f = 1;
+	while (2 * f <= kMaxReadBlock && cell >= static_cast<float>(2 * f) * kReadCell)
+		f *= 2;
+	return f;
 }
 
 /* A point of the traced (possibly scaled) frame in full-resolution pixels;
@@ -233,23 +242,22 @@ struct Detector::Impl {
 	std::vector<detail::Quad> regionQuads;
 	detail::RegionScratch regionScratch; /* for a front end without a region map */
 	detail::WarpedMarker warped;
-	/* Candidates with large cells are read on f x f block means of the
-	 * frame (f = 2 .. kMaxReadBlock, readBlock()): a patch around the
-	 * candidate, or the whole frame once patches would read more than it
-	 * (kept for the frame's other candidates of that f). Sized at the first
-	 * frame of a size, so later frames allocate nothing. */
+	/* Candidates with large cells are read on the frame halved f times
+	 * (readBlock()): a patch around the candidate, or the whole frame once
+	 * the frame's patches would read more than it (then kept for its other
+	 * candidates of that f). Sized at the first frame of a size: later
+	 * frames allocate nothing. */
 	struct BlockView {
 		ImageView view;
 		int ox = 0, oy = 0; /* the frame pixel at the top left of block (0, 0) */
 	};
 	std::array<std::uint64_t, kMaxReadBlock + 1> blockFrameOf{}; /* finishedFrames it was made for */
 	std::array<std::size_t, kMaxReadBlock + 1> blockFrameAt{};
-	std::vector<std::uint8_t> blockFrames, blockPatch;
+	std::vector<std::uint8_t> blockFrames, blockPatch, blockHalf;
 	std::size_t blockPatchRead = 0; /* frame pixels the frame's patches read */
 	int blockSizedW = 0, blockSizedH = 0;
-	detail::RegionScratch blockScratch;
 	std::uint64_t finishedFrames = 0;
-	BlockView blockView(const ImageView &image, int f, const std::array<Point2f, 4> &outline);
+	BlockView blockView(const ImageView &image, int f, const std::array<Point2f, 4> &outline, float margin);
 	/* With a batch warper (runFinish() only): per candidate its traced
 	 * outline, whether it refined, and its place in the warped batch (-1
 	 * when not warped); per warped candidate its corners and samples. */
@@ -340,7 +348,7 @@ void Detector::Impl::trace(Slot &slot)
  * it stays unbiased on strongly blurred edges (blur set: corner error 0.40
  * -> 0.35 px). It can fail to measure a side where the default one does
  * not (large blurred markers upsampled 3x): then the default one. `image`
- * is the frame or a block frame of `block` x `block` means (finish()). */
+ * is the frame or the frame halved to blocks of `block` pixels (finish()). */
 bool Detector::Impl::refineQuad(const ImageView &image, const Slot &slot, detail::Quad &q, float search,
 				 int block) const
 {
@@ -352,8 +360,10 @@ bool Detector::Impl::refineQuad(const ImageView &image, const Slot &slot, detail
 	return detail::refineCorners(image, q.corners, search);
 }
 
+/* `image` halved f (2, 4, 8) times, whole or the blocks of a patch
+ * reaching `margin` pixels beyond the outline's box. */
 Detector::Impl::BlockView Detector::Impl::blockView(const ImageView &image, int f,
-						   const std::array<Point2f, 4> &outline)
+						   const std::array<Point2f, 4> &outline, float margin)
 {
 	const std::size_t frameArea = static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height);
 	if (image.width != blockSizedW || image.height != blockSizedH) {
@@ -361,19 +371,28 @@ Detector::Impl::BlockView Detector::Impl::blockView(const ImageView &image, int 
 		blockSizedH = image.height;
 		blockFrameOf.fill(0);
 		std::size_t all = 0;
-		for (int g = 2; g <= kMaxReadBlock; ++g) {
+		for (int g = 2; g <= kMaxReadBlock; g *= 2) {
 			blockFrameAt[static_cast<std::size_t>(g)] = all;
 			all += static_cast<std::size_t>(image.width / g) * static_cast<std::size_t>(image.height / g);
 		}
 		blockFrames.resize(all);
 		blockPatch.reserve(frameArea / 4);
-		blockScratch.sums.reserve(static_cast<std::size_t>(image.width));
+		blockHalf.reserve(frameArea / 4 + frameArea / 16);
 	}
+	/* The frame (or patch) halved log2(f) times: the first halvings into
+	 * blockHalf (a quarter of the frame, then a sixteenth), the last into
+	 * `out`. */
+	auto halve = [&](const ImageView &src, std::uint8_t *out) {
+		ImageView level = src;
+		for (int g = 2; g < f; g *= 2) {
+			const int w = level.width / 2, h = level.height / 2;
+			std::uint8_t *dst = blockHalf.data() + (g == 2 ? 0 : frameArea / 4);
+			detail::halveImage(level, dst);
+			level = ImageView(dst, w, h, w);
+		}
+		detail::halveImage(level, out);
+	};
 	const int W = image.width / f, H = image.height / f;
-	BlockView b;
-	/* The patch: the outline's box and, around it, a cell (the reads' ring
-	 * outside the border) and what refinement reads across a side (its
-	 * search and profile: at most 13 block pixels), in whole blocks. */
 	float x0 = outline[0].x, x1 = x0, y0 = outline[0].y, y1 = y0;
 	for (const Point2f &p : outline) {
 		x0 = std::min(x0, p.x);
@@ -381,32 +400,31 @@ Detector::Impl::BlockView Detector::Impl::blockView(const ImageView &image, int 
 		y0 = std::min(y0, p.y);
 		y1 = std::max(y1, p.y);
 	}
-	const float margin =
-		static_cast<float>(f) * 14.0f + std::max(x1 - x0, y1 - y0) / static_cast<float>(dict->bits + 2);
 	const float ff = static_cast<float>(f);
 	const int bx0 = std::clamp(static_cast<int>(std::floor((x0 - margin) / ff)), 0, W);
 	const int by0 = std::clamp(static_cast<int>(std::floor((y0 - margin) / ff)), 0, H);
 	const int bx1 = std::clamp(static_cast<int>(std::ceil((x1 + margin) / ff)) + 1, bx0, W);
 	const int by1 = std::clamp(static_cast<int>(std::ceil((y1 + margin) / ff)) + 1, by0, H);
-	const std::size_t read = static_cast<std::size_t>(bx1 - bx0) * static_cast<std::size_t>(by1 - by0) *
-				 static_cast<std::size_t>(f * f);
+	const int w = bx1 - bx0, h = by1 - by0;
+	const std::size_t read = static_cast<std::size_t>(w) * static_cast<std::size_t>(h) * static_cast<std::size_t>(f * f);
 	const auto fi = static_cast<std::size_t>(f);
-	std::uint8_t *frame = blockFrames.data() + blockFrameAt[fi];
+	BlockView b;
 	if (blockFrameOf[fi] != finishedFrames && blockPatchRead + read <= frameArea) {
 		blockPatchRead += read;
-		const int w = bx1 - bx0, h = by1 - by0;
+		blockHalf.resize(frameArea / 4 + frameArea / 16);
 		blockPatch.resize(static_cast<std::size_t>(w) * static_cast<std::size_t>(h));
-		const ImageView sub(image.row(by0 * f) + bx0 * f, w * f, h * f, image.stride);
 		if (w > 0 && h > 0)
-			detail::blockMeans(sub, f, blockPatch.data(), blockScratch);
+			halve(ImageView(image.row(by0 * f) + bx0 * f, w * f, h * f, image.stride), blockPatch.data());
 		b.view = ImageView(blockPatch.data(), w, h, w);
 		b.ox = bx0 * f;
 		b.oy = by0 * f;
 		return b;
 	}
+	std::uint8_t *frame = blockFrames.data() + blockFrameAt[fi];
 	if (blockFrameOf[fi] != finishedFrames) {
+		blockHalf.resize(frameArea / 4 + frameArea / 16);
 		if (W > 0 && H > 0)
-			detail::blockMeans(image, f, frame, blockScratch);
+			halve(image, frame);
 		blockFrameOf[fi] = finishedFrames;
 	}
 	b.view = ImageView(frame, W, H, W);
@@ -429,7 +447,7 @@ void Detector::Impl::refineAndWarpAll(const ImageView &image, Slot &slot, float 
 		batch.place[k] = -1;
 		batch.refined[k] = 0;
 		if (readBlock(corners, dict->bits) > 1)
-			continue; /* read on a block frame by finish() */
+			continue; /* read on a halved frame by finish() */
 		batch.refined[k] = refineQuad(image, slot, slot.quads[k], search, 1);
 		if (batch.refined[k] && sidesAtLeast(corners, config.min_marker_side)) {
 			batch.place[k] = static_cast<int>(batch.quads.size());
@@ -453,7 +471,7 @@ void Detector::Impl::finish(const ImageView &image, Slot &slot)
 	res.markers.clear();
 	res.candidates = 0;
 	auto t = Clock::now();
-	++finishedFrames; /* block frames made before are stale */
+	++finishedFrames; /* halved frames made before are stale */
 	blockPatchRead = 0;
 
 	/* The traced outline lies within 2.5 traced pixels of the marker's. */
@@ -506,27 +524,35 @@ void Detector::Impl::finish(const ImageView &image, Slot &slot)
 			refineMs += msSince(t);
 			continue;
 		}
-		/* Large cells are read on a frame of f x f block means, in its
-		 * pixels (readBlock()), with at least the frame's search: blur
-		 * spreads a large marker's edges over as many of them as a small
-		 * one's over the frame's. The corners come back at the end. */
+		/* Large cells are read on the frame halved f times, in its pixels
+		 * (readBlock()), with at least the frame's search: blur spreads a
+		 * large marker's edges over as many of them as a small one's over
+		 * the frame's. The patch reaches what refinement reads across a
+		 * side (its search and profile: 13 pixels of the halved frame at
+		 * most) and the reads' ring a cell outside the border; a white
+		 * frame is only read inside (insetQuad()). The corners come back
+		 * to the frame at the end. */
 		const int f = readBlock(tracedOutline, bits);
 		const bool inBatch = batched && f == 1;
-		const BlockView block = f == 1 ? BlockView{ image } : blockView(image, f, tracedOutline);
+		const float ff = static_cast<float>(f);
+		const float cellPx = shortestSide(tracedOutline) / static_cast<float>(bits + 2);
+		const BlockView block =
+			f == 1 ? BlockView{ image }
+			       : blockView(image, f, tracedOutline,
+					   traced >= whiteFrame ? ff : std::max(14.0f * ff, cellPx + 2.0f * ff));
 		const ImageView &img = block.view;
 		const Point2f origin{ static_cast<float>(block.ox), static_cast<float>(block.oy) };
-		const float minSide = config.min_marker_side / static_cast<float>(f);
+		const float minSide = config.min_marker_side / ff;
 		std::array<Point2f, 4> outline = tracedOutline;
 		if (f > 1) {
 			for (int i = 0; i < 4; ++i) {
-				outline[i] = toFullResolution({ outline[i].x - origin.x, outline[i].y - origin.y },
-							      static_cast<float>(f));
+				outline[i] = toFullResolution({ outline[i].x - origin.x, outline[i].y - origin.y }, ff);
 				q.corners[i] = outline[i];
 			}
 		}
 		bool refined = inBatch ? batch.refined[k] != 0
 				       : traced < whiteFrame &&
-						 refineQuad(img, slot, q, std::max(search / static_cast<float>(f), kSearch), f);
+						 refineQuad(img, slot, q, std::max(search / ff, kSearch), f);
 		refineMs += msSince(t);
 		detail::Binarised b;
 		const detail::WarpedMarker *samples = &warped;
@@ -610,7 +636,7 @@ void Detector::Impl::finish(const ImageView &image, Slot &slot)
 			continue;
 		if (f > 1) {
 			for (Point2f &p : q.corners) {
-				p = toFullResolution(p, 1.0f / static_cast<float>(f));
+				p = toFullResolution(p, 1.0f / ff);
 				p = { p.x + origin.x, p.y + origin.y };
 			}
 		}

@@ -301,76 +301,11 @@ bool darkRow(const std::uint8_t *d, const std::uint8_t *mid, int w, std::uint8_t
 }
 #endif
 
-void blockMeansScalar(const ImageView &src, int k, std::uint8_t *out)
+void halveImage(const ImageView &src, std::uint8_t *out)
 {
-	const int w = src.width / k, h = src.height / k, d = k * k;
+	const int w = src.width / 2, h = src.height / 2;
 	for (int y = 0; y < h; ++y)
-		for (int x = 0; x < w; ++x) {
-			int sum = 0;
-			for (int j = 0; j < k; ++j)
-				for (int i = 0; i < k; ++i)
-					sum += src.row(y * k + j)[x * k + i];
-			out[static_cast<std::size_t>(y) * w + x] = static_cast<std::uint8_t>((sum + d / 2) / d);
-		}
-}
-
-namespace {
-
-/* One row of blocks from its column sums, with k a constant so that the
- * compiler can unroll (and vectorise) the sums of k neighbours. */
-template <int K>
-void blockRow(const std::uint16_t *__restrict sum, int w, const BlockDivider &divide, std::uint8_t *__restrict o)
-{
-	for (int x = 0; x < w; ++x) {
-		std::uint32_t t = K * K / 2;
-		for (int i = 0; i < K; ++i)
-			t += sum[x * K + i];
-		o[x] = static_cast<std::uint8_t>(divide(t));
-	}
-}
-
-} // namespace
-
-void blockMeans(const ImageView &src, int k, std::uint8_t *out, RegionScratch &s)
-{
-	const int w = src.width / k, h = src.height / k;
-	if (k == 2) {
-		for (int y = 0; y < h; ++y)
-			decimateRow(src.row(2 * y), src.row(2 * y + 1), w, out + static_cast<std::size_t>(y) * w);
-		return;
-	}
-	/* Column sums of k rows (vectorised by the compiler; k <= 257 keeps
-	 * them in 16 bits), then k of them per block, divided by k * k. */
-	const int n = w * k;
-	s.sums.resize(static_cast<std::size_t>(n));
-	std::uint16_t *__restrict sum = s.sums.data();
-	const BlockDivider divide(k);
-	for (int y = 0; y < h; ++y) {
-		const std::uint8_t *__restrict r = src.row(y * k);
-		for (int x = 0; x < n; ++x)
-			sum[x] = r[x];
-		for (int j = 1; j < k; ++j) {
-			r = src.row(y * k + j);
-			for (int x = 0; x < n; ++x)
-				sum[x] = static_cast<std::uint16_t>(sum[x] + r[x]);
-		}
-		std::uint8_t *o = out + static_cast<std::size_t>(y) * w;
-		switch (k) {
-		case 3: blockRow<3>(sum, w, divide, o); break;
-		case 4: blockRow<4>(sum, w, divide, o); break;
-		case 5: blockRow<5>(sum, w, divide, o); break;
-		case 6: blockRow<6>(sum, w, divide, o); break;
-		case 7: blockRow<7>(sum, w, divide, o); break;
-		case 8: blockRow<8>(sum, w, divide, o); break;
-		default:
-			for (int x = 0; x < w; ++x) {
-				std::uint32_t t = static_cast<std::uint32_t>(k * k / 2);
-				for (int i = 0; i < k; ++i)
-					t += sum[x * k + i];
-				o[x] = static_cast<std::uint8_t>(divide(t));
-			}
-		}
-	}
+		decimateRow(src.row(2 * y), src.row(2 * y + 1), w, out + static_cast<std::size_t>(y) * w);
 }
 
 void regionMap(const ImageView &src, float srcScale, int minContrast, TraceMap &out, RegionScratch &s)
@@ -380,7 +315,7 @@ void regionMap(const ImageView &src, float srcScale, int minContrast, TraceMap &
 		return;
 	}
 	s.decimated.resize(static_cast<std::size_t>(src.width / 2) * (src.height / 2));
-	blockMeans(src, 2, s.decimated.data(), s);
+	halveImage(src, s.decimated.data());
 	regionMapFromMeans(src.width, src.height, srcScale, minContrast, out, s);
 }
 

@@ -1,8 +1,6 @@
 // SPDX-License-Identifier: MIT
 // The region map: the frame's dark regions at half resolution, where the
-// second source of candidates is traced (see EdgeMap::regions), and the
-// block means it is made of (which also give the frames that candidates
-// with large cells are read on). The exact
+// second source of candidates is traced (see EdgeMap::regions). The exact
 // integer rule is at the top of front_end_cpu.cpp; the row kernels are
 // vectorised where Highway is built in, beside their scalar references.
 #pragma once
@@ -22,7 +20,6 @@ constexpr int kRegionTile = 4;
 /// Working rows of regionMap(), kept between frames.
 struct RegionScratch {
 	std::vector<std::uint8_t> decimated; ///< the half-resolution image
-	std::vector<std::uint16_t> sums;     ///< blockMeans(): column sums of a row of blocks
 	std::vector<std::uint8_t> tileMin, tileMax, lo, mid, level, spread;
 };
 
@@ -43,33 +40,9 @@ inline bool makesRegionMap(int width, int height, int minContrast)
 void regionMapFromMeans(int width, int height, float srcScale, int minContrast, TraceMap &out,
 			RegionScratch &scratch);
 
-/// t / (k * k), rounded down, for t < 256 k^2, without a division: with
-/// m = 2^40 / d + 1 (rounded down) the product's error stays below 1/d for
-/// d = k^2 < 4096, so the quotient is exact (the tests check every t for
-/// every such k); larger blocks divide.
-class BlockDivider
-{
-public:
-	explicit BlockDivider(int k)
-		: d_(static_cast<std::uint32_t>(k) * static_cast<std::uint32_t>(k)),
-		  m_((std::uint64_t{ 1 } << 40) / d_ + 1)
-	{
-	}
-	std::uint32_t operator()(std::uint32_t t) const
-	{
-		return d_ < 4096 ? static_cast<std::uint32_t>((t * m_) >> 40) : t / d_;
-	}
-
-private:
-	std::uint32_t d_;
-	std::uint64_t m_;
-};
-
-/// out, (src.width / k) x (src.height / k) = the rounded means of src's
-/// k x k blocks (k >= 2): (sum + k * k / 2) / (k * k), rounded down.
-void blockMeans(const ImageView &src, int k, std::uint8_t *out, RegionScratch &scratch);
-/// The same, one block at a time with a division: the reference.
-void blockMeansScalar(const ImageView &src, int k, std::uint8_t *out);
+/// out, (src.width / 2) x (src.height / 2) = decimateRow() of each pair of
+/// src's rows: the image at half resolution, as the region map makes it.
+void halveImage(const ImageView &src, std::uint8_t *out);
 
 /// out[x] = the rounded mean of r0[2x], r0[2x + 1], r1[2x], r1[2x + 1] for
 /// x in [0, w).

@@ -211,40 +211,6 @@ TEST(RegionMap, FrontEndBandsMakeTheSameMap)
 	}
 }
 
-/* The reciprocal that divides a block's sum: exact for every sum a block
- * can have, for every block it is used for (the frames candidates are read
- * on) and well beyond. */
-TEST(BlockMeans, DividerIsExact)
-{
-	for (int k = 2; k <= 80; ++k) {
-		const detail::BlockDivider divide(k);
-		const auto d = static_cast<std::uint32_t>(k * k);
-		for (std::uint32_t t = 0; t < 256 * d; ++t)
-			if (divide(t) != t / d) {
-				ADD_FAILURE() << "k " << k << " t " << t << ": " << divide(t) << " != " << t / d;
-				return;
-			}
-	}
-}
-
-TEST(BlockMeans, MatchTheirReference)
-{
-	std::mt19937 rng(3);
-	for (int k : { 2, 3, 4, 5, 6, 7, 8, 12 })
-		for (auto [W, H, pad] : { std::tuple{ 64, 48, 0 }, { 37, 29, 5 }, { 13, 100, 1 }, { 5, 5, 2 } }) {
-			Image img(W, H, 0, pad);
-			for (auto &p : img.pixels)
-				p = static_cast<std::uint8_t>(rng() & 0xFF);
-			const int w = W / k, h = H / k;
-			std::vector<std::uint8_t> got(static_cast<std::size_t>(w) * h + 1, 0xAA), want(got);
-			detail::RegionScratch scratch;
-			detail::blockMeans(img.view(), k, got.data(), scratch);
-			detail::blockMeansScalar(img.view(), k, want.data());
-			EXPECT_EQ(got, want) << "k " << k << " " << W << "x" << H;
-			EXPECT_EQ(got.back(), 0xAA) << "k " << k << ": nothing written past the end";
-		}
-}
-
 TEST(RegionMap, EmptyWhenOffOrTooSmall)
 {
 	Image img(5, 100, 0);
