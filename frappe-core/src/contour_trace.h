@@ -29,7 +29,7 @@ struct Quad {
 
 struct TraceParams {
 	float cluster_radius = 4.0f; ///< corner pixels closer than this form one corner
-	float min_side = 8.0f;       ///< shortest acceptable side, traced pixels
+	float min_side = 8.0f;       ///< least mean side (no side under 0.6 of it), traced pixels
 	float border_margin = 1.0f;  ///< corners must lie this far inside the frame
 	/// Corner clusters a border needs before its outline is fitted: edge
 	/// borders without them are mostly clutter; region borders have none.

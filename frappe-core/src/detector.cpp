@@ -65,6 +65,21 @@ bool sidesAtLeast(const std::array<Point2f, 4> &q, float side)
 	return true;
 }
 
+/* Large enough to read: sides of minSide on average, none under 0.6 of it
+ * (a marker tilted 65 degrees is read across its foreshortened sides). */
+bool bigEnough(const std::array<Point2f, 4> &q, float minSide)
+{
+	float sum = 0.0f;
+	for (int i = 0; i < 4; ++i) {
+		const float dx = q[i].x - q[(i + 1) & 3].x, dy = q[i].y - q[(i + 1) & 3].y;
+		const float side = std::sqrt(dx * dx + dy * dy);
+		if (side < 0.6f * minSide)
+			return false;
+		sum += side;
+	}
+	return sum >= 4.0f * minSide;
+}
+
 float quadArea(const std::array<Point2f, 4> &q)
 {
 	float twice = 0.0f;
@@ -449,7 +464,7 @@ void Detector::Impl::refineAndWarpAll(const ImageView &image, Slot &slot, float 
 		if (readBlock(corners, dict->bits) > 1)
 			continue; /* read on a halved frame by finish() */
 		batch.refined[k] = refineQuad(image, slot, slot.quads[k], search, 1);
-		if (batch.refined[k] && sidesAtLeast(corners, config.min_marker_side)) {
+		if (batch.refined[k] && bigEnough(corners, config.min_marker_side)) {
 			batch.place[k] = static_cast<int>(batch.quads.size());
 			batch.quads.push_back(corners);
 		}
@@ -556,7 +571,7 @@ void Detector::Impl::finish(const ImageView &image, Slot &slot)
 		refineMs += msSince(t);
 		detail::Binarised b;
 		const detail::WarpedMarker *samples = &warped;
-		if (refined && sidesAtLeast(q.corners, minSide)) {
+		if (refined && bigEnough(q.corners, minSide)) {
 			++res.candidates;
 			t = Clock::now();
 			if (inBatch) {
@@ -582,7 +597,7 @@ void Detector::Impl::finish(const ImageView &image, Slot &slot)
 			q.corners = outline;
 			const bool inset = detail::insetQuad(img, q.corners, bits, warped);
 			refineMs += msSince(t);
-			readable = inset && sidesAtLeast(q.corners, minSide);
+			readable = inset && bigEnough(q.corners, minSide);
 			if (readable) {
 				++res.candidates;
 				t = Clock::now();
@@ -597,9 +612,9 @@ void Detector::Impl::finish(const ImageView &image, Slot &slot)
 			/* Quarter-cell samples of small cells lie within a pixel of
 			 * their neighbours: read the cells at their centres, at the
 			 * refined corners, else at the traced ones. */
-			if (sidesAtLeast(q.corners, minSide))
+			if (bigEnough(q.corners, minSide))
 				read = detail::readCellCentres(img, q.corners, *codes, policy, warped);
-			if (!read.ok() && refined && sidesAtLeast(outline, minSide)) {
+			if (!read.ok() && refined && bigEnough(outline, minSide)) {
 				read = detail::readCellCentres(img, outline, *codes, policy, warped);
 				if (read.ok())
 					q.corners = outline;

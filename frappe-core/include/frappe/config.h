@@ -78,8 +78,11 @@ struct Config {
 	/// belong to one corner cluster.
 	float corner_cluster_radius = 4.0f;
 
-	/// Candidates with a side shorter than this (full-resolution pixels) are
-	/// dropped before refinement: below about 1.5 px per cell nothing decodes.
+	/// Candidates whose sides average less than this (full-resolution
+	/// pixels), or with a side under 0.6 of it, are dropped before
+	/// refinement: below about 1.5 px per cell nothing decodes, but a tilted
+	/// marker reads across its foreshortened sides. Lower finds smaller
+	/// markers at more cost.
 	float min_marker_side = 10.0f;
 
 	/// Worker threads for the front end (split into row bands). 1 = strictly
