@@ -125,12 +125,12 @@ bool smallCells(const std::array<Point2f, 4> &q, int bits)
 
 /* Candidates with cells of 2 kReadCell pixels or more are read on the frame
  * halved into blocks of f = 2, 4 or 8 pixels (the largest with cells of
- * kReadCell or more there). Corner refinement's windows and the reads' sampling are sized for
- * cells of a few pixels; on larger ones (a marker close to the camera, a
- * frame of high resolution) blur spans more pixels than the windows, and
- * the same scenes read at 3x their resolution lost markers and placed
- * corners 2-3 times as far off. Read at their own scale, candidates of any
- * size are read alike. */
+ * kReadCell or more there). Corner refinement's windows and the reads'
+ * sampling are sized for cells of a few pixels; on larger ones (a marker
+ * close to the camera, a frame of high resolution) blur spans more pixels
+ * than the windows, and the same scenes read at 3x their resolution lost
+ * markers and placed corners 2-3 times as far off. Read at their own
+ * scale, candidates of any size are read alike. */
 constexpr float kReadCell = 6.0f;
 constexpr int kMaxReadBlock = 8;
 
@@ -257,11 +257,11 @@ struct Detector::Impl {
 	std::vector<detail::Quad> regionQuads;
 	detail::RegionScratch regionScratch; /* for a front end without a region map */
 	detail::WarpedMarker warped;
-	/* Candidates with large cells are read on the frame halved f times
-	 * (readBlock()): a patch around the candidate, or the whole frame once
-	 * the frame's patches would read more than it (then kept for its other
-	 * candidates of that f). Sized at the first frame of a size: later
-	 * frames allocate nothing. */
+	/* Candidates with large cells are read on the frame halved into blocks
+	 * of f pixels (readBlock()): a patch around the candidate, or the whole
+	 * frame once the frame's patches would read more than it (then kept for
+	 * its other candidates of that f). Sized at the first frame of a size:
+	 * later frames allocate nothing. */
 	struct BlockView {
 		ImageView view;
 		int ox = 0, oy = 0; /* the frame pixel at the top left of block (0, 0) */
