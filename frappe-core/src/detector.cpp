@@ -55,14 +55,20 @@ void validate(const Config &c, const Dictionary &d)
 }
 
 
-bool sidesAtLeast(const std::array<Point2f, 4> &q, float side)
+/* The square of the shortest of a quad's four sides. */
+float shortestSide2(const std::array<Point2f, 4> &q)
 {
+	float side2 = INFINITY;
 	for (int i = 0; i < 4; ++i) {
 		const float dx = q[i].x - q[(i + 1) & 3].x, dy = q[i].y - q[(i + 1) & 3].y;
-		if (dx * dx + dy * dy < side * side)
-			return false;
+		side2 = std::min(side2, dx * dx + dy * dy);
 	}
-	return true;
+	return side2;
+}
+
+bool sidesAtLeast(const std::array<Point2f, 4> &q, float side)
+{
+	return shortestSide2(q) >= side * side;
 }
 
 /* Large enough to read: sides of minSide on average, none under 0.6 of it
@@ -134,22 +140,16 @@ bool smallCells(const std::array<Point2f, 4> &q, int bits)
 constexpr float kReadCell = 6.0f;
 constexpr int kMaxReadBlock = 8;
 
-/* The shortest side of a quad's four. */
-float shortestSide(const std::array<Point2f, 4> &q)
+/* A quad's cell size, along its shortest side. */
+float cellSide(const std::array<Point2f, 4> &q, int bits)
 {
-	float side2 = INFINITY;
-	for (int i = 0; i < 4; ++i) {
-		const float dx = q[i].x - q[(i + 1) & 3].x, dy = q[i].y - q[(i + 1) & 3].y;
-		side2 = std::min(side2, dx * dx + dy * dy);
-	}
-	return std::sqrt(side2);
+	return std::sqrt(shortestSide2(q)) / static_cast<float>(bits + 2);
 }
 
-/* The block (1: the frame itself) a candidate with this traced outline is
- * read at. */
-int readBlock(const std::array<Point2f, 4> &outline, int bits)
+/* The block (1: the frame itself) a candidate with cells of `cell` pixels
+ * is read at. */
+int readBlock(float cell)
 {
-	const float cell = shortestSide(outline) / static_cast<float>(bits + 2);
 	int f = 1;
 	while (2 * f <= kMaxReadBlock && cell >= static_cast<float>(2 * f) * kReadCell)
 		f *= 2;
@@ -392,7 +392,7 @@ Detector::Impl::BlockView Detector::Impl::blockView(const ImageView &image, int 
 		}
 		blockFrames.resize(all);
 		blockPatch.reserve(frameArea / 4);
-		blockHalf.reserve(frameArea / 4 + frameArea / 16);
+		blockHalf.resize(frameArea / 4 + frameArea / 16);
 	}
 	/* The frame (or patch) halved log2(f) times: the first halvings into
 	 * blockHalf (a quarter of the frame, then a sixteenth), the last into
@@ -426,7 +426,6 @@ Detector::Impl::BlockView Detector::Impl::blockView(const ImageView &image, int 
 	BlockView b;
 	if (blockFrameOf[fi] != finishedFrames && blockPatchRead + read <= frameArea) {
 		blockPatchRead += read;
-		blockHalf.resize(frameArea / 4 + frameArea / 16);
 		blockPatch.resize(static_cast<std::size_t>(w) * static_cast<std::size_t>(h));
 		if (w > 0 && h > 0)
 			halve(ImageView(image.row(by0 * f) + bx0 * f, w * f, h * f, image.stride), blockPatch.data());
@@ -437,7 +436,6 @@ Detector::Impl::BlockView Detector::Impl::blockView(const ImageView &image, int 
 	}
 	std::uint8_t *frame = blockFrames.data() + blockFrameAt[fi];
 	if (blockFrameOf[fi] != finishedFrames) {
-		blockHalf.resize(frameArea / 4 + frameArea / 16);
 		if (W > 0 && H > 0)
 			halve(image, frame);
 		blockFrameOf[fi] = finishedFrames;
@@ -461,7 +459,7 @@ void Detector::Impl::refineAndWarpAll(const ImageView &image, Slot &slot, float 
 		batch.outlines[k] = corners;
 		batch.place[k] = -1;
 		batch.refined[k] = 0;
-		if (readBlock(corners, dict->bits) > 1)
+		if (readBlock(cellSide(corners, dict->bits)) > 1)
 			continue; /* read on a halved frame by finish() */
 		batch.refined[k] = refineQuad(image, slot, slot.quads[k], search, 1);
 		if (batch.refined[k] && bigEnough(corners, config.min_marker_side)) {
@@ -547,10 +545,10 @@ void Detector::Impl::finish(const ImageView &image, Slot &slot)
 		 * most) and the reads' ring a cell outside the border; a white
 		 * frame is only read inside (insetQuad()). The corners come back
 		 * to the frame at the end. */
-		const int f = readBlock(tracedOutline, bits);
+		const float cellPx = cellSide(tracedOutline, bits);
+		const int f = readBlock(cellPx);
 		const bool inBatch = batched && f == 1;
 		const float ff = static_cast<float>(f);
-		const float cellPx = shortestSide(tracedOutline) / static_cast<float>(bits + 2);
 		const BlockView block =
 			f == 1 ? BlockView{ image }
 			       : blockView(image, f, tracedOutline,

@@ -96,62 +96,35 @@ bool DarkRow(const std::uint8_t *d, const std::uint8_t *mid, int w, std::uint8_t
 	return found;
 }
 
-/* spreadTilesScalar's two passes with whole vectors of tiles; the tail of
- * each row as the scalar form does it. */
+/* spreadTilesScalar's two passes with whole vectors of tiles. */
 void SpreadTiles(std::uint8_t *tileMin, std::uint8_t *tileMax, int tx, int ty, std::uint8_t *work)
 {
 	const hn::ScalableTag<std::uint8_t> d;
 	const int N = static_cast<int>(hn::Lanes(d));
-	std::uint8_t *HWY_RESTRICT a = work, *HWY_RESTRICT b = work + tx + 2;
-	/* Across, through a copy with the end tiles repeated. */
-	for (int j = 0; j < ty; ++j) {
-		std::uint8_t *HWY_RESTRICT tmin = tileMin + static_cast<std::size_t>(j) * tx;
-		std::uint8_t *HWY_RESTRICT tmax = tileMax + static_cast<std::size_t>(j) * tx;
-		std::memcpy(a + 1, tmin, tx);
-		std::memcpy(b + 1, tmax, tx);
-		a[0] = a[1];
-		a[tx + 1] = a[tx];
-		b[0] = b[1];
-		b[tx + 1] = b[tx];
+	auto across = [&](const std::uint8_t *a, const std::uint8_t *b, std::uint8_t *tmin, std::uint8_t *tmax,
+			  int n) HWY_ATTR {
 		int i = 0;
-		for (; i + N <= tx; i += N) {
+		for (; i + N <= n; i += N) {
 			hn::StoreU(hn::Min(hn::Min(hn::LoadU(d, a + i), hn::LoadU(d, a + i + 1)), hn::LoadU(d, a + i + 2)), d,
 				   tmin + i);
 			hn::StoreU(hn::Max(hn::Max(hn::LoadU(d, b + i), hn::LoadU(d, b + i + 1)), hn::LoadU(d, b + i + 2)), d,
 				   tmax + i);
 		}
-		for (; i < tx; ++i) {
-			tmin[i] = std::min(std::min(a[i], a[i + 1]), a[i + 2]);
-			tmax[i] = std::max(std::max(b[i], b[i + 1]), b[i + 2]);
-		}
-	}
-	/* Then down, keeping the row above as it was. */
-	std::uint8_t *HWY_RESTRICT upMin = b + tx + 2, *HWY_RESTRICT upMax = upMin + tx;
-	for (int j = 0; j < ty; ++j) {
-		std::uint8_t *HWY_RESTRICT tmin = tileMin + static_cast<std::size_t>(j) * tx;
-		std::uint8_t *HWY_RESTRICT tmax = tileMax + static_cast<std::size_t>(j) * tx;
-		const std::uint8_t *dnMin = j + 1 < ty ? tmin + tx : tmin;
-		const std::uint8_t *dnMax = j + 1 < ty ? tmax + tx : tmax;
-		if (j == 0) {
-			std::memcpy(upMin, tmin, tx);
-			std::memcpy(upMax, tmax, tx);
-		}
+		return i;
+	};
+	auto down = [&](std::uint8_t *upMin, std::uint8_t *upMax, const std::uint8_t *dnMin,
+			const std::uint8_t *dnMax, std::uint8_t *tmin, std::uint8_t *tmax, int n) HWY_ATTR {
 		int i = 0;
-		for (; i + N <= tx; i += N) {
-			const auto m = hn::LoadU(d, tmin + i), n = hn::LoadU(d, tmax + i);
+		for (; i + N <= n; i += N) {
+			const auto m = hn::LoadU(d, tmin + i), x = hn::LoadU(d, tmax + i);
 			hn::StoreU(hn::Min(hn::Min(hn::LoadU(d, upMin + i), m), hn::LoadU(d, dnMin + i)), d, tmin + i);
-			hn::StoreU(hn::Max(hn::Max(hn::LoadU(d, upMax + i), n), hn::LoadU(d, dnMax + i)), d, tmax + i);
+			hn::StoreU(hn::Max(hn::Max(hn::LoadU(d, upMax + i), x), hn::LoadU(d, dnMax + i)), d, tmax + i);
 			hn::StoreU(m, d, upMin + i);
-			hn::StoreU(n, d, upMax + i);
+			hn::StoreU(x, d, upMax + i);
 		}
-		for (; i < tx; ++i) {
-			const std::uint8_t m = tmin[i], n = tmax[i];
-			tmin[i] = std::min(std::min(upMin[i], m), dnMin[i]);
-			tmax[i] = std::max(std::max(upMax[i], n), dnMax[i]);
-			upMin[i] = m;
-			upMax[i] = n;
-		}
-	}
+		return i;
+	};
+	spreadTilesWith(tileMin, tileMax, tx, ty, work, across, down);
 }
 
 } // namespace HWY_NAMESPACE
@@ -204,41 +177,8 @@ void tileExtremesScalar(const std::uint8_t *rows, std::ptrdiff_t stride, int n, 
 
 void spreadTilesScalar(std::uint8_t *tileMin, std::uint8_t *tileMax, int tx, int ty, std::uint8_t *work)
 {
-	/* Across, through a copy with the end tiles repeated, then down,
-	 * keeping the row above aside. */
-	std::uint8_t *__restrict a = work, *__restrict b = work + tx + 2;
-	for (int j = 0; j < ty; ++j) {
-		std::uint8_t *__restrict tmin = tileMin + static_cast<std::size_t>(j) * tx;
-		std::uint8_t *__restrict tmax = tileMax + static_cast<std::size_t>(j) * tx;
-		std::memcpy(a + 1, tmin, tx);
-		std::memcpy(b + 1, tmax, tx);
-		a[0] = a[1];
-		a[tx + 1] = a[tx];
-		b[0] = b[1];
-		b[tx + 1] = b[tx];
-		for (int i = 0; i < tx; ++i) {
-			tmin[i] = std::min(std::min(a[i], a[i + 1]), a[i + 2]);
-			tmax[i] = std::max(std::max(b[i], b[i + 1]), b[i + 2]);
-		}
-	}
-	std::uint8_t *__restrict upMin = b + tx + 2, *__restrict upMax = upMin + tx;
-	for (int j = 0; j < ty; ++j) {
-		std::uint8_t *__restrict tmin = tileMin + static_cast<std::size_t>(j) * tx;
-		std::uint8_t *__restrict tmax = tileMax + static_cast<std::size_t>(j) * tx;
-		const std::uint8_t *__restrict dnMin = j + 1 < ty ? tmin + tx : tmin;
-		const std::uint8_t *__restrict dnMax = j + 1 < ty ? tmax + tx : tmax;
-		if (j == 0) {
-			std::memcpy(upMin, tmin, tx);
-			std::memcpy(upMax, tmax, tx);
-		}
-		for (int i = 0; i < tx; ++i) {
-			const std::uint8_t m = tmin[i], n = tmax[i];
-			tmin[i] = std::min(std::min(upMin[i], m), dnMin[i]);
-			tmax[i] = std::max(std::max(upMax[i], n), dnMax[i]);
-			upMin[i] = m;
-			upMax[i] = n;
-		}
-	}
+	auto none = [](auto &&...) { return 0; };
+	spreadTilesWith(tileMin, tileMax, tx, ty, work, none, none);
 }
 
 bool darkRowTilesScalar(const std::uint8_t *d, const std::uint8_t *mid, int w, std::uint8_t *out,

@@ -5,8 +5,10 @@
 // vectorised where Highway is built in, beside their scalar references.
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <vector>
 
 #include "frappe/edge_map.h"
@@ -66,6 +68,51 @@ void tileExtremesScalar(const std::uint8_t *rows, std::ptrdiff_t stride, int n, 
 /// Each of the tx x ty tiles' extremes becomes the least (greatest) over
 /// the 3 x 3 tiles around it that exist, in place. work: 4 tx + 4 bytes.
 void spreadTilesScalar(std::uint8_t *tileMin, std::uint8_t *tileMax, int tx, int ty, std::uint8_t *work);
+/// The frame every form of spreadTiles shares: across each row through a
+/// copy with its end tiles repeated (work: a, b), then down, keeping each
+/// row's values before the pass for the next (work: upMin, upMax).
+/// across(a, b, tmin, tmax, tx) and down(upMin, upMax, dnMin, dnMax, tmin,
+/// tmax, tx) do the tiles they can in whole vectors and return how many;
+/// the rest are done here, one by one.
+template <class Across, class Down>
+void spreadTilesWith(std::uint8_t *tileMin, std::uint8_t *tileMax, int tx, int ty, std::uint8_t *work,
+		     Across across, Down down)
+{
+	std::uint8_t *a = work, *b = work + tx + 2;
+	for (int j = 0; j < ty; ++j) {
+		std::uint8_t *tmin = tileMin + static_cast<std::size_t>(j) * tx;
+		std::uint8_t *tmax = tileMax + static_cast<std::size_t>(j) * tx;
+		std::memcpy(a + 1, tmin, tx);
+		std::memcpy(b + 1, tmax, tx);
+		a[0] = a[1];
+		a[tx + 1] = a[tx];
+		b[0] = b[1];
+		b[tx + 1] = b[tx];
+		for (int i = across(a, b, tmin, tmax, tx); i < tx; ++i) {
+			tmin[i] = std::min(std::min(a[i], a[i + 1]), a[i + 2]);
+			tmax[i] = std::max(std::max(b[i], b[i + 1]), b[i + 2]);
+		}
+	}
+	std::uint8_t *upMin = b + tx + 2, *upMax = upMin + tx;
+	for (int j = 0; j < ty; ++j) {
+		std::uint8_t *tmin = tileMin + static_cast<std::size_t>(j) * tx;
+		std::uint8_t *tmax = tileMax + static_cast<std::size_t>(j) * tx;
+		const std::uint8_t *dnMin = j + 1 < ty ? tmin + tx : tmin;
+		const std::uint8_t *dnMax = j + 1 < ty ? tmax + tx : tmax;
+		if (j == 0) {
+			std::memcpy(upMin, tmin, tx);
+			std::memcpy(upMax, tmax, tx);
+		}
+		for (int i = down(upMin, upMax, dnMin, dnMax, tmin, tmax, tx); i < tx; ++i) {
+			const std::uint8_t m = tmin[i], n = tmax[i];
+			tmin[i] = std::min(std::min(upMin[i], m), dnMin[i]);
+			tmax[i] = std::max(std::max(upMax[i], n), dnMax[i]);
+			upMin[i] = m;
+			upMax[i] = n;
+		}
+	}
+}
+
 #ifdef FRAPPE_HAVE_HWY
 /// spreadTilesScalar, vectorised (Highway's best target).
 void spreadTiles(std::uint8_t *tileMin, std::uint8_t *tileMax, int tx, int ty, std::uint8_t *work);

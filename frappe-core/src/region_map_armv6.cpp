@@ -213,56 +213,31 @@ void tileExtremesV6(const std::uint8_t *rows, std::ptrdiff_t stride, int n, int 
 
 void spreadTilesV6(std::uint8_t *tileMin, std::uint8_t *tileMax, int tx, int ty, std::uint8_t *work)
 {
-	/* Across: four tiles a word from a copy of the row with its end tiles
-	 * repeated (three unaligned loads: the tiles left of, at and right
-	 * of each). */
-	std::uint8_t *a = work, *b = work + tx + 2;
-	for (int j = 0; j < ty; ++j) {
-		std::uint8_t *tmin = tileMin + static_cast<std::size_t>(j) * tx;
-		std::uint8_t *tmax = tileMax + static_cast<std::size_t>(j) * tx;
-		std::memcpy(a + 1, tmin, tx);
-		std::memcpy(b + 1, tmax, tx);
-		a[0] = a[1];
-		a[tx + 1] = a[tx];
-		b[0] = b[1];
-		b[tx + 1] = b[tx];
+	/* Four tiles a word: across, from three unaligned loads of the padded
+	 * copy (the tiles left of, at and right of each); down, from the row
+	 * above as it was, the row and the row below. */
+	auto across = [](const std::uint8_t *a, const std::uint8_t *b, std::uint8_t *tmin, std::uint8_t *tmax,
+			 int n) {
 		int i = 0;
-		for (; i + 4 <= tx; i += 4) {
+		for (; i + 4 <= n; i += 4) {
 			store32(tmin + i, min8(min8(load32(a + i), load32(a + i + 1)), load32(a + i + 2)));
 			store32(tmax + i, max8(max8(load32(b + i), load32(b + i + 1)), load32(b + i + 2)));
 		}
-		for (; i < tx; ++i) {
-			tmin[i] = std::min(std::min(a[i], a[i + 1]), a[i + 2]);
-			tmax[i] = std::max(std::max(b[i], b[i + 1]), b[i + 2]);
-		}
-	}
-	/* Down, keeping each row's values before the pass for the next. */
-	std::uint8_t *upMin = b + tx + 2, *upMax = upMin + tx;
-	for (int j = 0; j < ty; ++j) {
-		std::uint8_t *tmin = tileMin + static_cast<std::size_t>(j) * tx;
-		std::uint8_t *tmax = tileMax + static_cast<std::size_t>(j) * tx;
-		const std::uint8_t *dnMin = j + 1 < ty ? tmin + tx : tmin;
-		const std::uint8_t *dnMax = j + 1 < ty ? tmax + tx : tmax;
-		if (j == 0) {
-			std::memcpy(upMin, tmin, tx);
-			std::memcpy(upMax, tmax, tx);
-		}
+		return i;
+	};
+	auto down = [](std::uint8_t *upMin, std::uint8_t *upMax, const std::uint8_t *dnMin, const std::uint8_t *dnMax,
+		       std::uint8_t *tmin, std::uint8_t *tmax, int n) {
 		int i = 0;
-		for (; i + 4 <= tx; i += 4) {
-			const u32 m = load32(tmin + i), n = load32(tmax + i);
+		for (; i + 4 <= n; i += 4) {
+			const u32 m = load32(tmin + i), x = load32(tmax + i);
 			store32(tmin + i, min8(min8(load32(upMin + i), m), load32(dnMin + i)));
-			store32(tmax + i, max8(max8(load32(upMax + i), n), load32(dnMax + i)));
+			store32(tmax + i, max8(max8(load32(upMax + i), x), load32(dnMax + i)));
 			store32(upMin + i, m);
-			store32(upMax + i, n);
+			store32(upMax + i, x);
 		}
-		for (; i < tx; ++i) {
-			const std::uint8_t m = tmin[i], n = tmax[i];
-			tmin[i] = std::min(std::min(upMin[i], m), dnMin[i]);
-			tmax[i] = std::max(std::max(upMax[i], n), dnMax[i]);
-			upMin[i] = m;
-			upMax[i] = n;
-		}
-	}
+		return i;
+	};
+	spreadTilesWith(tileMin, tileMax, tx, ty, work, across, down);
 }
 
 __attribute__((optimize("omit-frame-pointer"))) void darkRowV6(const std::uint8_t *d, const std::uint8_t *mid, int w, std::uint8_t *out, std::uint8_t *tiles)
