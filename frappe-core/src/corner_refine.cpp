@@ -70,6 +70,23 @@ constexpr int kMaxReach = 23; /* search window, pixels either side */
 constexpr int kMaxProfile = 2 * (kMaxReach + kMaxRun + 1) + 1;
 /* Steepest fall over two pixels below which a column is noise, not edge. */
 constexpr int kMinDrop = 6;
+/* The centroid moment2 / (2 mass) pixels in 1/16 pixel, rounded half away
+ * from zero; mass > 0. */
+inline int centroid16(int moment2, int mass)
+{
+	return (8 * moment2 + (moment2 >= 0 ? mass / 2 : -mass / 2)) / mass;
+}
+
+constexpr int kMinWindow16 = 32;
+/* RefineWindow::symmetric's window (window16: a fall at 16 k + 8 counts
+ * min(16, window16 - its distance from c16) / 16) for falls spanning
+ * pixels lo..hi: at most window16, and reaching (window16 - 8) no further
+ * from c16 than the nearer end of the falls; at least a pixel (or
+ * window16 when that is less). */
+inline int symmetricWindow16(int window16, int c16, int lo, int hi)
+{
+	return std::max(std::min(window16, kMinWindow16), std::min(window16, std::min(c16 - 16 * lo, 16 * hi - c16) + 8));
+}
 
 /* A side's columns for the vector kernel: p[r][i] is column i's pixel
  * j = kLoMin - kRun - 1 + r steps inwards, r < kHiMax - kLoMin + 2 kRun + 3;
@@ -82,7 +99,8 @@ struct Columns {
 	static constexpr int kPad = 16;
 	int n;
 	int kLoMin, kHiMax;
-	int run, window16; /* RefineWindow's */
+	int run, window16, passes; /* RefineWindow's */
+	bool symmetric;
 	alignas(64) std::uint8_t p[kMaxProfile][kLanes];
 	alignas(64) std::int32_t kLo[kLanes];
 	alignas(64) std::int32_t kHi[kLanes];
@@ -171,26 +189,46 @@ void MeasureColumns(Columns &c)
 			mass = hn::Add(mass, fall);
 			moment2 = hn::Add(moment2, hn::Mul(fall, hn::Set(d, 2 * m + 1)));
 		}
-		/* (8 moment2 +- mass / 2) / mass, truncated: the quotient of
-		 * |numerator| < 2^21 by mass in floats is off by at most one,
-		 * which the remainder corrects. */
-		const auto num = hn::Add(hn::ShiftLeft<3>(hn::Abs(moment2)), hn::ShiftRight<1>(mass));
-		const auto den = hn::IfThenElse(valid, mass, one);
-		auto q = hn::ConvertTo(d, hn::Div(hn::ConvertTo(df, num), hn::ConvertTo(df, den)));
-		const auto rem = hn::Sub(num, hn::Mul(q, den));
-		q = hn::Add(q, hn::IfThenElseZero(hn::Gt(rem, hn::Sub(den, one)), one));
-		q = hn::Sub(q, hn::IfThenElseZero(hn::Lt(rem, zero), one));
-		const auto c16 = hn::IfThenElse(hn::Lt(moment2, zero), hn::Neg(q), q);
+		/* centroid16(): (8 moment2 +- mass / 2) / mass, truncated: the
+		 * quotient of |numerator| < 2^21 by mass in floats is off by at
+		 * most one, which the remainder corrects. */
+		auto centroid16V = [&](decltype(zero) mom2, decltype(zero) m, decltype(valid) ok) {
+			const auto num = hn::Add(hn::ShiftLeft<3>(hn::Abs(mom2)), hn::ShiftRight<1>(m));
+			const auto den = hn::IfThenElse(ok, m, one);
+			auto q = hn::ConvertTo(d, hn::Div(hn::ConvertTo(df, num), hn::ConvertTo(df, den)));
+			const auto rem = hn::Sub(num, hn::Mul(q, den));
+			q = hn::Add(q, hn::IfThenElseZero(hn::Gt(rem, hn::Sub(den, one)), one));
+			q = hn::Sub(q, hn::IfThenElseZero(hn::Lt(rem, zero), one));
+			return hn::IfThenElse(hn::Lt(mom2, zero), hn::Neg(q), q);
+		};
+		auto c16 = centroid16V(moment2, mass, valid);
 
-		/* The falls weighted by how much of each lies in the window. */
+		/* The falls weighted by how much of each lies in the window,
+		 * symmetricWindow16() wide if asked, c.passes times. */
 		auto wMass = zero, wMoment2 = zero;
-		const auto full = hn::Set(d, 16);
-		for (int m = m0; m <= m1; ++m) {
-			const auto dist = hn::Abs(hn::Sub(hn::Set(d, 16 * m + 8), c16));
-			const auto f16 = hn::Min(hn::Max(hn::Sub(hn::Set(d, c.window16), dist), zero), full);
-			const auto wf = hn::Mul(f16, hn::Load(d, falls + (m - m0) * N));
-			wMass = hn::Add(wMass, wf);
-			wMoment2 = hn::Add(wMoment2, hn::Mul(wf, hn::Set(d, 2 * m + 1)));
+		auto live = valid;
+		const auto full = hn::Set(d, 16), eight = hn::Set(d, 8);
+		const auto lo16 = hn::ShiftLeft<4>(lo), hi16 = hn::ShiftLeft<4>(hi);
+		for (int pass = 0; pass < c.passes; ++pass) {
+			const auto reach = hn::Min(hn::Sub(c16, lo16), hn::Sub(hi16, c16));
+			const auto window16 =
+				c.symmetric ? hn::Max(hn::Set(d, std::min(c.window16, kMinWindow16)),
+						      hn::Min(hn::Set(d, c.window16), hn::Add(reach, eight)))
+					    : hn::Set(d, c.window16);
+			auto pm = zero, pm2 = zero;
+			for (int m = m0; m <= m1; ++m) {
+				const auto dist = hn::Abs(hn::Sub(hn::Set(d, 16 * m + 8), c16));
+				const auto f16 = hn::Min(hn::Max(hn::Sub(window16, dist), zero), full);
+				const auto wf = hn::Mul(f16, hn::Load(d, falls + (m - m0) * N));
+				pm = hn::Add(pm, wf);
+				pm2 = hn::Add(pm2, hn::Mul(wf, hn::Set(d, 2 * m + 1)));
+			}
+			/* A lane whose window holds no fall keeps its last sums
+			 * (the scalar loop stops there). */
+			wMass = hn::IfThenElse(live, pm, wMass);
+			wMoment2 = hn::IfThenElse(live, pm2, wMoment2);
+			live = hn::And(live, hn::Gt(pm, zero));
+			c16 = hn::IfThenElse(live, centroid16V(pm2, pm, live), c16);
 		}
 		hn::Store(hn::IfThenElseZero(valid, wMass), d, c.mass + i);
 		hn::Store(hn::IfThenElseZero(valid, wMoment2), d, c.moment2 + i);
@@ -230,7 +268,7 @@ inline int ceilInt(float x)
  * w (0: no edge) and their moment2, so that the crossing is at
  * moment2 / (2 w) steps, both in sixteenths of the falls. */
 template <typename Pixel>
-inline int measureColumn(Pixel p, int kLo, int kHi, int kRun, int kWindow16, int &moment2Out)
+inline int measureColumn(Pixel p, int kLo, int kHi, const RefineWindow &win, int &moment2Out)
 {
 	/* Strongest fall in intensity going inwards (white border outside,
 	 * black frame inside); rises belong to other edges. */
@@ -249,6 +287,7 @@ inline int measureColumn(Pixel p, int kLo, int kHi, int kRun, int kWindow16, int
 	 * p(k) - p(k + 1) lies at k + 1/2. */
 	int lo = best - 1, hi = best + 1;
 	int prev = p(lo);
+	const int kRun = win.run;
 	for (int next; lo > best - 1 - kRun && (next = p(lo - 1)) > prev; prev = next)
 		--lo;
 	prev = p(hi);
@@ -267,13 +306,21 @@ inline int measureColumn(Pixel p, int kLo, int kHi, int kRun, int kWindow16, int
 		moment2 += fall * (2 * k + 1);
 	}
 	/* Their centroid, in 1/16 pixel (rounded), centres the window. */
-	const int c16 = (8 * moment2 + (moment2 >= 0 ? mass / 2 : -mass / 2)) / mass;
+	int c16 = centroid16(moment2, mass);
 	int wMass = 0, wMoment2 = 0;
-	for (int k = lo; k < hi; ++k) {
-		const int f16 = std::clamp(kWindow16 - std::abs(16 * k + 8 - c16), 0, 16);
-		const int wf = f16 * falls[k - lo];
-		wMass += wf;
-		wMoment2 += wf * (2 * k + 1);
+	for (int pass = 0; pass < win.passes; ++pass) {
+		const int window16 = win.symmetric ? symmetricWindow16(win.window16, c16, lo, hi) : win.window16;
+		wMass = 0;
+		wMoment2 = 0;
+		for (int k = lo; k < hi; ++k) {
+			const int f16 = std::clamp(window16 - std::abs(16 * k + 8 - c16), 0, 16);
+			const int wf = f16 * falls[k - lo];
+			wMass += wf;
+			wMoment2 += wf * (2 * k + 1);
+		}
+		if (wMass <= 0)
+			break;
+		c16 = centroid16(wMoment2, wMass);
 	}
 	moment2Out = wMoment2;
 	return wMass;
@@ -405,6 +452,8 @@ bool fitSide(const ImageView &img, Point2f a, Point2f b, float search, int maxPo
 	std::int32_t vFixes[kFinePoints];
 	cols.run = kRun;
 	cols.window16 = kWindow16;
+	cols.symmetric = win.symmetric;
+	cols.passes = win.passes;
 	cols.kLoMin = kMaxReach;
 	cols.kHiMax = -kMaxReach;
 	for (int i = 0; i < nPoints; ++i, accFix += stepFix) {
@@ -463,13 +512,13 @@ bool fitSide(const ImageView &img, Point2f a, Point2f b, float search, int maxPo
 		if (u >= 0 && u < uDim && vc - half >= 0 && vc + half < vDim) {
 			const std::uint8_t *px = img.data + u * uStep + vc * vStep;
 			wMass = measureColumn([px, step](int j) { return static_cast<int>(px[j * step]); }, kLo, kHi,
-					      kRun, kWindow16, wMoment2);
+					      win, wMoment2);
 		} else {
 			/* Clamped to the image, as a bilinear sampler would. */
 			const int uc = std::clamp(u, 0, uDim - 1);
 			for (int j = -half; j <= half; ++j)
 				p[j] = img.data[uc * uStep + std::clamp(vc + dir * j, 0, vDim - 1) * vStep];
-			wMass = measureColumn([p](int j) { return p[j]; }, kLo, kHi, kRun, kWindow16, wMoment2);
+			wMass = measureColumn([p](int j) { return p[j]; }, kLo, kHi, win, wMoment2);
 		}
 		addCrossing(sums, U, vFix, vc, wMass, wMoment2, dir, vRef, reachFix);
 	}
@@ -531,6 +580,7 @@ bool refineCorners(const ImageView &image, std::array<Point2f, 4> &corners, floa
 	RefineWindow win = window;
 	win.run = std::clamp(win.run, 1, kMaxRun);
 	win.window16 = std::clamp(win.window16, 8, 16 * kMaxRun);
+	win.passes = std::clamp(win.passes, 1, 4);
 	std::array<Point2f, 4> q = corners;
 	/* The wide first pass only has to place the sides roughly: few points. */
 	if (!refineOnce(image, q, search, kCoarsePoints, win))

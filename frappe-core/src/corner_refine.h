@@ -14,9 +14,19 @@ namespace frappe::detail {
 /// defaults suit sharp and slightly blurred edges next to code cells a few
 /// pixels away; a wider window stays unbiased on an edge blurred over many
 /// pixels (run at most 8).
+///
+/// With `symmetric`, the window also reaches no further from the centroid
+/// than the falls do on its other side, and is centred again on the new
+/// centroid `passes` times in all. A blurred edge next to another (a
+/// one-cell quiet zone, a code cell) has its falls cut short on that side,
+/// which pulls a plain window's centroid away from it; a cut matched on
+/// the other side keeps a symmetric profile's centroid in place. On sharp
+/// edges it only narrows the window (more noise): for wide windows.
 struct RefineWindow {
 	int run = 3;
 	int window16 = 32;
+	bool symmetric = false;
+	int passes = 1; ///< 1..4
 };
 
 /// Refines the corners of a clockwise quadrilateral on the full-resolution

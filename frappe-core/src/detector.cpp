@@ -205,7 +205,7 @@ private:
 };
 
 /* The corner refinement window for cells large enough (refineQuad). */
-constexpr detail::RefineWindow kBlurWindow{ 6, 64 };
+constexpr detail::RefineWindow kBlurWindow{ 6, 64, true, 2 };
 
 /* Largest image side accepted: contour coordinates are ints and buffers are
  * sized from width * height. */

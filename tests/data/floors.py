@@ -30,10 +30,11 @@ SETS = {
     'synth/images':             Floor(sens=(0.94, 0.93), fp=(0, 0), mae=(0.20, 0.20)),
     'synth/apriltag36h11':      Floor(sens=(0.95, 0.95), fp=(0, 0), mae=(0.20, 0.20)),
     # Corners under motion blur of 8-12 px stay 1-2 px off (a fifth of the
-    # markers give a third of the error): the refinement window (detector.cpp,
-    # refineQuad) spans 7 px, not a whole blurred edge. The cell-centre read
-    # (verify.cpp) reads more of those markers: 0.350 -> 0.360 px.
-    'synth/blur':               Floor(sens=(0.68, 0.66), fp=(0, 0), mae=(0.37, 0.35), large=(0.97, 0.95)),
+    # markers give a third of the error): a blurred side's fall overlaps the
+    # next edge's (a one-cell quiet zone, a code cell), which no window on
+    # the falls undoes. The symmetric window (corner_refine.h) takes back
+    # the part a one-sided cut causes: 0.361 -> 0.351 px.
+    'synth/blur':               Floor(sens=(0.68, 0.66), fp=(0, 0), mae=(0.36, 0.35), large=(0.97, 0.95)),
     'synth/blur-apriltag36h11': Floor(sens=(0.68, 0.64), fp=(0, 0), large=(0.97, 0.95)),
     # Markers needing a corrected bit: the 4x4 families and 16h5 correct
     # none by default now (as OpenCV's defaults), for no wrong ids.
