@@ -256,22 +256,22 @@ bool EdgeRow(const GradRows &rows, int w, const FrontEndParams &params, std::uin
 	bool any = false;
 	out[0] = 0;
 	out[w - 1] = 0;
-	/* Per column x, over rows y-1..y+1: the sums of gx^2 and of 2 gx gy. */
-	struct ColumnSums {
-		hn::Vec<decltype(d32)> xx, xy2;
-	};
-	auto columnSums = [&](int x) FRAPPE_INLINE_LAMBDA {
-		ColumnSums sums{ zero, zero };
+	/* Per column x, over rows y-1..y+1: the sums of gx^2 (xx) and of
+	 * 2 gx gy (xy2). Pairs of variables, not a struct: SVE's sizeless
+	 * vectors cannot be members. */
+	using V32 = hn::Vec<decltype(d32)>;
+	auto columnSums = [&](int x, V32 &xx, V32 &xy2) FRAPPE_INLINE_LAMBDA {
+		xx = zero;
+		xy2 = zero;
 		for (int r = 0; r < 3; ++r) {
 			const auto t = pairs(r, x);
 			const auto swapped = hn::BitCast(d16, hn::RotateRight<16>(hn::BitCast(du32, t)));
-			sums.xx = hn::Add(sums.xx, PairDot(d32, t, hn::And(t, lowHalf)));
-			sums.xy2 = hn::Add(sums.xy2, PairDot(d32, t, swapped));
+			xx = hn::Add(xx, PairDot(d32, t, hn::And(t, lowHalf)));
+			xy2 = hn::Add(xy2, PairDot(d32, t, swapped));
 		}
-		return sums;
 	};
-	ColumnSums cached{ zero, zero }, cachedPrev{ zero, zero };
-	int cachedAt = -1; /* cached holds the column sums from here on */
+	V32 cachedXx = zero, cachedXy2 = zero, cachedPrevXx = zero, cachedPrevXy2 = zero;
+	int cachedAt = -1; /* cached* hold the column sums from here on */
 
 	/* Classifies the N pixels from x. */
 	auto edgeVector = [&](int x) FRAPPE_INLINE_LAMBDA {
@@ -310,25 +310,31 @@ bool EdgeRow(const GradRows &rows, int w, const FrontEndParams &params, std::uin
 			/* The 3x3 sums as column sums over the three rows,
 			 * then across; the next vector's column sums are kept,
 			 * as edges run along rows. */
-			ColumnSums left, cur, right;
+			V32 leftXx = zero, leftXy2 = zero, curXx = zero, curXy2 = zero, rightXx = zero, rightXy2 = zero;
 			if (x == cachedAt) {
-				cur = cached;
-				left = { PrevColumn(d32, cachedPrev.xx, cur.xx), PrevColumn(d32, cachedPrev.xy2, cur.xy2) };
+				curXx = cachedXx;
+				curXy2 = cachedXy2;
+				leftXx = PrevColumn(d32, cachedPrevXx, curXx);
+				leftXy2 = PrevColumn(d32, cachedPrevXy2, curXy2);
 			} else {
-				cur = columnSums(x);
-				left = columnSums(x - 1);
+				columnSums(x, curXx, curXy2);
+				columnSums(x - 1, leftXx, leftXy2);
 			}
 			if (x + 2 * N <= w) {
-				const ColumnSums nextSums = columnSums(x + N);
-				right = { NextColumn(d32, cur.xx, nextSums.xx), NextColumn(d32, cur.xy2, nextSums.xy2) };
-				cachedPrev = cur;
-				cached = nextSums;
+				V32 nextXx = zero, nextXy2 = zero;
+				columnSums(x + N, nextXx, nextXy2);
+				rightXx = NextColumn(d32, curXx, nextXx);
+				rightXy2 = NextColumn(d32, curXy2, nextXy2);
+				cachedPrevXx = curXx;
+				cachedPrevXy2 = curXy2;
+				cachedXx = nextXx;
+				cachedXy2 = nextXy2;
 				cachedAt = x + N;
 			} else {
-				right = columnSums(x + 1);
+				columnSums(x + 1, rightXx, rightXy2);
 			}
-			const auto sxx = hn::Add(hn::Add(left.xx, cur.xx), right.xx);
-			const auto sxy2 = hn::Add(hn::Add(left.xy2, cur.xy2), right.xy2);
+			const auto sxx = hn::Add(hn::Add(leftXx, curXx), rightXx);
+			const auto sxy2 = hn::Add(hn::Add(leftXy2, curXy2), rightXy2);
 			/* Sxx - Syy = 2 Sxx - S; |Sxy| >> 8 = |2 Sxy| >> 9. */
 			const auto c = hn::ShiftRight<9>(hn::Sub(s, twoT));
 			const auto ad = hn::ShiftRight<9>(hn::Abs(hn::Sub(hn::Add(sxx, sxx), s)));

@@ -23,6 +23,19 @@ namespace HWY_NAMESPACE {
 
 namespace hn = hwy::HWY_NAMESPACE;
 
+/* v << bits, lane by lane. Highway 1.0.3 (Debian 12) spells it Shl on the
+ * scalable targets (SVE, RVV: no operators on sizeless types) and
+ * operator<< elsewhere. */
+template <class V>
+HWY_INLINE V ShiftLeftBy(V v, V bits)
+{
+#if HWY_HAVE_SCALABLE
+	return hn::Shl(v, bits);
+#else
+	return hn::operator<<(v, bits);
+#endif
+}
+
 void LabelsFromEdges(const std::uint8_t *edges, std::size_t n, std::uint8_t *labels)
 {
 	const hn::ScalableTag<std::uint8_t> d8;
@@ -140,7 +153,7 @@ std::uint32_t SideCoverage(const std::uint32_t *pts, std::size_t n, const SideLi
 			hit = hn::And(hit, hn::FirstN(df, n - k));
 		/* t is in [0, 16) where it counts: the shift never exceeds 15. */
 		const auto bin = hn::BitCast(du, hn::ConvertTo(di, hn::IfThenElseZero(hit, t)));
-		covered = hn::Or(covered, hn::IfThenElseZero(hn::RebindMask(du, hit), hn::operator<<(one, bin)));
+		covered = hn::Or(covered, hn::IfThenElseZero(hn::RebindMask(du, hit), ShiftLeftBy(one, bin)));
 	}
 	HWY_ALIGN std::uint32_t lanes[HWY_MAX_BYTES / 4];
 	hn::Store(covered, du, lanes);

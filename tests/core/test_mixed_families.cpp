@@ -111,8 +111,9 @@ void expectOnlyTheirOwn(const Image &img, const std::vector<Placed> &placed, con
 		}
 		/* Its own family's markers are all found. */
 		for (std::size_t i = 0; i < placed.size(); ++i) {
-			if (placed[i].dict == &dict)
+			if (placed[i].dict == &dict) {
 				EXPECT_TRUE(seen.count(i)) << scene << ": " << dict.name << " missed id " << placed[i].id;
+			}
 		}
 	}
 }
