@@ -3,7 +3,7 @@
 # of OpenCV 4.6's aruco module, per frame and per pixel, per stage.
 #
 # Cross-builds frappe-core for ARMv6KZ + VFPv2 (Debian's armel toolchain,
-# scripts/arm/armv6-armel.ini), runs tests/bench/frappe_count.cpp under
+# scripts/arm/armv6-armel-sysroot.ini), runs tests/bench/frappe_count.cpp under
 # `qemu-arm -cpu arm1176` with the instruction-counting TCG plugin
 # scripts/arm/frappecount.c, and prints the tables (see docs/arm.md).
 # Not a test: nothing is asserted. Needs a Debian 12 (bookworm) amd64 host.
@@ -160,7 +160,7 @@ if [ ! -f "$BUILD/build.ninja" ]; then
 	for o in simd gst vc4 tests examples cli; do
 		grep -q "option('$o'" "$SRC/meson_options.txt" && opts+=("-D$o=disabled")
 	done
-	meson setup "$BUILD" "$SRC" --cross-file "$XF" --cross-file "$HERE/armv6-armel.ini" "${opts[@]}" \
+	meson setup "$BUILD" "$SRC" --cross-file "$XF" --cross-file "$HERE/armv6-armel-sysroot.ini" "${opts[@]}" \
 		>"$CACHE/meson-setup.log" 2>&1 || { cat "$CACHE/meson-setup.log" >&2; die "meson setup failed" 4; }
 fi
 step "ninja: frappe-core (ARMv6)"

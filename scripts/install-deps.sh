@@ -15,12 +15,24 @@ packages=(
 	# the GStreamer element and its examples
 	libgstreamer1.0-dev libgstreamer-plugins-base1.0-dev
 	gstreamer1.0-tools gstreamer1.0-plugins-base gstreamer1.0-plugins-good
+	# the Raspberry Pis' CPUs, emulated: the core and vc4 suites cross-built
+	# for ARMv6 (scripts/arm/armv6-armel.ini) and aarch64
+	# (scripts/arm/armv8-arm64.ini), and the ARMv6 kernels' test (tests/armv6)
+	qemu-user crossbuild-essential-armel crossbuild-essential-arm64
+	libgtest-dev:armel libgmock-dev:armel
+	libhwy-dev:arm64 libgtest-dev:arm64 libgmock-dev:arm64
 )
 
 if [ "$(id -u)" -ne 0 ]; then
 	exec sudo "$0" "$@"
 fi
 export DEBIAN_FRONTEND=noninteractive
+# The cross builds' libraries through multiarch: GoogleTest for armel (the
+# cross toolchain's own libc and libstdc++ are used there), GoogleTest and
+# Highway for arm64 (the update below then lists their packages).
+for arch in armel arm64; do
+	dpkg --print-foreign-architectures | grep -qx "$arch" || dpkg --add-architecture "$arch"
+done
 missing=()
 for p in "${packages[@]}"; do
 	dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
