@@ -14,6 +14,7 @@
 #include "contour_trace.h"
 #include "corner_refine.h"
 #include "decode.h"
+#include "front_end_rows.h"
 #include "region_map.h"
 #include "verify.h"
 
@@ -811,5 +812,6 @@ int Detector::maxHamming() const { return impl_->maxHamming; }
 FrontEndParams Detector::frontEndParams() const { return impl_->params; }
 
 const char *version() { return FRAPPE_VERSION; }
+const char *simdTarget() { return detail::simdTargetName(); }
 
 } // namespace frappe

@@ -181,6 +181,15 @@ const RowKernels &bestRowKernels()
 	return scalarRowKernels();
 #endif
 }
+
+const char *simdTargetName()
+{
+#ifdef FRAPPE_HAVE_ARMV6_KERNELS
+	return "ARMv6 SIMD32";
+#else
+	return "scalar";
+#endif
+}
 #endif
 
 } // namespace frappe::detail

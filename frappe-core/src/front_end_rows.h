@@ -109,6 +109,8 @@ const RowKernels &scalarRowKernels();
 /// The fastest kernels for this CPU (Highway's runtime dispatch), or the
 /// ARMv6 SIMD32 ones, or the scalar ones.
 const RowKernels &bestRowKernels();
+/// What bestRowKernels() runs on this CPU (frappe::simdTarget()).
+const char *simdTargetName();
 
 #if defined(__ARM_FEATURE_SIMD32) && defined(__ARM_FEATURE_DSP) && defined(__ARMEL__)
 #define FRAPPE_HAVE_ARMV6_KERNELS 1

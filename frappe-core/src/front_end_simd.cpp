@@ -394,6 +394,12 @@ void RunBand(const BandJob &job)
 }
 
 } // namespace
+
+const char *TargetName()
+{
+	return hwy::TargetName(HWY_TARGET);
+}
+
 } // namespace HWY_NAMESPACE
 } // namespace frappe::detail
 HWY_AFTER_NAMESPACE();
@@ -402,6 +408,13 @@ HWY_AFTER_NAMESPACE();
 namespace frappe::detail {
 
 HWY_EXPORT(RunBand);
+HWY_EXPORT(TargetName);
+
+/* The same dispatch as the band loop's, so it names the code that runs. */
+const char *simdTargetName()
+{
+	return HWY_DYNAMIC_DISPATCH(TargetName)();
+}
 
 namespace {
 
