@@ -182,6 +182,17 @@ $TRIPLET-g++ "${CXXFLAGS[@]}" -no-pie -o "$OUT/frappe-count" "$SRC/tests/bench/f
 	-L"$SYSLIB" "${LIBS[@]}" -Wl,-rpath-link,"$SYSLIB" -Wl,-rpath-link,"$SYSROOT/lib/$TRIPLET" \
 	-Wl,-Map,"$OUT/frappe-count.map" || die "building the driver failed" 4
 $TRIPLET-nm -n -S -C "$OUT/frappe-count" > "$OUT/frappe-count.syms"
+# The markers' entry addresses, where the plugin fires them (and nowhere
+# else in them). One straddling a 4 KiB page (the driver aligns them so none
+# does) would be split in two translation blocks: say so, as a layout change.
+# (functions only, not their `sink` variables; OpenCV's only when it runs)
+awk -v cv="$OPENCV" '$3 ~ /^[Tt]$/ && $4 ~ /^armcount_mark_[a-z_]*$/ && (cv == 1 || $4 !~ /opencv/) { print $1, $4 }' \
+	"$OUT/frappe-count.syms" > "$OUT/marks.txt"
+[ -s "$OUT/marks.txt" ] || die "no armcount_mark_* symbols in $OUT/frappe-count" 4
+awk '$3 ~ /^[Tt]$/ && $4 ~ /^armcount_mark_[a-z_]*$/ { print $1, $2, $4 }' "$OUT/frappe-count.syms" | while read -r a z name; do
+	[ $(( 16#$a >> 12 )) = $(( (16#$a + 16#$z - 1) >> 12 )) ] || echo "arm-count: note: $name straddles a 4 KiB page" >&2
+done
+
 
 # ---- count -------------------------------------------------------------------
 n=$(grep -cv '^\s*\(#\|$\)' "$LIST" || true)
@@ -191,7 +202,7 @@ args=(--list "$LIST" --dictionary "$DICT" --max "$MAX" --out-frappe "$OUT/frappe
 [ "$OPENCV" = 1 ] && args+=(--out-opencv "$OUT/opencv.jsonl") || args+=(--no-opencv)
 [ -n "$REGION" ] && args+=(--region-contrast "$REGION")
 # relative paths in the list are relative to the current directory (the contract)
-( qemu-arm -cpu arm1176 -L "$SYSROOT" -d plugin -plugin "$PLUGIN,out=$OUT/count.log" \
+( qemu-arm -cpu arm1176 -L "$SYSROOT" -d plugin -plugin "$PLUGIN,out=$OUT/count.log,marks=$OUT/marks.txt" \
 	"$OUT/frappe-count" "${args[@]}" > "$OUT/driver.txt" 2> "$OUT/qemu.log" ) ||
 	{ tail -20 "$OUT/qemu.log" >&2; die "the counting run failed (log: $OUT/qemu.log)" 5; }
 

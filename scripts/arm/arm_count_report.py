@@ -136,6 +136,49 @@ def short(name, n=70):
     return base if len(base) <= n else base[: n - 3] + "..."
 
 
+# What the driver calls, in order: once warmup, then for each image the
+# frappe markers and, with OpenCV, its two; exit is written by the plugin.
+NEXT = {
+    None: ("warmup", "frappe_begin"),
+    "warmup": ("frappe_begin", "exit"),
+    "frappe_begin": ("frappe_front",),
+    "frappe_front": ("frappe_back",),
+    "frappe_back": ("frappe_begin", "opencv_begin", "exit"),
+    "opencv_begin": ("opencv_end",),
+    "opencv_end": ("frappe_begin", "exit"),
+}
+
+
+def split_frames(marks):
+    """The frames of a well-formed marker sequence; stops with what broke it
+    (a marker firing twice, a missing one) instead of miscounting."""
+    frames = []
+    prev = None
+    for i, (label, total, cls, bk) in enumerate(marks):
+        expect = NEXT.get(prev, ())
+        if label not in expect:
+            counts = defaultdict(int)
+            for m in marks:
+                counts[m[0]] += 1
+            seen = ", ".join(f"{k} x{v}" for k, v in counts.items())
+            sys.exit(f"arm_count_report: marker #{i} is {label} after {prev or 'the start'}, expected "
+                     f"{' or '.join(expect) or 'nothing'} (frame {max(len(frames) - 1, 0)}, from 0). Markers in the log: {seen}. "
+                     "A marker counted more often than frappe_begin fires more than once a call: "
+                     "is the plugin older than scripts/arm/frappecount.c, or its marks file of another build?")
+        if label == "frappe_begin":
+            frames.append({"fe": None, "be": None, "cv": None})
+        elif label == "frappe_front":
+            frames[-1]["fe"] = (cls, bk)
+        elif label == "frappe_back":
+            frames[-1]["be"] = (cls, bk)
+        elif label == "opencv_end":
+            frames[-1]["cv"] = (cls, bk)
+        prev = label
+    if prev is not None and prev != "exit":
+        print(f"warning: the log ends after {prev}, not at the plugin's exit marker", file=sys.stderr)
+    return [f for f in frames if f["be"] is not None]
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--log", required=True)
@@ -187,30 +230,14 @@ def main():
         print(f"warning: {len(marks) - len(merged)} repeated markers merged", file=sys.stderr)
     marks = merged
 
-    # split the marks into frames
-    frames = []   # dict per frame
-    cur = None
-    for label, total, cls, bk in marks:
-        if label == "frappe_begin":
-            cur = {"fe": None, "be": None, "cv": None}
-            frames.append(cur)
-        elif label == "frappe_front" and cur is not None:
-            cur["fe"] = (cls, bk)
-        elif label == "frappe_back" and cur is not None:
-            cur["be"] = (cls, bk)
-        elif label == "opencv_end" and cur is not None:
-            cur["cv"] = (cls, bk)
-    incomplete = [k for k, fr in enumerate(frames) if fr["fe"] is None or fr["be"] is None]
-    if incomplete:
-        sys.exit(f"arm_count_report: frames {incomplete[:5]} lack their front/back markers")
-    if len(frames) != len(sizes):
-        print(f"warning: {len(frames)} counted frames but {len(sizes)} images in the driver output",
-              file=sys.stderr)
-    n = min(len(frames), len(sizes))
-    if n == 0:
+    frames = split_frames(marks)
+    if not frames:
         sys.exit("arm_count_report: no counted frames (was the plugin loaded? is the driver unstripped?)")
-    frames = frames[:n]
-    sizes = sizes[:n]
+    if len(frames) != len(sizes):
+        # per-pixel numbers would pair frames with the wrong image sizes
+        sys.exit(f"arm_count_report: {len(frames)} counted frames but {len(sizes)} images in the driver "
+                 f"output ({a.driver}): the run or the log is incomplete")
+    n = len(frames)
 
     per_stage = defaultdict(list)      # stage -> per-frame insns
     per_stage_px = defaultdict(list)

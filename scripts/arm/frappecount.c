@@ -14,7 +14,13 @@
  *    ARMv6 has no divide instruction) counts to the main-executable function
  *    whose BL/BLX executed last ("lib", i.e. the library code it called).
  * Markers: a call to a function whose name starts with `armcount_mark_`
- * (extern "C", noinline) writes one snapshot to the out file:
+ * (extern "C", noinline) writes one snapshot to the out file. A marker
+ * fires at its entry address only: with marks=FILE ("<hex address> <name>"
+ * lines, from `nm`) exactly there, without it at the lowest address seen in
+ * the function. Anywhere else would be wrong: QEMU ends a translation block
+ * at a page boundary, so a marker that straddles a 4 KiB page is also met at
+ * the start of a second block in its middle (issue 15: fired twice a call).
+ * The log:
  *    M <label> <total insns so far>
  *    C <12 class deltas> <memory-access delta>
  *    B <bucket> <self delta> <lib delta>      (only buckets that changed)
@@ -27,7 +33,7 @@
  * SPDX-License-Identifier: GPL-2.0-or-later
  *
  * Use: qemu-arm -cpu arm1176 -L SYSROOT -d plugin \
- *          -plugin ./libfrappecount.so,out=FILE ./prog args
+ *          -plugin ./libfrappecount.so,out=FILE[,marks=FILE] ./prog args
  */
 #include <inttypes.h>
 #include <stdbool.h>
@@ -67,6 +73,15 @@ static uint64_t cls_count[C_N], cls_snap[C_N];
 static uint64_t mem_acc, mem_snap;
 static uint32_t cur_caller;          /* bucket of the last executed BL/BLX */
 static FILE *out;
+
+/* marks=FILE: the markers' entry addresses from the symbol table */
+#define MAX_MARKS 64
+static struct {
+    uint64_t addr;
+    char *label;
+    uint64_t fired;
+} marks[MAX_MARKS];
+static int n_marks = -1;             /* -1: no marks file, use the lowest address seen */
 
 static enum cls classify_a32(uint32_t i)
 {
@@ -164,16 +179,13 @@ static void on_lib_tb(unsigned int vcpu, void *ud)
     buckets[cur_caller].lib += (uint64_t)(uintptr_t)ud;
 }
 
-static void on_mark(unsigned int vcpu, void *ud)
+static void write_mark(const char *label)
 {
     uint64_t total = 0;
-    if (!out) {
-        return;
-    }
     for (int c = 0; c < C_N; c++) {
         total += cls_count[c];
     }
-    fprintf(out, "M %s %" PRIu64 "\nC", (const char *)ud, total);
+    fprintf(out, "M %s %" PRIu64 "\nC", label, total);
     for (int c = 0; c < C_N; c++) {
         fprintf(out, " %" PRIu64, cls_count[c] - cls_snap[c]);
         cls_snap[c] = cls_count[c];
@@ -189,6 +201,59 @@ static void on_mark(unsigned int vcpu, void *ud)
             b->snap_lib = b->lib;
         }
     }
+}
+
+static void on_mark(unsigned int vcpu, void *ud)
+{
+    if (out) {
+        write_mark((const char *)ud);
+    }
+}
+
+static void on_mark_exact(unsigned int vcpu, void *ud)
+{
+    int k = (int)(uintptr_t)ud;
+    marks[k].fired++;
+    if (out) {
+        write_mark(marks[k].label);
+    }
+}
+
+/* the marks=FILE entry at this address, or -1 */
+static int mark_at(uint64_t va)
+{
+    for (int k = 0; k < n_marks; k++) {
+        if (marks[k].addr == va) {
+            return k;
+        }
+    }
+    return -1;
+}
+
+static int read_marks(const char *path)
+{
+    FILE *f = fopen(path, "r");
+    char name[256];
+    unsigned long long addr;
+    if (!f) {
+        fprintf(stderr, "frappecount: cannot read %s\n", path);
+        return -1;
+    }
+    n_marks = 0;
+    while (fscanf(f, "%llx %255s", &addr, name) == 2) {
+        if (strncmp(name, MARK_PREFIX, strlen(MARK_PREFIX)) != 0) {
+            continue;
+        }
+        if (n_marks == MAX_MARKS) {
+            fprintf(stderr, "frappecount: more than %d markers in %s\n", MAX_MARKS, path);
+            break;
+        }
+        marks[n_marks].addr = addr;
+        marks[n_marks].label = strdup(name + strlen(MARK_PREFIX));
+        n_marks++;
+    }
+    fclose(f);
+    return 0;
 }
 
 static void tb_trans(qemu_plugin_id_t id, struct qemu_plugin_tb *tb)
@@ -222,12 +287,17 @@ static void tb_trans(qemu_plugin_id_t id, struct qemu_plugin_tb *tb)
             qemu_plugin_register_vcpu_insn_exec_cb(insn, on_call, QEMU_PLUGIN_CB_NO_REGS,
                                                    (void *)(uintptr_t)b);
         }
-        /* Only at the marker's entry: a TB ends at a page boundary, so a
-         * marker that straddles one is also met at the start of a second
-         * TB (k == 0) in its middle, and would fire twice per call. The
-         * first TB of a marker always starts at its entry (it is entered
-         * by a call), so its lowest address seen is the entry. */
-        if (strncmp(s, MARK_PREFIX, strlen(MARK_PREFIX)) == 0 && va == buckets[b].entry) {
+        /* Only at the marker's entry (see the top). Without marks=FILE the
+         * entry is the lowest address seen: a marker is entered by a call,
+         * so its first TB starts at its entry. */
+        if (n_marks >= 0) {
+            int m = mark_at(va);
+            if (m >= 0) {
+                qemu_plugin_register_vcpu_insn_exec_cb(insn, on_mark_exact, QEMU_PLUGIN_CB_NO_REGS,
+                                                       (void *)(uintptr_t)m);
+            }
+        } else if (strncmp(s, MARK_PREFIX, strlen(MARK_PREFIX)) == 0 && va == buckets[b].entry) {
+
             qemu_plugin_register_vcpu_insn_exec_cb(insn, on_mark, QEMU_PLUGIN_CB_NO_REGS,
                                                    (void *)(s + strlen(MARK_PREFIX)));
         }
@@ -247,8 +317,18 @@ static void at_exit(qemu_plugin_id_t id, void *p)
     }
     snprintf(line, sizeof line, "frappecount: insns %" PRIu64 ", functions %u\n", total, n_buckets - 1);
     qemu_plugin_outs(line);
+    /* a marker that never fired: its address in marks=FILE is not where
+     * the program runs it (a PIE, or a file of another build) */
+    for (int k = 0; k < n_marks; k++) {
+        if (!marks[k].fired) {
+            snprintf(line, sizeof line, "frappecount: marker %s at 0x%" PRIx64 " never fired\n",
+                     marks[k].label, marks[k].addr);
+            qemu_plugin_outs(line);
+        }
+    }
     if (out) {
-        on_mark(0, (void *)"exit");
+        write_mark("exit");
+
         for (uint32_t k = 1; k < n_buckets; k++) {
             fprintf(out, "N %u %" PRIx64 " %s\n", k, buckets[k].entry, buckets[k].name);
         }
@@ -265,6 +345,10 @@ QEMU_PLUGIN_EXPORT int qemu_plugin_install(qemu_plugin_id_t id, const qemu_info_
             out = fopen(argv[k] + 4, "w");
             if (!out) {
                 fprintf(stderr, "frappecount: cannot write %s\n", argv[k] + 4);
+                return -1;
+            }
+        } else if (strncmp(argv[k], "marks=", 6) == 0) {
+            if (read_marks(argv[k] + 6) != 0) {
                 return -1;
             }
         } else {
