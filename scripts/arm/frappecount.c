@@ -1,9 +1,10 @@
 /*
  * frappecount: a QEMU 7.2 TCG plugin (plugin API v1, Debian 12's qemu-user)
- * that counts the guest instructions of a 32-bit ARM (A32) program per
- * function of the main executable and per interval between marker calls.
- * Used by scripts/arm-count.sh; based on the team's armcount plugin (same
- * instruction classes).
+ * that counts the guest instructions of an ARM program (A32 under qemu-arm,
+ * A64 under qemu-aarch64) per function of the main executable and per
+ * interval between marker calls. Used by scripts/arm-count.sh; based on the
+ * team's armcount plugin (same A32 instruction classes; A64 instructions are
+ * sorted into the same twelve slots, named in the log's first line).
  *
  * Attribution:
  *  - an instruction inside a symbol of the main executable (unstripped,
@@ -12,7 +13,8 @@
  *    libstdc++, OpenCV; PLT stubs) or in a symbol starting with "__" (the
  *    libgcc helpers linked into the executable: __aeabi_idiv, __divsi3 ...:
  *    ARMv6 has no divide instruction) counts to the main-executable function
- *    whose BL/BLX executed last ("lib", i.e. the library code it called).
+ *    whose BL/BLX (A64: BL/BLR) executed last ("lib", i.e. the library
+ *    code it called).
  * Markers: a call to a function whose name starts with `armcount_mark_`
  * (extern "C", noinline) writes one snapshot to the out file. A marker
  * fires at its entry address only: with marks=FILE ("<hex address> <name>"
@@ -21,6 +23,7 @@
  * at a page boundary, so a marker that straddles a 4 KiB page is also met at
  * the start of a second block in its middle (issue 15: fired twice a call).
  * The log:
+ *    A <class names, 12>                      (first line)
  *    M <label> <total insns so far>
  *    C <12 class deltas> <memory-access delta>
  *    B <bucket> <self delta> <lib delta>      (only buckets that changed)
@@ -34,6 +37,7 @@
  *
  * Use: qemu-arm -cpu arm1176 -L SYSROOT -d plugin \
  *          -plugin ./libfrappecount.so,out=FILE[,marks=FILE] ./prog args
+ *      qemu-aarch64 -cpu cortex-a53 -L / -d plugin -plugin ... ./prog args
  */
 #include <inttypes.h>
 #include <stdbool.h>
@@ -54,6 +58,12 @@ static const char *const cls_name[C_N] = {
     "alu", "mul", "media_simd32", "branch", "load", "store", "ldm", "stm",
     "vfp", "vfp_ldst", "thumb16", "other"
 };
+/* A64 in the same slots: no SIMD32 or Thumb; LDP/STP take the LDM/STM
+ * slots, NEON and FP data processing the VFP slot. */
+static const char *const cls_name_a64[C_N] = {
+    "alu", "mul", "-", "branch", "load", "store", "ldp", "stp",
+    "simd_fp", "simd_fp_ldst", "-", "other"
+};
 
 #define MAX_BUCKETS 65536
 #define HASH_SIZE (1 << 17)
@@ -73,6 +83,7 @@ static uint64_t cls_count[C_N], cls_snap[C_N];
 static uint64_t mem_acc, mem_snap;
 static uint32_t cur_caller;          /* bucket of the last executed BL/BLX */
 static FILE *out;
+static bool a64;                     /* qemu-aarch64 */
 
 /* marks=FILE: the markers' entry addresses from the symbol table */
 #define MAX_MARKS 64
@@ -133,6 +144,49 @@ static enum cls classify_a32(uint32_t i)
         }
         return (cp == 10 || cp == 11) ? C_VFP : C_OTHER;
     }
+}
+
+static enum cls classify_a64(uint32_t i)
+{
+    uint32_t op0 = (i >> 25) & 0xf;
+
+    if ((op0 & 0xe) == 0x8) {
+        return C_ALU;              /* data processing, immediate */
+    }
+    if ((op0 & 0xe) == 0xa) {
+        if ((i >> 24) == 0xd4 || (i >> 22) == 0x354) {
+            return C_OTHER;        /* exceptions (SVC), system (barriers, hints) */
+        }
+        return C_BRANCH;
+    }
+    if ((op0 & 0x5) == 0x4) {      /* loads and stores */
+        bool simd = (i >> 26) & 1, load = (i >> 22) & 1;
+        if (((i >> 28) & 3) == 3 && !simd) {
+            load = ((i >> 22) & 3) != 0; /* single register: opc 1x are loads too */
+        } else if (((i >> 28) & 3) == 1 && ((i >> 24) & 1) == 0) {
+            load = true;           /* literal */
+        }
+        if (simd) {
+            return C_VFP_LDST;
+        }
+        if (((i >> 27) & 7) == 5) {
+            return load ? C_LDM : C_STM; /* pairs */
+        }
+        return load ? C_LOAD : C_STORE;
+    }
+    if ((op0 & 0x7) == 0x5) {      /* data processing, register */
+        return ((i >> 24) & 0x1f) == 0x1b ? C_MUL : C_ALU;
+    }
+    if ((op0 & 0x7) == 0x7) {
+        return C_VFP;              /* NEON and scalar FP */
+    }
+    return C_OTHER;
+}
+
+static bool is_call_a64(uint32_t i)
+{
+    return (i & 0xfc000000u) == 0x94000000u ||        /* BL */
+           (i & 0xfffffc1fu) == 0xd63f0000u;          /* BLR */
 }
 
 static bool is_call_a32(uint32_t i)
@@ -266,9 +320,11 @@ static void tb_trans(qemu_plugin_id_t id, struct qemu_plugin_tb *tb)
         uint64_t va = qemu_plugin_insn_vaddr(insn);
         uint32_t w = 0;
         enum cls c = C_THUMB;
+        bool call = false;
         if (qemu_plugin_insn_size(insn) == 4) {
             memcpy(&w, qemu_plugin_insn_data(insn), 4);
-            c = classify_a32(w);
+            c = a64 ? classify_a64(w) : classify_a32(w);
+            call = a64 ? is_call_a64(w) : is_call_a32(w);
         }
         qemu_plugin_register_vcpu_insn_exec_inline(insn, QEMU_PLUGIN_INLINE_ADD_U64,
                                                    &cls_count[c], 1);
@@ -283,7 +339,7 @@ static void tb_trans(qemu_plugin_id_t id, struct qemu_plugin_tb *tb)
         uint32_t b = bucket_of(s, va);
         qemu_plugin_register_vcpu_insn_exec_inline(insn, QEMU_PLUGIN_INLINE_ADD_U64,
                                                    &buckets[b].self, 1);
-        if (qemu_plugin_insn_size(insn) == 4 && is_call_a32(w)) {
+        if (call) {
             qemu_plugin_register_vcpu_insn_exec_cb(insn, on_call, QEMU_PLUGIN_CB_NO_REGS,
                                                    (void *)(uintptr_t)b);
         }
@@ -297,7 +353,6 @@ static void tb_trans(qemu_plugin_id_t id, struct qemu_plugin_tb *tb)
                                                        (void *)(uintptr_t)m);
             }
         } else if (strncmp(s, MARK_PREFIX, strlen(MARK_PREFIX)) == 0 && va == buckets[b].entry) {
-
             qemu_plugin_register_vcpu_insn_exec_cb(insn, on_mark, QEMU_PLUGIN_CB_NO_REGS,
                                                    (void *)(s + strlen(MARK_PREFIX)));
         }
@@ -328,7 +383,6 @@ static void at_exit(qemu_plugin_id_t id, void *p)
     }
     if (out) {
         write_mark("exit");
-
         for (uint32_t k = 1; k < n_buckets; k++) {
             fprintf(out, "N %u %" PRIx64 " %s\n", k, buckets[k].entry, buckets[k].name);
         }
@@ -356,8 +410,16 @@ QEMU_PLUGIN_EXPORT int qemu_plugin_install(qemu_plugin_id_t id, const qemu_info_
             return -1;
         }
     }
-    if (strcmp(info->target_name, "arm") != 0) {
-        fprintf(stderr, "frappecount: classes assume 32-bit ARM; target is %s\n", info->target_name);
+    a64 = strcmp(info->target_name, "aarch64") == 0;
+    if (!a64 && strcmp(info->target_name, "arm") != 0) {
+        fprintf(stderr, "frappecount: classes assume ARM; target is %s\n", info->target_name);
+    }
+    if (out) {
+        fprintf(out, "A");
+        for (int c = 0; c < C_N; c++) {
+            fprintf(out, " %s", a64 ? cls_name_a64[c] : cls_name[c]);
+        }
+        fprintf(out, "\n");
     }
     qemu_plugin_register_vcpu_tb_trans_cb(id, tb_trans);
     qemu_plugin_register_atexit_cb(id, at_exit, NULL);
