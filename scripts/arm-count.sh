@@ -1,27 +1,36 @@
 #!/bin/bash
-# ARMv6 (Raspberry Pi Zero, ARM1176JZF-S) instruction counts of frappe-core and
-# of OpenCV 4.6's aruco module, per frame and per pixel, per stage.
+# ARMv6 (Raspberry Pi Zero, ARM1176JZF-S) or aarch64 (Pi Zero 2 W, 3, 4)
+# instruction counts of frappe-core and of OpenCV 4.6's aruco module, per
+# frame and per pixel, per stage.
 #
 # Cross-builds frappe-core for ARMv6KZ + VFPv2 (Debian's armel toolchain,
-# scripts/arm/armv6-armel-sysroot.ini), runs tests/bench/frappe_count.cpp under
-# `qemu-arm -cpu arm1176` with the instruction-counting TCG plugin
+# scripts/arm/armv6-armel-sysroot.ini) or for ARMv8-A (Debian's arm64
+# toolchain and multiarch libraries, scripts/arm/armv8-arm64.ini), runs
+# tests/bench/frappe_count.cpp under `qemu-arm -cpu arm1176` or
+# `qemu-aarch64 -cpu cortex-a53` with the instruction-counting TCG plugin
 # scripts/arm/frappecount.c, and prints the tables (see docs/arm.md).
 # Not a test: nothing is asserted. Needs a Debian 12 (bookworm) amd64 host.
 #
 # usage: scripts/arm-count.sh [options]
+#   --arch A           armv6 (default) or aarch64
+#   --scalar           aarch64 only: -Dsimd=disabled (the scalar kernels)
+#                      instead of Highway's NEON kernels (ARMv6 is always
+#                      -Dsimd=disabled, with its SIMD32 kernels)
 #   --list FILE        images, one path a line (the detector contract's list format)
 #   --images DIR       or every *.png / *.jpg in DIR
 #                      (default: ../shared/data/synth/images beside the checkout)
 #   --dictionary NAME  default aruco_mip_36h12
 #   --max N            only the first N images
-#   --no-opencv        count frappe only
+#   --no-opencv        count frappe only (always so with --arch aarch64)
 #   --region-contrast C  Config::region_contrast for frappe (0: no region map
 #                      and no region candidates; default: the Config default)
 #   --out DIR          where the results go (default: BUILD/arm-count)
-#   --build DIR        cross build dir (default: build-armel in the checkout)
+#   --build DIR        cross build dir (default in the checkout: build-armel,
+#                      build-arm64-count, build-arm64-count-scalar)
 #   --setup            install missing host packages with apt-get (root) instead of stopping
 #   --jobs N           ninja -j (default 2)
-# env: FRAPPE_ARM_CACHE  where the sysroot, the plugin and the qemu header live
+# env: FRAPPE_ARM_CACHE  where the sysroot, the plugin, the qemu header and the
+#                        arm64 libpng/libjpeg/zlib archives live
 #                        (default ${XDG_CACHE_HOME:-$HOME/.cache}/frappe-arm)
 #      SYSROOT           an existing armel sysroot to reuse (e.g. /tmp/sysroot-armel
 #                        from the team's make-sysroot.sh; it needs libopencv_aruco
@@ -32,8 +41,11 @@ set -euo pipefail
 SRC=$(cd "$(dirname "$0")/.." && pwd)
 HERE=$SRC/scripts/arm
 LIST="" IMAGES="" DICT=aruco_mip_36h12 MAX=0 OPENCV=1 BUILD="" SETUP=0 JOBS=2 REGION="" OUT=""
+ARCH=armv6 SCALAR=0
 while [ $# -gt 0 ]; do
 	case "$1" in
+	--arch) ARCH=$2; shift 2;;
+	--scalar) SCALAR=1; shift;;
 	--list) LIST=$2; shift 2;;
 	--images) IMAGES=$2; shift 2;;
 	--dictionary) DICT=$2; shift 2;;
@@ -48,16 +60,36 @@ while [ $# -gt 0 ]; do
 	*) echo "arm-count: unknown option $1 (see --help)" >&2; exit 2;;
 	esac
 done
-BUILD=${BUILD:-$SRC/build-armel}
-CACHE=${FRAPPE_ARM_CACHE:-${XDG_CACHE_HOME:-$HOME/.cache}/frappe-arm}
-SYSROOT=${SYSROOT:-$CACHE/sysroot-armel}
-TRIPLET=arm-linux-gnueabi
-OUT=${OUT:-$BUILD/arm-count}
-mkdir -p "$OUT"
-OUT=$(cd "$OUT" && pwd)
 t0=$(date +%s)
 step() { echo "== [$(( $(date +%s) - t0 )) s] $*" >&2; }
 die() { echo "arm-count: $1" >&2; exit "${2:-1}"; }
+CACHE=${FRAPPE_ARM_CACHE:-${XDG_CACHE_HOME:-$HOME/.cache}/frappe-arm}
+case "$ARCH" in
+armv6)
+	[ "$SCALAR" = 0 ] || die "--scalar is for --arch aarch64 (the ARMv6 build has no Highway)" 2
+	BUILD=${BUILD:-$SRC/build-armel}
+	SYSROOT=${SYSROOT:-$CACHE/sysroot-armel}
+	TRIPLET=arm-linux-gnueabi
+	QEMU=(qemu-arm -cpu arm1176 -L "$SYSROOT")
+	REPORT_ARCH=armv6
+	;;
+aarch64)
+	# no sysroot: Debian's arm64 multiarch libraries (loader, libstdc++, libhwy)
+	SUFFIX=""
+	[ "$SCALAR" = 0 ] || SUFFIX=-scalar
+	BUILD=${BUILD:-$SRC/build-arm64-count$SUFFIX}
+	TRIPLET=aarch64-linux-gnu
+	QEMU=(qemu-aarch64 -cpu cortex-a53 -L /)
+	REPORT_ARCH=aarch64$SUFFIX
+	# Debian's libopencv-dev:arm64 is not co-installable with the amd64 one
+	# (it would replace hundreds of packages): frappe only
+	OPENCV=0
+	;;
+*) die "--arch is armv6 or aarch64, not $ARCH" 2;;
+esac
+OUT=${OUT:-$BUILD/arm-count}
+mkdir -p "$OUT"
+OUT=$(cd "$OUT" && pwd)
 
 # ---- the image list ----------------------------------------------------------
 if [ -z "$LIST" ]; then
@@ -74,14 +106,23 @@ LIST=$(cd "$(dirname "$LIST")" && pwd)/$(basename "$LIST")
 
 # ---- host tools ---------------------------------------------------------------
 need_pkgs=""
-command -v $TRIPLET-g++ >/dev/null || need_pkgs="$need_pkgs crossbuild-essential-armel"
-command -v qemu-arm >/dev/null || need_pkgs="$need_pkgs qemu-user"
+if [ "$ARCH" = aarch64 ]; then
+	dpkg --print-foreign-architectures | grep -qx arm64 ||
+		die "the arm64 architecture is not enabled: dpkg --add-architecture arm64 && apt-get update" 3
+	command -v $TRIPLET-g++ >/dev/null || need_pkgs="$need_pkgs crossbuild-essential-arm64"
+	# the loader and C++ runtime qemu-aarch64 -L / runs the driver with
+	[ -f /usr/lib/$TRIPLET/libstdc++.so.6 ] || need_pkgs="$need_pkgs libstdc++6:arm64"
+	[ "$SCALAR" = 1 ] || [ -f /usr/lib/$TRIPLET/pkgconfig/libhwy.pc ] || need_pkgs="$need_pkgs libhwy-dev:arm64"
+else
+	command -v $TRIPLET-g++ >/dev/null || need_pkgs="$need_pkgs crossbuild-essential-armel"
+fi
+command -v "${QEMU[0]}" >/dev/null || need_pkgs="$need_pkgs qemu-user"
 command -v meson >/dev/null || need_pkgs="$need_pkgs meson"
 command -v ninja >/dev/null || need_pkgs="$need_pkgs ninja-build"
 command -v pkg-config >/dev/null || need_pkgs="$need_pkgs pkgconf"
 command -v python3 >/dev/null || need_pkgs="$need_pkgs python3"
 command -v gcc >/dev/null || need_pkgs="$need_pkgs gcc"
-if [ ! -f "$SYSROOT/usr/lib/$TRIPLET/libstdc++.so.6" ] && ! command -v mmdebstrap >/dev/null; then
+if [ "$ARCH" = armv6 ] && [ ! -f "$SYSROOT/usr/lib/$TRIPLET/libstdc++.so.6" ] && ! command -v mmdebstrap >/dev/null; then
 	need_pkgs="$need_pkgs mmdebstrap"
 fi
 if [ -n "$need_pkgs" ]; then
@@ -98,11 +139,12 @@ if [ -n "$need_pkgs" ]; then
 	fi
 fi
 # qemu-user-static cannot load plugins; Debian's dynamic qemu-user can.
-if ! ldd "$(command -v qemu-arm)" >/dev/null 2>&1; then
-	die "$(command -v qemu-arm) is a static build, which cannot load TCG plugins: install qemu-user (not only qemu-user-static)" 3
+if ! ldd "$(command -v "${QEMU[0]}")" >/dev/null 2>&1; then
+	die "$(command -v "${QEMU[0]}") is a static build, which cannot load TCG plugins: install qemu-user (not only qemu-user-static)" 3
 fi
 
-# ---- the armel sysroot --------------------------------------------------------
+# ---- the armel sysroot, or arm64 libpng/libjpeg/zlib ----------------------------
+if [ "$ARCH" = armv6 ]; then
 if [ ! -f "$SYSROOT/usr/lib/$TRIPLET/libstdc++.so.6" ]; then
 	[ -e "$SYSROOT" ] && [ -n "$(ls -A "$SYSROOT" 2>/dev/null)" ] &&
 		die "$SYSROOT exists but is not an armel sysroot (no usr/lib/$TRIPLET/libstdc++.so.6); remove it or set SYSROOT" 3
@@ -118,6 +160,25 @@ SYSLIB=$SYSROOT/usr/lib/$TRIPLET
 	die "the sysroot $SYSROOT has no libpng/libjpeg headers (install libpng-dev and libjpeg62-turbo-dev into it, or use scripts/arm/make-sysroot-count.sh)" 3
 if [ "$OPENCV" = 1 ] && [ ! -e "$SYSLIB/libopencv_aruco.so" ]; then
 	die "the sysroot $SYSROOT has no libopencv_aruco.so (scripts/arm/make-sysroot-count.sh adds it); or pass --no-opencv" 3
+fi
+else
+	# The driver's image decoding, linked statically from the arm64 -dev
+	# packages unpacked into the cache: installing them by multiarch pulls
+	# libc6-dev:arm64 and upgrades a dozen host packages to matching versions.
+	# The system's are used when installed.
+	ADEV=$CACHE/arm64-dev
+	if [ -f /usr/lib/$TRIPLET/libpng16.a ] && [ -f /usr/lib/$TRIPLET/libjpeg.a ] && [ -f /usr/lib/$TRIPLET/libz.a ]; then
+		ADEV=""
+	elif [ ! -f "$ADEV/usr/lib/$TRIPLET/libjpeg.a" ] || [ ! -f "$ADEV/usr/lib/$TRIPLET/libpng16.a" ] ||
+	     [ ! -f "$ADEV/usr/lib/$TRIPLET/libz.a" ]; then
+		step "libpng/libjpeg/zlib arm64 archives -> $ADEV (apt-get download)"
+		rm -rf "$ADEV.debs" && mkdir -p "$ADEV.debs" && chmod 777 "$ADEV.debs" # apt's _apt user writes there
+		( cd "$ADEV.debs" && apt-get download -q libpng-dev:arm64 libjpeg62-turbo-dev:arm64 zlib1g-dev:arm64 &&
+		  for d in ./*.deb; do dpkg-deb -x "$d" "$ADEV"; done ) >"$CACHE/arm64-dev.log" 2>&1 ||
+			die "could not get the arm64 libpng/libjpeg/zlib packages (log: $CACHE/arm64-dev.log); or install libpng-dev:arm64 libjpeg62-turbo-dev:arm64" 3
+		rm -rf "$ADEV.debs"
+	fi
+	SYSLIB=${ADEV:-}/usr/lib/$TRIPLET
 fi
 
 # ---- the counting plugin (needs qemu-plugin.h from Debian's qemu source) ------
@@ -148,55 +209,84 @@ if [ ! -f "$PLUGIN" ] || [ "$HERE/frappecount.c" -nt "$PLUGIN" ]; then
 		"$HERE/frappecount.c" -o "$PLUGIN"
 fi
 
-# ---- cross build of frappe-core (static, no Highway: the ARMv6 row kernels) ---
+# ---- cross build of frappe-core (static; ARMv6: no Highway, its row kernels) --
 mkdir -p "$CACHE"
-XF=$CACHE/sysroot-armel.ini
-printf "[constants]\nsysroot = '%s'\n" "$SYSROOT" > "$XF.tmp"
-cmp -s "$XF.tmp" "$XF" 2>/dev/null && rm "$XF.tmp" || mv "$XF.tmp" "$XF"
+if [ "$ARCH" = armv6 ]; then
+	XF=$CACHE/sysroot-armel.ini
+	printf "[constants]\nsysroot = '%s'\n" "$SYSROOT" > "$XF.tmp"
+	cmp -s "$XF.tmp" "$XF" 2>/dev/null && rm "$XF.tmp" || mv "$XF.tmp" "$XF"
+	XFILES=(--cross-file "$XF" --cross-file "$HERE/armv6-armel-sysroot.ini")
+	WHAT="ARMv6KZ + VFPv2" SIMD=disabled
+else
+	XFILES=(--cross-file "$HERE/armv8-arm64.ini")
+	WHAT="ARMv8-A, $([ "$SCALAR" = 1 ] && echo scalar || echo "Highway NEON")"
+	SIMD=$([ "$SCALAR" = 1 ] && echo disabled || echo enabled)
+fi
 if [ ! -f "$BUILD/build.ninja" ]; then
-	step "meson setup $BUILD (cross, ARMv6KZ + VFPv2)"
-	opts=(--buildtype=release -Ddefault_library=static)
+	step "meson setup $BUILD (cross, $WHAT)"
+	opts=(--buildtype=release -Ddefault_library=static "-Dsimd=$SIMD")
 	# switch off whatever the project can build beside the library
-	for o in simd gst vc4 tests examples cli; do
+	for o in gst vc4 tests examples cli; do
 		grep -q "option('$o'" "$SRC/meson_options.txt" && opts+=("-D$o=disabled")
 	done
-	meson setup "$BUILD" "$SRC" --cross-file "$XF" --cross-file "$HERE/armv6-armel-sysroot.ini" "${opts[@]}" \
+	meson setup "$BUILD" "$SRC" "${XFILES[@]}" "${opts[@]}" \
 		>"$CACHE/meson-setup.log" 2>&1 || { cat "$CACHE/meson-setup.log" >&2; die "meson setup failed" 4; }
+elif ! python3 -c "import json,sys; sys.exit(0 if any(o['name'] == 'simd' and o['value'] == '$SIMD'
+		for o in json.load(open('$BUILD/meson-info/intro-buildoptions.json'))) else 1)" 2>/dev/null; then
+	die "$BUILD was not set up with -Dsimd=$SIMD (a build of another --arch or --scalar?): pass another --build" 4
 fi
-step "ninja: frappe-core (ARMv6)"
+step "ninja: frappe-core ($WHAT)"
 LIB=frappe-core/libfrappe-core.a
 ninja -C "$BUILD" -j"$JOBS" "$LIB" >&2 || die "cross build of frappe-core failed" 4
 
 step "driver tests/bench/frappe_count.cpp"
 mkdir -p "$OUT"
-CXXFLAGS=(-std=c++20 -O3 -march=armv6kz -mtune=arm1176jzf-s -mfpu=vfp -mfloat-abi=softfp -pthread
-	  -I"$SRC/frappe-core/include" -isystem "$SYSROOT/usr/include" -isystem "$SYSROOT/usr/include/$TRIPLET")
+CXXFLAGS=(-std=c++20 -O3 -pthread -I"$SRC/frappe-core/include")
 LIBS=("$BUILD/$LIB")
-if [ "$OPENCV" = 1 ]; then
-	CXXFLAGS+=(-DFRAPPE_COUNT_OPENCV -isystem "$SYSROOT/usr/include/opencv4")
-	LIBS+=(-lopencv_aruco -lopencv_calib3d -lopencv_imgproc -lopencv_core)
+if [ "$ARCH" = armv6 ]; then
+	CXXFLAGS+=(-march=armv6kz -mtune=arm1176jzf-s -mfpu=vfp -mfloat-abi=softfp
+		   -isystem "$SYSROOT/usr/include" -isystem "$SYSROOT/usr/include/$TRIPLET")
+	if [ "$OPENCV" = 1 ]; then
+		CXXFLAGS+=(-DFRAPPE_COUNT_OPENCV -isystem "$SYSROOT/usr/include/opencv4")
+		LIBS+=(-lopencv_aruco -lopencv_calib3d -lopencv_imgproc -lopencv_core)
+	fi
+	LIBS+=(-L"$SYSLIB" -lpng16 -ljpeg -lz -Wl,-rpath-link,"$SYSLIB" -Wl,-rpath-link,"$SYSROOT/lib/$TRIPLET")
+else
+	# the archives by path: -L/usr/lib/$TRIPLET could also put the multiarch
+	# libc before the cross toolchain's
+	[ -n "$ADEV" ] && CXXFLAGS+=(-isystem "$ADEV/usr/include" -isystem "$ADEV/usr/include/$TRIPLET")
+	[ "$SCALAR" = 1 ] || LIBS+=(/usr/lib/$TRIPLET/libhwy.so)
+	LIBS+=("$SYSLIB/libpng16.a" "$SYSLIB/libjpeg.a" "$SYSLIB/libz.a" -lm)
 fi
-LIBS+=(-lpng16 -ljpeg -lz)
 # -no-pie: the plugin's addresses then match the executable's symbol table.
 $TRIPLET-g++ "${CXXFLAGS[@]}" -no-pie -o "$OUT/frappe-count" "$SRC/tests/bench/frappe_count.cpp" \
-	-L"$SYSLIB" "${LIBS[@]}" -Wl,-rpath-link,"$SYSLIB" -Wl,-rpath-link,"$SYSROOT/lib/$TRIPLET" \
-	-Wl,-Map,"$OUT/frappe-count.map" || die "building the driver failed" 4
+	"${LIBS[@]}" -Wl,-Map,"$OUT/frappe-count.map" || die "building the driver failed" 4
 $TRIPLET-nm -n -S -C "$OUT/frappe-count" > "$OUT/frappe-count.syms"
+# The markers' entry addresses, where the plugin fires them (and nowhere
+# else in them). One straddling a 4 KiB page (the driver aligns them so none
+# does) would be split in two translation blocks: say so, as a layout change.
+# (functions only, not their `sink` variables; OpenCV's only when it runs)
+awk -v cv="$OPENCV" '$3 ~ /^[Tt]$/ && $4 ~ /^armcount_mark_[a-z_]*$/ && (cv == 1 || $4 !~ /opencv/) { print $1, $4 }' \
+	"$OUT/frappe-count.syms" > "$OUT/marks.txt"
+[ -s "$OUT/marks.txt" ] || die "no armcount_mark_* symbols in $OUT/frappe-count" 4
+awk '$3 ~ /^[Tt]$/ && $4 ~ /^armcount_mark_[a-z_]*$/ { print $1, $2, $4 }' "$OUT/frappe-count.syms" | while read -r a z name; do
+	[ $(( 16#$a >> 12 )) = $(( (16#$a + 16#$z - 1) >> 12 )) ] || echo "arm-count: note: $name straddles a 4 KiB page" >&2
+done
 
 # ---- count -------------------------------------------------------------------
 n=$(grep -cv '^\s*\(#\|$\)' "$LIST" || true)
 [ "$MAX" -gt 0 ] && [ "$MAX" -lt "$n" ] && n=$MAX
-step "counting $n images under qemu-arm -cpu arm1176 (OpenCV: $([ "$OPENCV" = 1 ] && echo yes || echo no))"
+step "counting $n images under ${QEMU[*]:0:3} (OpenCV: $([ "$OPENCV" = 1 ] && echo yes || echo no))"
 args=(--list "$LIST" --dictionary "$DICT" --max "$MAX" --out-frappe "$OUT/frappe.jsonl")
 [ "$OPENCV" = 1 ] && args+=(--out-opencv "$OUT/opencv.jsonl") || args+=(--no-opencv)
 [ -n "$REGION" ] && args+=(--region-contrast "$REGION")
 # relative paths in the list are relative to the current directory (the contract)
-( qemu-arm -cpu arm1176 -L "$SYSROOT" -d plugin -plugin "$PLUGIN,out=$OUT/count.log" \
+( "${QEMU[@]}" -d plugin -plugin "$PLUGIN,out=$OUT/count.log,marks=$OUT/marks.txt" \
 	"$OUT/frappe-count" "${args[@]}" > "$OUT/driver.txt" 2> "$OUT/qemu.log" ) ||
 	{ tail -20 "$OUT/qemu.log" >&2; die "the counting run failed (log: $OUT/qemu.log)" 5; }
 
 step "report"
 python3 "$HERE/arm_count_report.py" --log "$OUT/count.log" --map "$OUT/frappe-count.map" \
 	--syms "$OUT/frappe-count.syms" --driver "$OUT/driver.txt" --md "$OUT/report.md" \
-	--csv "$OUT/frames.csv"
+	--csv "$OUT/frames.csv" --arch "$REPORT_ARCH"
 step "done: $OUT/report.md"

@@ -7,7 +7,9 @@ linker map and `nm -n -S -C` of the driver (to map each counted function to
 its object file, hence its stage, and to demangle it), and the driver's
 stdout (image sizes). Per frame: frappe = the intervals frappe_begin ->
 frappe_front (runFrontEnd) -> frappe_back (runBackEnd); OpenCV = opencv_begin
--> opencv_end (cv::aruco::detectMarkers).
+-> opencv_end (cv::aruco::detectMarkers). --arch names the target in the
+headings (armv6, aarch64 or aarch64-scalar); the instruction classes are
+named by the log itself (A line; older logs: the A32 names).
 """
 import argparse
 import bisect
@@ -17,6 +19,15 @@ from collections import defaultdict
 
 CLASSES = ["alu", "mul", "media_simd32", "branch", "load", "store", "ldm", "stm",
            "vfp", "vfp_ldst", "thumb16", "other"]
+# --arch: (how it ran, the frappe heading)
+TARGETS = {
+    "armv6": ("qemu-arm -cpu arm1176",
+              "frappe-core, ARMv6KZ + VFPv2 (-O3, -Dsimd=disabled: the ARMv6 SIMD32 row kernels)"),
+    "aarch64": ("qemu-aarch64 -cpu cortex-a53",
+                "frappe-core, aarch64 (ARMv8-A, -O3, Highway NEON kernels, static dispatch)"),
+    "aarch64-scalar": ("qemu-aarch64 -cpu cortex-a53",
+                       "frappe-core, aarch64 (ARMv8-A, -O3, -Dsimd=disabled: the scalar kernels)"),
+}
 STAGES = ["adaptive_scale", "front_end", "region_map", "trace", "refine", "warp", "decode", "detector", "other"]
 
 
@@ -34,13 +45,16 @@ def percentile(v, p):
 def parse_log(path):
     marks = []  # (label, total, classes[13], {bucket: (self, lib)})
     names = {}
+    classes = list(CLASSES)
     cur = None
     with open(path) as f:
         for line in f:
             t = line.split()
             if not t:
                 continue
-            if t[0] == "M":
+            if t[0] == "A":
+                classes = t[1:]
+            elif t[0] == "M":
                 cur = [t[1], int(t[2]), None, {}]
                 marks.append(cur)
             elif t[0] == "C":
@@ -49,7 +63,7 @@ def parse_log(path):
                 cur[3][int(t[1])] = (int(t[2]), int(t[3]))
             elif t[0] == "N":
                 names[int(t[1])] = (int(t[2], 16), " ".join(t[3:]))
-    return marks, names
+    return marks, names, classes
 
 
 def parse_map(path):
@@ -136,6 +150,54 @@ def short(name, n=70):
     return base if len(base) <= n else base[: n - 3] + "..."
 
 
+# What the driver calls, in order: once warmup, then for each image the
+# frappe markers and, with OpenCV, its two; exit is written by the plugin.
+NEXT = {
+    None: ("warmup", "frappe_begin"),
+    "warmup": ("frappe_begin", "exit"),
+    "frappe_begin": ("frappe_front",),
+    "frappe_front": ("frappe_back",),
+    "frappe_back": ("frappe_begin", "opencv_begin", "exit"),
+    "opencv_begin": ("opencv_end",),
+    "opencv_end": ("frappe_begin", "exit"),
+}
+
+
+def split_frames(marks):
+    """The frames of a well-formed marker sequence; stops with what broke it
+    (a marker firing twice, a missing one) instead of miscounting."""
+    frames = []
+    prev = None
+    for i, (label, total, cls, bk) in enumerate(marks):
+        expect = NEXT.get(prev, ())
+        if label not in expect:
+            counts = defaultdict(int)
+            for m in marks:
+                counts[m[0]] += 1
+            seen = ", ".join(f"{k} x{v}" for k, v in counts.items())
+            sys.exit(f"arm_count_report: marker #{i} is {label} after {prev or 'the start'}, expected "
+                     f"{' or '.join(expect) or 'nothing'} (frame {max(len(frames) - 1, 0)}, from 0). Markers in the log: {seen}. "
+                     "A marker counted more often than frappe_begin fires more than once a call: "
+                     "is the plugin older than scripts/arm/frappecount.c, or its marks file of another build?")
+        if label == "frappe_begin":
+            frames.append({"fe": None, "be": None, "cv": None})
+        elif label == "frappe_front":
+            frames[-1]["fe"] = (cls, bk)
+        elif label == "frappe_back":
+            frames[-1]["be"] = (cls, bk)
+        elif label == "opencv_end":
+            frames[-1]["cv"] = (cls, bk)
+        prev = label
+    if prev is not None and prev != "exit":
+        print(f"warning: the log ends after {prev}, not at the plugin's exit marker", file=sys.stderr)
+    return [f for f in frames if f["be"] is not None]
+
+
+def check_classes(classes, path):
+    if len(classes) != 12:
+        sys.exit(f"arm_count_report: {path} names {len(classes)} instruction classes, expected 12")
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--log", required=True)
@@ -145,9 +207,11 @@ def main():
     ap.add_argument("--md")
     ap.add_argument("--csv")
     ap.add_argument("--top", type=int, default=25)
+    ap.add_argument("--arch", default="armv6", choices=list(TARGETS))
     a = ap.parse_args()
+    target = TARGETS[a.arch]
 
-    marks, names = parse_log(a.log)
+    marks, names, classes = parse_log(a.log)
     ranges = parse_map(a.map)
     starts = [r[0] for r in ranges]
     syms = parse_syms(a.syms)
@@ -187,30 +251,15 @@ def main():
         print(f"warning: {len(marks) - len(merged)} repeated markers merged", file=sys.stderr)
     marks = merged
 
-    # split the marks into frames
-    frames = []   # dict per frame
-    cur = None
-    for label, total, cls, bk in marks:
-        if label == "frappe_begin":
-            cur = {"fe": None, "be": None, "cv": None}
-            frames.append(cur)
-        elif label == "frappe_front" and cur is not None:
-            cur["fe"] = (cls, bk)
-        elif label == "frappe_back" and cur is not None:
-            cur["be"] = (cls, bk)
-        elif label == "opencv_end" and cur is not None:
-            cur["cv"] = (cls, bk)
-    incomplete = [k for k, fr in enumerate(frames) if fr["fe"] is None or fr["be"] is None]
-    if incomplete:
-        sys.exit(f"arm_count_report: frames {incomplete[:5]} lack their front/back markers")
-    if len(frames) != len(sizes):
-        print(f"warning: {len(frames)} counted frames but {len(sizes)} images in the driver output",
-              file=sys.stderr)
-    n = min(len(frames), len(sizes))
-    if n == 0:
+    frames = split_frames(marks)
+    if not frames:
         sys.exit("arm_count_report: no counted frames (was the plugin loaded? is the driver unstripped?)")
-    frames = frames[:n]
-    sizes = sizes[:n]
+    if len(frames) != len(sizes):
+        # per-pixel numbers would pair frames with the wrong image sizes
+        sys.exit(f"arm_count_report: {len(frames)} counted frames but {len(sizes)} images in the driver "
+                 f"output ({a.driver}): the run or the log is incomplete")
+    n = len(frames)
+    check_classes(classes, a.log)
 
     per_stage = defaultdict(list)      # stage -> per-frame insns
     per_stage_px = defaultdict(list)
@@ -261,8 +310,8 @@ def main():
 
     out = []
     P = out.append
-    P(f"{n} frames, {sizes[0][0]}x{sizes[0][1]} (first), instructions counted under qemu-arm -cpu arm1176\n")
-    P("### frappe-core, ARMv6KZ + VFPv2 (-O3, -Dsimd=disabled: the ARMv6 SIMD32 row kernels)\n")
+    P(f"{n} frames, {sizes[0][0]}x{sizes[0][1]} (first), instructions counted under {target[0]}\n")
+    P(f"### {target[1]}\n")
     P("| stage | median insns/frame | p90 insns/frame | median insns/px | p90 insns/px | share |")
     P("|---|---:|---:|---:|---:|---:|")
     grand = sum(whole)
@@ -279,13 +328,15 @@ def main():
     P(f"| (check: runFrontEnd interval) | | | {percentile(fe_l, .5):.2f} | {percentile(fe_l, .9):.2f} | |")
     P(f"| (check: runBackEnd interval) | | | {percentile(be_l, .5):.2f} | {percentile(be_l, .9):.2f} | |")
     P("")
-    P("Library code is Debian armel's (ARMv5TE, soft-float libm: an atan2f call costs ~1500 instructions "
-      "there, a sin/cos/atan2 in double ~2700): on a hard-float Pi OS build it costs a fraction of this.\n")
+    if a.arch == "armv6":
+        P("Library code is Debian armel's (ARMv5TE, soft-float libm: an atan2f call costs ~1500 instructions "
+          "there, a sin/cos/atan2 in double ~2700): on a hard-float Pi OS build it costs a fraction of this.\n")
     P("Stages by the object file / function each instruction's function belongs to (library and libgcc "
       "code counted to its caller); `detector` = detector.cpp's own code (checks, the back end's loop). "
       "Medians of each row are taken separately, so they do not add up to the whole frame's median.\n")
     if cv_l:
-        P("### OpenCV 4.6 aruco (Debian armel: ARMv5TE, soft-float; reference only)\n")
+        P("### OpenCV 4.6 aruco (Debian armel: ARMv5TE, soft-float; reference only)\n" if a.arch == "armv6"
+          else "### OpenCV 4.6 aruco (Debian arm64; reference only)\n")
         P("| | median insns/frame | p90 insns/frame | median insns/px | p90 insns/px |")
         P("|---|---:|---:|---:|---:|")
         P(f"| detectMarkers | {percentile(cv_l, .5)/1e6:.1f} M | {percentile(cv_l, .9)/1e6:.1f} M | "
@@ -293,13 +344,15 @@ def main():
         P(f"\nratio of medians (OpenCV / frappe, whole frame): {percentile(cv_l, .5)/percentile(whole, .5):.1f}x\n")
 
     P("### Instruction classes (all frames, insns per pixel)\n")
-    hdr = CLASSES[:10] + ["mem accesses"]
+    # the first ten slots, less those the target has no instructions for ("-")
+    cols = [k for k in range(10) if classes[k] != "-"]
+    hdr = [classes[k] for k in cols] + ["mem accesses"]
     P("| part | total | " + " | ".join(hdr) + " |")
     P("|---|---:|" + "---:|" * len(hdr))
     for label, c in (("frappe front end", cls_fe), ("frappe back end", cls_be), ("opencv aruco", cls_cv)):
         if sum(c[:12]) == 0:
             continue
-        vals = [c[CLASSES.index(k)] for k in CLASSES[:10]] + [c[12]]
+        vals = [c[k] for k in cols] + [c[12]]
         P(f"| {label} | {sum(c[:12])/total_px:.2f} | " + " | ".join(f"{v/total_px:.2f}" for v in vals) + " |")
     P("")
 

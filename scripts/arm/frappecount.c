@@ -1,9 +1,10 @@
 /*
  * frappecount: a QEMU 7.2 TCG plugin (plugin API v1, Debian 12's qemu-user)
- * that counts the guest instructions of a 32-bit ARM (A32) program per
- * function of the main executable and per interval between marker calls.
- * Used by scripts/arm-count.sh; based on the team's armcount plugin (same
- * instruction classes).
+ * that counts the guest instructions of an ARM program (A32 under qemu-arm,
+ * A64 under qemu-aarch64) per function of the main executable and per
+ * interval between marker calls. Used by scripts/arm-count.sh; based on the
+ * team's armcount plugin (same A32 instruction classes; A64 instructions are
+ * sorted into the same twelve slots, named in the log's first line).
  *
  * Attribution:
  *  - an instruction inside a symbol of the main executable (unstripped,
@@ -12,9 +13,17 @@
  *    libstdc++, OpenCV; PLT stubs) or in a symbol starting with "__" (the
  *    libgcc helpers linked into the executable: __aeabi_idiv, __divsi3 ...:
  *    ARMv6 has no divide instruction) counts to the main-executable function
- *    whose BL/BLX executed last ("lib", i.e. the library code it called).
+ *    whose BL/BLX (A64: BL/BLR) executed last ("lib", i.e. the library
+ *    code it called).
  * Markers: a call to a function whose name starts with `armcount_mark_`
- * (extern "C", noinline) writes one snapshot to the out file:
+ * (extern "C", noinline) writes one snapshot to the out file. A marker
+ * fires at its entry address only: with marks=FILE ("<hex address> <name>"
+ * lines, from `nm`) exactly there, without it at the lowest address seen in
+ * the function. Anywhere else would be wrong: QEMU ends a translation block
+ * at a page boundary, so a marker that straddles a 4 KiB page is also met at
+ * the start of a second block in its middle (issue 15: fired twice a call).
+ * The log:
+ *    A <class names, 12>                      (first line)
  *    M <label> <total insns so far>
  *    C <12 class deltas> <memory-access delta>
  *    B <bucket> <self delta> <lib delta>      (only buckets that changed)
@@ -27,7 +36,8 @@
  * SPDX-License-Identifier: GPL-2.0-or-later
  *
  * Use: qemu-arm -cpu arm1176 -L SYSROOT -d plugin \
- *          -plugin ./libfrappecount.so,out=FILE ./prog args
+ *          -plugin ./libfrappecount.so,out=FILE[,marks=FILE] ./prog args
+ *      qemu-aarch64 -cpu cortex-a53 -L / -d plugin -plugin ... ./prog args
  */
 #include <inttypes.h>
 #include <stdbool.h>
@@ -48,6 +58,12 @@ static const char *const cls_name[C_N] = {
     "alu", "mul", "media_simd32", "branch", "load", "store", "ldm", "stm",
     "vfp", "vfp_ldst", "thumb16", "other"
 };
+/* A64 in the same slots: no SIMD32 or Thumb; LDP/STP take the LDM/STM
+ * slots, NEON and FP data processing the VFP slot. */
+static const char *const cls_name_a64[C_N] = {
+    "alu", "mul", "-", "branch", "load", "store", "ldp", "stp",
+    "simd_fp", "simd_fp_ldst", "-", "other"
+};
 
 #define MAX_BUCKETS 65536
 #define HASH_SIZE (1 << 17)
@@ -67,6 +83,16 @@ static uint64_t cls_count[C_N], cls_snap[C_N];
 static uint64_t mem_acc, mem_snap;
 static uint32_t cur_caller;          /* bucket of the last executed BL/BLX */
 static FILE *out;
+static bool a64;                     /* qemu-aarch64 */
+
+/* marks=FILE: the markers' entry addresses from the symbol table */
+#define MAX_MARKS 64
+static struct {
+    uint64_t addr;
+    char *label;
+    uint64_t fired;
+} marks[MAX_MARKS];
+static int n_marks = -1;             /* -1: no marks file, use the lowest address seen */
 
 static enum cls classify_a32(uint32_t i)
 {
@@ -120,6 +146,49 @@ static enum cls classify_a32(uint32_t i)
     }
 }
 
+static enum cls classify_a64(uint32_t i)
+{
+    uint32_t op0 = (i >> 25) & 0xf;
+
+    if ((op0 & 0xe) == 0x8) {
+        return C_ALU;              /* data processing, immediate */
+    }
+    if ((op0 & 0xe) == 0xa) {
+        if ((i >> 24) == 0xd4 || (i >> 22) == 0x354) {
+            return C_OTHER;        /* exceptions (SVC), system (barriers, hints) */
+        }
+        return C_BRANCH;
+    }
+    if ((op0 & 0x5) == 0x4) {      /* loads and stores */
+        bool simd = (i >> 26) & 1, load = (i >> 22) & 1;
+        if (((i >> 28) & 3) == 3 && !simd) {
+            load = ((i >> 22) & 3) != 0; /* single register: opc 1x are loads too */
+        } else if (((i >> 28) & 3) == 1 && ((i >> 24) & 1) == 0) {
+            load = true;           /* literal */
+        }
+        if (simd) {
+            return C_VFP_LDST;
+        }
+        if (((i >> 27) & 7) == 5) {
+            return load ? C_LDM : C_STM; /* pairs */
+        }
+        return load ? C_LOAD : C_STORE;
+    }
+    if ((op0 & 0x7) == 0x5) {      /* data processing, register */
+        return ((i >> 24) & 0x1f) == 0x1b ? C_MUL : C_ALU;
+    }
+    if ((op0 & 0x7) == 0x7) {
+        return C_VFP;              /* NEON and scalar FP */
+    }
+    return C_OTHER;
+}
+
+static bool is_call_a64(uint32_t i)
+{
+    return (i & 0xfc000000u) == 0x94000000u ||        /* BL */
+           (i & 0xfffffc1fu) == 0xd63f0000u;          /* BLR */
+}
+
 static bool is_call_a32(uint32_t i)
 {
     if ((i >> 28) == 0xf) {
@@ -164,16 +233,13 @@ static void on_lib_tb(unsigned int vcpu, void *ud)
     buckets[cur_caller].lib += (uint64_t)(uintptr_t)ud;
 }
 
-static void on_mark(unsigned int vcpu, void *ud)
+static void write_mark(const char *label)
 {
     uint64_t total = 0;
-    if (!out) {
-        return;
-    }
     for (int c = 0; c < C_N; c++) {
         total += cls_count[c];
     }
-    fprintf(out, "M %s %" PRIu64 "\nC", (const char *)ud, total);
+    fprintf(out, "M %s %" PRIu64 "\nC", label, total);
     for (int c = 0; c < C_N; c++) {
         fprintf(out, " %" PRIu64, cls_count[c] - cls_snap[c]);
         cls_snap[c] = cls_count[c];
@@ -191,6 +257,59 @@ static void on_mark(unsigned int vcpu, void *ud)
     }
 }
 
+static void on_mark(unsigned int vcpu, void *ud)
+{
+    if (out) {
+        write_mark((const char *)ud);
+    }
+}
+
+static void on_mark_exact(unsigned int vcpu, void *ud)
+{
+    int k = (int)(uintptr_t)ud;
+    marks[k].fired++;
+    if (out) {
+        write_mark(marks[k].label);
+    }
+}
+
+/* the marks=FILE entry at this address, or -1 */
+static int mark_at(uint64_t va)
+{
+    for (int k = 0; k < n_marks; k++) {
+        if (marks[k].addr == va) {
+            return k;
+        }
+    }
+    return -1;
+}
+
+static int read_marks(const char *path)
+{
+    FILE *f = fopen(path, "r");
+    char name[256];
+    unsigned long long addr;
+    if (!f) {
+        fprintf(stderr, "frappecount: cannot read %s\n", path);
+        return -1;
+    }
+    n_marks = 0;
+    while (fscanf(f, "%llx %255s", &addr, name) == 2) {
+        if (strncmp(name, MARK_PREFIX, strlen(MARK_PREFIX)) != 0) {
+            continue;
+        }
+        if (n_marks == MAX_MARKS) {
+            fprintf(stderr, "frappecount: more than %d markers in %s\n", MAX_MARKS, path);
+            break;
+        }
+        marks[n_marks].addr = addr;
+        marks[n_marks].label = strdup(name + strlen(MARK_PREFIX));
+        n_marks++;
+    }
+    fclose(f);
+    return 0;
+}
+
 static void tb_trans(qemu_plugin_id_t id, struct qemu_plugin_tb *tb)
 {
     size_t n = qemu_plugin_tb_n_insns(tb);
@@ -201,9 +320,11 @@ static void tb_trans(qemu_plugin_id_t id, struct qemu_plugin_tb *tb)
         uint64_t va = qemu_plugin_insn_vaddr(insn);
         uint32_t w = 0;
         enum cls c = C_THUMB;
+        bool call = false;
         if (qemu_plugin_insn_size(insn) == 4) {
             memcpy(&w, qemu_plugin_insn_data(insn), 4);
-            c = classify_a32(w);
+            c = a64 ? classify_a64(w) : classify_a32(w);
+            call = a64 ? is_call_a64(w) : is_call_a32(w);
         }
         qemu_plugin_register_vcpu_insn_exec_inline(insn, QEMU_PLUGIN_INLINE_ADD_U64,
                                                    &cls_count[c], 1);
@@ -218,16 +339,20 @@ static void tb_trans(qemu_plugin_id_t id, struct qemu_plugin_tb *tb)
         uint32_t b = bucket_of(s, va);
         qemu_plugin_register_vcpu_insn_exec_inline(insn, QEMU_PLUGIN_INLINE_ADD_U64,
                                                    &buckets[b].self, 1);
-        if (qemu_plugin_insn_size(insn) == 4 && is_call_a32(w)) {
+        if (call) {
             qemu_plugin_register_vcpu_insn_exec_cb(insn, on_call, QEMU_PLUGIN_CB_NO_REGS,
                                                    (void *)(uintptr_t)b);
         }
-        /* Only at the marker's entry: a TB ends at a page boundary, so a
-         * marker that straddles one is also met at the start of a second
-         * TB (k == 0) in its middle, and would fire twice per call. The
-         * first TB of a marker always starts at its entry (it is entered
-         * by a call), so its lowest address seen is the entry. */
-        if (strncmp(s, MARK_PREFIX, strlen(MARK_PREFIX)) == 0 && va == buckets[b].entry) {
+        /* Only at the marker's entry (see the top). Without marks=FILE the
+         * entry is the lowest address seen: a marker is entered by a call,
+         * so its first TB starts at its entry. */
+        if (n_marks >= 0) {
+            int m = mark_at(va);
+            if (m >= 0) {
+                qemu_plugin_register_vcpu_insn_exec_cb(insn, on_mark_exact, QEMU_PLUGIN_CB_NO_REGS,
+                                                       (void *)(uintptr_t)m);
+            }
+        } else if (strncmp(s, MARK_PREFIX, strlen(MARK_PREFIX)) == 0 && va == buckets[b].entry) {
             qemu_plugin_register_vcpu_insn_exec_cb(insn, on_mark, QEMU_PLUGIN_CB_NO_REGS,
                                                    (void *)(s + strlen(MARK_PREFIX)));
         }
@@ -247,8 +372,17 @@ static void at_exit(qemu_plugin_id_t id, void *p)
     }
     snprintf(line, sizeof line, "frappecount: insns %" PRIu64 ", functions %u\n", total, n_buckets - 1);
     qemu_plugin_outs(line);
+    /* a marker that never fired: its address in marks=FILE is not where
+     * the program runs it (a PIE, or a file of another build) */
+    for (int k = 0; k < n_marks; k++) {
+        if (!marks[k].fired) {
+            snprintf(line, sizeof line, "frappecount: marker %s at 0x%" PRIx64 " never fired\n",
+                     marks[k].label, marks[k].addr);
+            qemu_plugin_outs(line);
+        }
+    }
     if (out) {
-        on_mark(0, (void *)"exit");
+        write_mark("exit");
         for (uint32_t k = 1; k < n_buckets; k++) {
             fprintf(out, "N %u %" PRIx64 " %s\n", k, buckets[k].entry, buckets[k].name);
         }
@@ -267,13 +401,25 @@ QEMU_PLUGIN_EXPORT int qemu_plugin_install(qemu_plugin_id_t id, const qemu_info_
                 fprintf(stderr, "frappecount: cannot write %s\n", argv[k] + 4);
                 return -1;
             }
+        } else if (strncmp(argv[k], "marks=", 6) == 0) {
+            if (read_marks(argv[k] + 6) != 0) {
+                return -1;
+            }
         } else {
             fprintf(stderr, "frappecount: unknown argument %s\n", argv[k]);
             return -1;
         }
     }
-    if (strcmp(info->target_name, "arm") != 0) {
-        fprintf(stderr, "frappecount: classes assume 32-bit ARM; target is %s\n", info->target_name);
+    a64 = strcmp(info->target_name, "aarch64") == 0;
+    if (!a64 && strcmp(info->target_name, "arm") != 0) {
+        fprintf(stderr, "frappecount: classes assume ARM; target is %s\n", info->target_name);
+    }
+    if (out) {
+        fprintf(out, "A");
+        for (int c = 0; c < C_N; c++) {
+            fprintf(out, " %s", a64 ? cls_name_a64[c] : cls_name[c]);
+        }
+        fprintf(out, "\n");
     }
     qemu_plugin_register_vcpu_tb_trans_cb(id, tb_trans);
     qemu_plugin_register_atexit_cb(id, at_exit, NULL);

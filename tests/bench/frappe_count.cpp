@@ -3,8 +3,8 @@
 // when built with FRAPPE_COUNT_OPENCV, OpenCV's aruco module on the images
 // of a list (the detector contract's list format), one detection per image
 // each, interleaved, single-threaded, and brackets every detection with
-// calls to empty marker functions (`armcount_mark_*`). Under qemu-arm with
-// the frappecount plugin each marker call writes a snapshot of the
+// calls to empty marker functions (`armcount_mark_*`). Under qemu-arm or
+// qemu-aarch64 with the frappecount plugin each marker call writes a snapshot of the
 // instruction counters, so the counts between two markers are exactly the
 // instructions of one detection (image decoding and the driver's own work
 // fall outside them).
@@ -46,9 +46,12 @@
 #endif
 
 /* The marker functions: the plugin recognises them by name. They must stay
- * real calls (noinline) and differ in body so the linker does not fold them. */
+ * real calls (noinline) and differ in body so the linker does not fold them.
+ * Aligned to 64 bytes (each is a few instructions) so none straddles a 4 KiB
+ * page: QEMU would split it into two translation blocks (issue 15; the
+ * plugin copes, and arm-count.sh checks the layout). */
 #define FRAPPE_COUNT_MARK(name, n)                                                                 \
-	extern "C" __attribute__((noinline, used)) void armcount_mark_##name()                      \
+	extern "C" __attribute__((noinline, used, aligned(64))) void armcount_mark_##name()         \
 	{                                                                                          \
 		static volatile int sink;                                                         \
 		sink = n;                                                                          \
