@@ -25,16 +25,19 @@ float AdaptiveScale::next(const Config &config)
 
 void AdaptiveScale::update(std::span<const Marker> markers)
 {
-	float shortest = 0.0f;
+	/* Squared lengths and one square root: hypot is a libm call, dear on
+	 * ARMv6. */
+	float shortest2 = 0.0f;
 	for (const Marker &m : markers) {
 		for (int i = 0; i < 4; ++i) {
 			const Point2f a = m.corners[i], b = m.corners[(i + 1) & 3];
-			const float s = std::hypot(a.x - b.x, a.y - b.y);
-			if (shortest == 0.0f || s < shortest)
-				shortest = s;
+			const float dx = a.x - b.x, dy = a.y - b.y;
+			const float s2 = dx * dx + dy * dy;
+			if (shortest2 == 0.0f || s2 < shortest2)
+				shortest2 = s2;
 		}
 	}
-	shortestSide_ = shortest;
+	shortestSide_ = std::sqrt(shortest2);
 }
 
 void AdaptiveScale::reset()

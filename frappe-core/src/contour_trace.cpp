@@ -14,6 +14,7 @@
 // a candidate's extreme points, box and side coverage) are trace_kernels.cpp,
 // vectorised where Highway is built in; the walk itself is follow().
 #include "contour_trace.h"
+#include "rounding.h"
 #include "trace_kernels.h"
 
 #include <algorithm>
@@ -535,11 +536,11 @@ void ContourTracer::sealInside(const Quad &quad, int w, int h)
 	};
 	float lo, hi;
 	const QuadSpans rows(q, true), columns(q, false);
-	for (int y = std::max(1, static_cast<int>(std::ceil(minY))); y <= std::min(h - 2, static_cast<int>(maxY)); ++y) {
+	for (int y = std::max(1, ceilInt(minY)); y <= std::min(h - 2, static_cast<int>(maxY)); ++y) {
 		if (!rows.span(static_cast<float>(y), lo, hi))
 			continue;
-		const int x0 = std::max(1, static_cast<int>(std::ceil(lo)));
-		const int x1 = std::min(w - 2, static_cast<int>(std::floor(hi)));
+		const int x0 = std::max(1, ceilInt(lo));
+		const int x1 = std::min(w - 2, floorInt(hi));
 		if (x0 > x1)
 			continue;
 		const std::ptrdiff_t row = static_cast<std::ptrdiff_t>(y) * stride;
@@ -547,11 +548,11 @@ void ContourTracer::sealInside(const Quad &quad, int w, int h)
 		reach(row + x0, -1, x0 - 1);
 		reach(row + x1, 1, w - 2 - x1);
 	}
-	for (int x = std::max(1, static_cast<int>(std::ceil(minX))); x <= std::min(w - 2, static_cast<int>(maxX)); ++x) {
+	for (int x = std::max(1, ceilInt(minX)); x <= std::min(w - 2, static_cast<int>(maxX)); ++x) {
 		if (!columns.span(static_cast<float>(x), lo, hi))
 			continue;
-		const int y0 = std::max(1, static_cast<int>(std::ceil(lo)));
-		const int y1 = std::min(h - 2, static_cast<int>(std::floor(hi)));
+		const int y0 = std::max(1, ceilInt(lo));
+		const int y1 = std::min(h - 2, floorInt(hi));
 		if (y0 > y1)
 			continue;
 		reach(static_cast<std::ptrdiff_t>(y0) * stride + x, -stride, y0 - 1);

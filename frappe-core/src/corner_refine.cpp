@@ -42,6 +42,7 @@
 #define FRAPPE_CORNER_REFINE_COMMON
 
 #include "corner_refine.h"
+#include "rounding.h"
 
 #include <algorithm>
 #include <cmath>
@@ -74,7 +75,18 @@ constexpr int kMinDrop = 6;
  * from zero; mass > 0. */
 inline int centroid16(int moment2, int mass)
 {
-	return (8 * moment2 + (moment2 >= 0 ? mass / 2 : -mass / 2)) / mass;
+	/* (8 moment2 +- mass / 2) / mass, truncated. ARMv6 has no integer
+	 * divide (libgcc's costs ~40 instructions, twice or more a column):
+	 * the quotient in floats, off by at most one, corrected by the
+	 * remainder, as the vector kernel computes it. */
+	const int num = 8 * std::abs(moment2) + mass / 2;
+	int q = static_cast<int>(static_cast<float>(num) / static_cast<float>(mass));
+	const int rem = num - q * mass;
+	if (rem >= mass)
+		++q;
+	else if (rem < 0)
+		--q;
+	return moment2 < 0 ? -q : q;
 }
 
 constexpr int kMinWindow16 = 32;
@@ -228,7 +240,12 @@ void MeasureColumns(Columns &c)
 			wMass = hn::IfThenElse(live, pm, wMass);
 			wMoment2 = hn::IfThenElse(live, pm2, wMoment2);
 			live = hn::And(live, hn::Gt(pm, zero));
-			c16 = hn::IfThenElse(live, centroid16V(pm2, pm, live), c16);
+			const auto next = hn::IfThenElse(live, centroid16V(pm2, pm, live), c16);
+			/* Converged in every lane: another pass would give the
+			 * same sums (the scalar loop stops lane by lane). */
+			if (hn::AllTrue(d, hn::Eq(next, c16)))
+				break;
+			c16 = next;
 		}
 		hn::Store(hn::IfThenElseZero(valid, wMass), d, c.mass + i);
 		hn::Store(hn::IfThenElseZero(valid, wMoment2), d, c.moment2 + i);
@@ -248,19 +265,6 @@ HWY_EXPORT(MeasureColumns);
 #endif
 
 namespace {
-
-/* floor and ceil with conversions only (ARMv6 has no rounding instruction,
- * and these run a few times per side). */
-inline int floorInt(float x)
-{
-	const int i = static_cast<int>(x);
-	return static_cast<float>(i) > x ? i - 1 : i;
-}
-inline int ceilInt(float x)
-{
-	const int i = static_cast<int>(x);
-	return static_cast<float>(i) < x ? i + 1 : i;
-}
 
 /* The edge's crossing of one column. p(j) is the pixel j steps inwards of
  * the side's nearest pixel, for |j| <= kLo/kHi's reach + kRun + 1; the
@@ -320,7 +324,11 @@ inline int measureColumn(Pixel p, int kLo, int kHi, const RefineWindow &win, int
 		}
 		if (wMass <= 0)
 			break;
-		c16 = centroid16(wMoment2, wMass);
+		/* Converged: another pass would give the same sums. */
+		const int next = centroid16(wMoment2, wMass);
+		if (next == c16)
+			break;
+		c16 = next;
 	}
 	moment2Out = wMoment2;
 	return wMass;
