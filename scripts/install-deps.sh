@@ -12,6 +12,9 @@ packages=(
 	libgtest-dev libgmock-dev libbenchmark-dev libapriltag-dev
 	# the data tests' scorer (../shared/tools/eval.py) and scripts/quality.py
 	python3-numpy
+	# the CMake package (its version file comes from cmake's templates) and
+	# its test; dpkg-shlibdeps for scripts/build-debs.sh
+	cmake dpkg-dev
 	# the GStreamer element and its examples
 	libgstreamer1.0-dev libgstreamer-plugins-base1.0-dev
 	gstreamer1.0-tools gstreamer1.0-plugins-base gstreamer1.0-plugins-good
