@@ -191,13 +191,16 @@ control() {
 	local depends
 	depends=$(shlibs_depends "$pkg") || die "cannot work out the Depends of $pkg"
 	mkdir -p "$dir/DEBIAN" "$dir/usr/share/doc/$pkg"
-	cat >"$dir/usr/share/doc/$pkg/copyright" <<EOF
-Format: https://www.debian.org/doc/packaging-manuals/copyright-format/1.0/
-Upstream-Name: frappe
-
-Files: *
-License: MIT
-EOF
+	# DEP-5, with the license text from LICENSE (an empty line as " .")
+	{
+		echo "Format: https://www.debian.org/doc/packaging-manuals/copyright-format/1.0/"
+		echo "Upstream-Name: frappe"
+		echo
+		echo "Files: *"
+		echo "Copyright: $(sed -n 's/^Copyright (c) //p' "$src/LICENSE")"
+		echo "License: MIT"
+		sed '1,/^Copyright/d' "$src/LICENSE" | sed -e '1{/^$/d}' -e 's/^$/./' -e 's/^/ /'
+	} >"$dir/usr/share/doc/$pkg/copyright"
 	{
 		echo "Package: $pkg"
 		echo "Version: $version"

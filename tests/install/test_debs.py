@@ -97,6 +97,12 @@ def main():
         root = os.path.join(tmp, "root")
         for deb in debs:
             run(["dpkg-deb", "-x", deb, root])
+        # Each package carries the license (DEP-5, the text of LICENSE).
+        for pkg in names:
+            path = os.path.join(root, "usr", "share", "doc", pkg, "copyright")
+            text = open(path).read() if os.path.exists(path) else ""
+            if "License: MIT" not in text or " Permission is hereby granted" not in text:
+                raise Failure(f"{pkg}: no MIT license text in /usr/share/doc/{pkg}/copyright")
 
         triplet = {"amd64": "x86_64-linux-gnu", "arm64": "aarch64-linux-gnu"}[arch]
         libdir = os.path.join(root, "usr", "lib", triplet)
