@@ -59,9 +59,12 @@ public:
 	virtual bool isMarker(Quad &quad) = 0;
 };
 
-/// Follows every border of the edge image once, keeps the closed ones with
-/// exactly four corner clusters that make a plausible marker outline, and
-/// drops the duplicate that the inner and outer borders of one ring give.
+/// Follows every border of the edge image once and keeps those that make a
+/// plausible marker outline: four corner clusters, or (with at least
+/// `min_clusters` of them) the outline's extreme points, convex, large
+/// enough and running along all four sides. Quads may repeat (the inner
+/// and outer borders of a ring that no probe sealed): the caller drops the
+/// repeats with removeDuplicateQuads().
 class ContourTracer
 {
 public:
@@ -138,7 +141,7 @@ private:
 };
 
 /// Drops quads whose corners all lie within `tolerance` of an earlier quad's
-/// (under the best cyclic alignment); returns the number kept.
+/// (under some cyclic alignment), keeping the first; in place.
 void removeDuplicateQuads(std::vector<Quad> &quads, float tolerance);
 
 } // namespace frappe::detail

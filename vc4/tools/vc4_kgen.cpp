@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: MIT
 // vc4-kgen HEADER LISTING: assembles every program (with the hazard lint) and writes a C++
 // header of code tables and uniform layouts plus a combined vc4asm-syntax listing.
-// Run by meson at build time; the runtime includes the header.
+// Run by meson at build time. Only tests/kgen_test.cpp includes the header (the tables
+// against the assembler); the front end builds its programs with the assembler at run time.
 #include <cstdio>
 #include <exception>
 #include <fstream>
