@@ -184,13 +184,17 @@ std::array<std::uint64_t, 4> rotationsOf(std::uint64_t code, int bits)
 
 } // namespace
 
+namespace {
+
 /* The nearest codeword is a popcount per codeword and rotation; without
  * -mpopcnt GCC calls a library routine for each, so on x86 a second copy
- * with the POPCNT instruction is chosen at load time. */
+ * with the POPCNT instruction is chosen at load time. (In an anonymous
+ * namespace: GCC exports the ifunc of target_clones whatever its
+ * visibility, and the library exports no internals.) */
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
 __attribute__((target_clones("popcnt", "default")))
 #endif
-Decoded decode(const Dictionary &dict, std::uint64_t code, int maxHamming)
+Decoded nearestCode(const Dictionary &dict, std::uint64_t code, int maxHamming)
 {
 	const std::array<std::uint64_t, 4> rotations = rotationsOf(code, dict.bits);
 	/* The nearest id and the nearest other id: an id's distance is its
@@ -233,6 +237,13 @@ Decoded decode(const Dictionary &dict, std::uint64_t code, int maxHamming)
 	if (best.id < 0 || best.hamming > maxHamming || best.runnerUp == best.hamming)
 		return { -1, 0, 0, best.runnerUp };
 	return best;
+}
+
+} // namespace
+
+Decoded decode(const Dictionary &dict, std::uint64_t code, int maxHamming)
+{
+	return nearestCode(dict, code, maxHamming);
 }
 
 CodeBook::CodeBook(const Dictionary &dict) : dict_(&dict)

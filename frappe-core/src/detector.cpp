@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // The Detector: runs the stages of Algorithm 1 in order and times each.
 #include "frappe/detector.h"
+#include "frappe/version.h"
 
 #include <chrono>
 #include <algorithm>
@@ -228,7 +229,7 @@ std::string_view stageName(Stage stage)
 	return "?";
 }
 
-struct Detector::Impl {
+struct FRAPPE_HIDDEN Detector::Impl {
 	Config config;
 	const Dictionary *dict = nullptr;
 	std::unique_ptr<detail::CodeBook> codes;
@@ -811,7 +812,7 @@ const Dictionary &Detector::dictionary() const { return *impl_->dict; }
 int Detector::maxHamming() const { return impl_->maxHamming; }
 FrontEndParams Detector::frontEndParams() const { return impl_->params; }
 
-const char *version() { return FRAPPE_VERSION; }
+const char *version() { return FRAPPE_VERSION_STRING; }
 const char *simdTarget() { return detail::simdTargetName(); }
 
 } // namespace frappe

@@ -168,7 +168,7 @@ private:
 
 } // namespace detail
 
-struct Pipeline::Impl {
+struct FRAPPE_HIDDEN Pipeline::Impl {
 	Impl(const Config &config, Mode mode) : detector(config)
 	{
 		if (mode == Mode::Frames)

@@ -47,7 +47,9 @@ def check_tree(args, prefix, libdir, includedir):
                                               "libfrappe-core.so", "pkgconfig/frappe-core.pc",
                                               "cmake/frappe/frappeConfig.cmake",
                                               "cmake/frappe/frappeConfigVersion.cmake")]
-    headers = sorted(os.listdir(os.path.join(args.source_root, "frappe-core", "include", "frappe")))
+    # the headers in the source tree, and version.h, which meson makes from version.h.in
+    headers = sorted(h for h in os.listdir(os.path.join(args.source_root, "frappe-core", "include", "frappe"))
+                     if h.endswith(".h")) + ["version.h"]
     want += [os.path.join(includedir, "frappe", h) for h in headers]
     if args.gstmeta:
         want += [os.path.join(libdir, f) for f in (f"libgstfrappemeta-1.0.so.{args.version}",

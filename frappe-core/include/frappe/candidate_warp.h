@@ -4,6 +4,8 @@
 // QPUs warp up to 32 candidates a launch).
 #pragma once
 
+#include "frappe/export.h"
+
 #include <array>
 #include <cstdint>
 #include <memory>
@@ -24,7 +26,7 @@ struct CandidateSamples {
 	float at(int x, int y) const { return samples[static_cast<std::size_t>(y) * side + x]; }
 };
 
-class CandidateWarper {
+class FRAPPE_EXPORT CandidateWarper {
 public:
 	virtual ~CandidateWarper() = default;
 	virtual const char *name() const = 0;
@@ -36,6 +38,6 @@ public:
 };
 
 /// The CPU's warp (double-precision homography, bilinear samples in float).
-std::unique_ptr<CandidateWarper> makeCpuWarper();
+FRAPPE_EXPORT std::unique_ptr<CandidateWarper> makeCpuWarper();
 
 } // namespace frappe

@@ -2,6 +2,8 @@
 // frappe/detector.h: the Frappe detector.
 #pragma once
 
+#include "frappe/export.h"
+
 #include <array>
 #include <memory>
 #include <string_view>
@@ -29,7 +31,7 @@ enum class Stage {
 constexpr int kStageCount = static_cast<int>(Stage::Count);
 
 /// Short lowercase name of a stage ("front_end", "trace", ...).
-std::string_view stageName(Stage stage);
+FRAPPE_EXPORT std::string_view stageName(Stage stage);
 
 /// Wall-clock milliseconds spent in each stage for one frame.
 struct StageTimes {
@@ -53,7 +55,7 @@ struct Result {
 /// One instance is used by one thread at a time; separate instances share
 /// nothing. After the first frame of a given size, detect() allocates no
 /// memory (result vectors keep their capacity).
-class Detector {
+class FRAPPE_EXPORT Detector {
 public:
 	/// Throws std::invalid_argument when the dictionary is unknown or a
 	/// parameter is out of range; the message says which and why.

@@ -3,6 +3,8 @@
 // interface every front-end implementation (CPU, VC4) provides.
 #pragma once
 
+#include "frappe/export.h"
+
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -28,7 +30,7 @@ struct FrontEndParams {
 
 /// A byte map the contour tracer follows: foreground pixels have bit 0
 /// (kEdge) set, and a 16x16 tile mask says where any are.
-struct TraceMap {
+struct FRAPPE_EXPORT TraceMap {
 	static constexpr std::uint8_t kEdge = 1;
 	static constexpr std::uint8_t kCorner = 2;
 	static constexpr int kTile = 16; ///< side of an empty-tile mask block
@@ -64,7 +66,7 @@ struct EdgeMap : TraceMap {
 };
 
 /// Scaled frame size for a scale factor: the same rounding everywhere.
-int scaledLength(int full, float scale);
+FRAPPE_EXPORT int scaledLength(int full, float scale);
 
 /// A front-end implementation: nearest-neighbour scaling, Sobel gradients,
 /// four-direction non-maximum suppression, the edge threshold, Shi-Tomasi
@@ -72,7 +74,7 @@ int scaledLength(int full, float scale);
 /// one call. Implementations must produce byte-identical EdgeMaps; one that
 /// does not make the region map (makesRegionMap()) gets the CPU's from the
 /// Detector.
-class FrontEnd {
+class FRAPPE_EXPORT FrontEnd {
 public:
 	virtual ~FrontEnd() = default;
 	virtual const char *name() const = 0;
@@ -86,6 +88,6 @@ public:
 
 /// The reference CPU front end. `threads` > 1 splits the frame into row
 /// bands processed in parallel; the output does not depend on it.
-std::unique_ptr<FrontEnd> makeCpuFrontEnd(int threads = 1);
+FRAPPE_EXPORT std::unique_ptr<FrontEnd> makeCpuFrontEnd(int threads = 1);
 
 } // namespace frappe

@@ -3,6 +3,8 @@
 // marker renderer.
 #pragma once
 
+#include "frappe/export.h"
+
 #include <array>
 #include <optional>
 
@@ -11,7 +13,7 @@
 namespace frappe {
 
 /// A 3x3 projective map, row-major, applied to (x, y, 1).
-struct Homography {
+struct FRAPPE_EXPORT Homography {
 	std::array<double, 9> h{ 1, 0, 0, 0, 1, 0, 0, 0, 1 };
 
 	Point2f map(double x, double y) const

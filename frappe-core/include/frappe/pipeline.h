@@ -2,6 +2,8 @@
 // frappe/pipeline.h: the paper's pipelined mode for a stream of frames.
 #pragma once
 
+#include "frappe/export.h"
+
 #include <memory>
 
 #include "frappe/config.h"
@@ -28,7 +30,7 @@ namespace frappe {
 /// whatever the balance of the stages and the spread of frame costs (1.76x
 /// on the synth images, where the staged mode gives 1.3x); twice the memory.
 /// In AScale mode each detector scales from the last frame it ran.
-class Pipeline {
+class FRAPPE_EXPORT Pipeline {
 public:
 	enum class Mode { Stages, Frames };
 

@@ -2,6 +2,8 @@
 // frappe/render.h: drawing markers, for printing, tests and sample videos.
 #pragma once
 
+#include "frappe/export.h"
+
 #include <array>
 #include <cstdint>
 #include <vector>
@@ -33,7 +35,7 @@ struct RenderOptions {
 /// canonical orientation; pixel centres at integers), through the
 /// homography those corners define. Pixels are area-averaged, so edges fall
 /// at their exact sub-pixel place. Throws std::out_of_range for a bad id.
-void renderMarker(MutableImageView image, const Dictionary &dict, int id,
+FRAPPE_EXPORT void renderMarker(MutableImageView image, const Dictionary &dict, int id,
 		  const std::array<Point2f, 4> &corners, const RenderOptions &options = {});
 
 /// Corners (top-left, top-right, bottom-right, bottom-left) of a square of
@@ -41,12 +43,12 @@ void renderMarker(MutableImageView image, const Dictionary &dict, int id,
 /// horizontal axis, seen by a pinhole camera `distance` sides away whose
 /// focal length keeps an untilted square `side` wide, then rolled by `roll`
 /// degrees in the image plane. For test scenes and samples.
-std::array<Point2f, 4> perspectiveSquare(float cx, float cy, float side, float roll, float tilt,
+FRAPPE_EXPORT std::array<Point2f, 4> perspectiveSquare(float cx, float cy, float side, float roll, float tilt,
 					 float distance = 4.0f);
 
 /// An upright marker image, `cell_px` pixels a cell, with its quiet zone:
 /// side = (bits + 2 + 2 * quiet_cells) * cell_px.
-std::vector<std::uint8_t> markerImage(const Dictionary &dict, int id, int cell_px,
+FRAPPE_EXPORT std::vector<std::uint8_t> markerImage(const Dictionary &dict, int id, int cell_px,
 				      int quiet_cells, int &side);
 
 } // namespace frappe

@@ -1,8 +1,9 @@
 // SPDX-License-Identifier: MIT
 // Built against an installed frappe (tests/install): runs a detector on a
-// blank frame and prints the library's version.
+// blank frame and prints the library's version, which must be the headers'.
 #include <cstdint>
 #include <cstdio>
+#include <string_view>
 #include <vector>
 
 #include <frappe/frappe.h>
@@ -18,5 +19,6 @@ int main()
 	const frappe::Result &result = detector.detect({ frame.data(), width, height });
 
 	std::printf("frappe %s markers %zu\n", frappe::version(), result.markers.size());
-	return 0;
+	static_assert(FRAPPE_VERSION_MAJOR >= 0 && FRAPPE_VERSION_MINOR >= 0 && FRAPPE_VERSION_PATCH >= 0);
+	return std::string_view(frappe::version()) == FRAPPE_VERSION_STRING ? 0 : 1;
 }
