@@ -1,0 +1,36 @@
+/* SPDX-License-Identifier: MIT
+ *
+ * gstfrappeoutput.h: what frappedetect makes of a frame's markers: the
+ * metas on its buffer, the `frappedetect` element message and the `stats`
+ * structure. The element's documentation block describes their fields.
+ */
+#pragma once
+
+#include <optional>
+#include <vector>
+
+#include <gst/gst.h>
+
+#include <frappe/detector.h>
+
+#include "pose.h"
+
+namespace frappe::gst {
+
+using Poses = std::vector<std::optional<Pose>>;
+
+/* A GstFrappeMarkerMeta and a "fiducial" GstVideoRegionOfInterestMeta per
+ * marker, on a writable buffer of a frame of width x height. */
+void attachMarkerMetas(GstBuffer *buffer, gint width, gint height, const Result &result, const Poses &poses,
+		       const char *dictionary);
+
+/* The `frappedetect` element message's structure; running and stream time
+ * come from `segment` when it is in time. */
+GstStructure *frameMessage(GstBuffer *buffer, const GstSegment &segment, const Result &result,
+			   const Poses &poses, const char *dictionary);
+
+/* The `stats` property's structure for the last frame. */
+GstStructure *statsStructure(guint64 frames, const Result &result, double poseMs, const char *backend,
+			     bool pipelined);
+
+} /* namespace frappe::gst */
