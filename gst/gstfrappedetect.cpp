@@ -84,7 +84,6 @@
 #include "gstfrappedetect.h"
 
 #include <cstdint>
-#include <cstdio>
 #include <exception>
 #include <memory>
 #include <optional>
@@ -130,8 +129,7 @@ struct FrappeDetectPrivate {
 	bool warnedStride = false;
 	bool warnedFallback = false;
 	guint64 frames = 0;
-	frappe::StageTimes windowTimes; /* sums over the current 100 frames */
-	double windowPoseMs = 0.0;
+	frappe::gst::StatsWindow window;
 };
 
 struct _GstFrappeDetect {
@@ -211,27 +209,9 @@ static void update_stats(GstFrappeDetect *self, const frappe::Result &result, do
 
 	GST_LOG_OBJECT(self, "stats %" GST_PTR_FORMAT, static_cast<void *>(s));
 
-	/* Every 100 frames, the average cost per stage at INFO level, so
-	 * GST_DEBUG=frappedetect:4 shows the speed without any tooling. */
-	priv->windowTimes.total_ms += result.times.total_ms + poseMs;
-	for (std::size_t i = 0; i < result.times.ms.size(); ++i)
-		priv->windowTimes.ms[i] += result.times.ms[i];
-	priv->windowPoseMs += poseMs;
-	if (priv->frames % 100 == 0) {
-		std::string line;
-		for (int i = 0; i < frappe::kStageCount; ++i) {
-			char part[64];
-			std::snprintf(part, sizeof(part), "%s %.2f, ",
-				      std::string(frappe::stageName(static_cast<frappe::Stage>(i))).c_str(),
-				      priv->windowTimes.ms[static_cast<std::size_t>(i)] / 100.0);
-			line += part;
-		}
-		GST_INFO_OBJECT(self, "last 100 frames, ms per frame: %spose %.2f, total %.2f%s", line.c_str(),
-				priv->windowPoseMs / 100.0, priv->windowTimes.total_ms / 100.0,
+	if (const auto line = priv->window.add(priv->frames, result, poseMs))
+		GST_INFO_OBJECT(self, "last 100 frames, ms per frame: %s%s", line->c_str(),
 				priv->active.pipelined ? " (front end overlapped with the back end)" : "");
-		priv->windowTimes = {};
-		priv->windowPoseMs = 0.0;
-	}
 	GST_OBJECT_LOCK(self);
 	if (priv->stats)
 		gst_structure_free(priv->stats);
@@ -575,8 +555,7 @@ static gboolean gst_frappe_detect_start(GstBaseTransform *trans)
 	self->priv->active = self->priv->props;
 	GST_OBJECT_UNLOCK(self);
 	self->priv->frames = 0;
-	self->priv->windowTimes = {};
-	self->priv->windowPoseMs = 0.0;
+	self->priv->window.reset();
 	self->priv->loggedMemory = false;
 	self->priv->warnedStride = false;
 	return TRUE;

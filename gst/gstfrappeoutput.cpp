@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <cstdio>
 #include <string>
 
 #include <gst/video/video.h>
@@ -145,6 +146,34 @@ GstStructure *statsStructure(guint64 frames, const Result &result, double poseMs
 			  result.times.total_ms + poseMs, "backend", G_TYPE_STRING, backend, "pipelined",
 			  G_TYPE_BOOLEAN, static_cast<gboolean>(pipelined), nullptr);
 	return s;
+}
+
+std::optional<std::string> StatsWindow::add(guint64 frames, const Result &result, double poseMs)
+{
+	times_.total_ms += result.times.total_ms + poseMs;
+	for (std::size_t i = 0; i < result.times.ms.size(); ++i)
+		times_.ms[i] += result.times.ms[i];
+	poseMs_ += poseMs;
+	if (frames % 100 != 0)
+		return std::nullopt;
+
+	std::string line;
+	char part[64];
+	for (int i = 0; i < kStageCount; ++i) {
+		std::snprintf(part, sizeof(part), "%s %.2f, ", std::string(stageName(static_cast<Stage>(i))).c_str(),
+			      times_.ms[static_cast<std::size_t>(i)] / 100.0);
+		line += part;
+	}
+	std::snprintf(part, sizeof(part), "pose %.2f, total %.2f", poseMs_ / 100.0, times_.total_ms / 100.0);
+	line += part;
+	reset();
+	return line;
+}
+
+void StatsWindow::reset()
+{
+	times_ = {};
+	poseMs_ = 0.0;
 }
 
 } /* namespace frappe::gst */

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <optional>
+#include <string>
 #include <vector>
 
 #include <gst/gst.h>
@@ -32,5 +33,21 @@ GstStructure *frameMessage(GstBuffer *buffer, const GstSegment &segment, const R
 /* The `stats` property's structure for the last frame. */
 GstStructure *statsStructure(guint64 frames, const Result &result, double poseMs, const char *backend,
 			     bool pipelined);
+
+/* Sums of the stage times over 100 frames, for one INFO line per 100
+ * frames: GST_DEBUG=frappedetect:4 shows the speed without any tooling. */
+class StatsWindow
+{
+public:
+	/* Adds frame number `frames` (from 1); at every 100th, returns the
+	 * average ms per frame of each stage, the pose and the total, and
+	 * starts again. */
+	std::optional<std::string> add(guint64 frames, const Result &result, double poseMs);
+	void reset();
+
+private:
+	StageTimes times_;
+	double poseMs_ = 0.0;
+};
 
 } /* namespace frappe::gst */
