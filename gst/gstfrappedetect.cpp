@@ -65,6 +65,10 @@
  * gap, stream-start and DRAIN queries, and drops it on flush.
  * Every buffer comes out once, in order, with its own metas.
  *
+ * When detection fails on a frame the element posts an error and returns
+ * a flow error, pipelined or not (pipelined, when the held frame is
+ * finished: at the next buffer or a drain); that buffer does not come out.
+ *
  * ## Example launch lines
  * |[
  * gst-launch-1.0 -m videotestsrc num-buffers=10 ! video/x-raw,format=GRAY8 ! frappedetect ! fakesink
@@ -220,17 +224,19 @@ static void update_stats(GstFrappeDetect *self, const frappe::Result &result, do
 }
 
 /* Attaches metas, draws, posts the message and releases the frame; the
- * buffer goes to the output list. */
-static void finish(GstFrappeDetect *self, InFlight &f)
+ * buffer goes to the output list. A back end that failed is an element
+ * error, pipelined or not, and the buffer is dropped. */
+static GstFlowReturn finish(GstFrappeDetect *self, InFlight &f)
 {
 	FrappeDetectPrivate *priv = self->priv;
 	const Settings &s = priv->active;
 
-	static const frappe::Result empty;
-	const frappe::Result &result = f.result ? *f.result : empty;
-	if (!f.error.empty())
-		GST_WARNING_OBJECT(self, "detection failed on %" GST_PTR_FORMAT ": %s", static_cast<void *>(f.buffer),
-				   f.error.c_str());
+	if (!f.error.empty() || !f.result) {
+		GST_ELEMENT_ERROR(self, STREAM, FAILED, ("Marker detection failed"), ("%s", f.error.c_str()));
+		f.discard();
+		return GST_FLOW_ERROR;
+	}
+	const frappe::Result &result = *f.result;
 	const std::string dictName(priv->detector->dictionary().name);
 
 	const gint64 t0 = g_get_monotonic_time();
@@ -258,17 +264,19 @@ static void finish(GstFrappeDetect *self, InFlight &f)
 
 	priv->output.push_back(f.buffer);
 	f.buffer = nullptr;
+	return GST_FLOW_OK;
 }
 
 /* Waits for the held frame's back end and finishes it. */
-static void finish_held(GstFrappeDetect *self)
+static GstFlowReturn finish_held(GstFrappeDetect *self)
 {
 	FrappeDetectPrivate *priv = self->priv;
 	if (!priv->held)
-		return;
+		return GST_FLOW_OK;
 	priv->worker.wait();
-	finish(self, *priv->held);
+	const GstFlowReturn ret = finish(self, *priv->held);
 	priv->held.reset();
+	return ret;
 }
 
 /* Throws the held frame away (flush, stop). */
@@ -294,7 +302,7 @@ static void clear_output(GstFrappeDetect *self)
 static GstFlowReturn drain(GstFrappeDetect *self)
 {
 	FrappeDetectPrivate *priv = self->priv;
-	finish_held(self);
+	const GstFlowReturn held = finish_held(self);
 	GstFlowReturn ret = GST_FLOW_OK;
 	std::vector<GstBuffer *> out;
 	out.swap(priv->output);
@@ -306,11 +314,11 @@ static GstFlowReturn drain(GstFrappeDetect *self)
 			gst_buffer_unref(b);
 		}
 	}
-	return ret;
+	return ret != GST_FLOW_OK ? ret : held;
 }
 
 /* Picks up property changes; may finish the held frame first. */
-static void apply_settings(GstFrappeDetect *self)
+static GstFlowReturn apply_settings(GstFrappeDetect *self)
 {
 	FrappeDetectPrivate *priv = self->priv;
 	GST_OBJECT_LOCK(self);
@@ -319,8 +327,9 @@ static void apply_settings(GstFrappeDetect *self)
 
 	const bool rebuild = !next.sameDetector(priv->active);
 	const bool pipelineChange = next.pipelined != priv->active.pipelined;
+	GstFlowReturn ret = GST_FLOW_OK;
 	if (rebuild || pipelineChange)
-		finish_held(self);
+		ret = finish_held(self);
 	priv->active = next;
 	if (rebuild && priv->detector) {
 		GST_DEBUG_OBJECT(self, "settings changed, rebuilding the detector");
@@ -330,6 +339,7 @@ static void apply_settings(GstFrappeDetect *self)
 		GST_DEBUG_OBJECT(self, "pipelined now %d", next.pipelined);
 		gst_element_post_message(GST_ELEMENT(self), gst_message_new_latency(GST_OBJECT(self)));
 	}
+	return ret;
 }
 
 static void log_memory(GstFrappeDetect *self, GstBuffer *buffer)
@@ -362,7 +372,11 @@ static GstFlowReturn process(GstFrappeDetect *self, GstBuffer *input)
 	FrappeDetectPrivate *priv = self->priv;
 	GstVideoFilter *filter = GST_VIDEO_FILTER(self);
 
-	apply_settings(self);
+	GstFlowReturn ret = apply_settings(self);
+	if (ret != GST_FLOW_OK) {
+		gst_buffer_unref(input);
+		return ret;
+	}
 	if (!ensure_detector(self)) {
 		gst_buffer_unref(input);
 		return GST_FLOW_NOT_NEGOTIATED;
@@ -404,16 +418,16 @@ static GstFlowReturn process(GstFrappeDetect *self, GstBuffer *input)
 			detector.runFrontEnd(f.image, f.slot);
 		}
 	} catch (const std::exception &e) {
-		f.discard();
-		GST_ELEMENT_ERROR(self, STREAM, FAILED, ("Marker detection failed"), ("%s", e.what()));
-		return GST_FLOW_ERROR;
+		f.error = e.what();
 	}
-	if (!pipelined) {
-		finish(self, f);
-		return GST_FLOW_OK;
-	}
+	if (!pipelined || !f.error.empty())
+		return finish(self, f);
 
-	finish_held(self);
+	ret = finish_held(self);
+	if (ret != GST_FLOW_OK) {
+		f.discard();
+		return ret;
+	}
 	priv->held = std::move(f);
 	InFlight *h = &*priv->held;
 	frappe::Detector *d = &detector;
