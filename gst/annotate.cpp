@@ -123,4 +123,53 @@ void Canvas::number(int value, double cx, double cy, int cell)
 	}
 }
 
+void annotateMarkers(GstVideoFrame *frame, const Result &result, const std::vector<std::optional<Pose>> &poses,
+		     double markerSize, const Camera &camera)
+{
+	Canvas canvas(frame);
+	for (std::size_t i = 0; i < result.markers.size(); ++i) {
+		const Marker &m = result.markers[i];
+		double side = 0.0;
+		for (int k = 0; k < 4; ++k) {
+			const auto a = m.corners[static_cast<std::size_t>(k)];
+			const auto b = m.corners[static_cast<std::size_t>((k + 1) & 3)];
+			side += std::hypot(a.x - b.x, a.y - b.y) / 4.0;
+		}
+		const int thickness = std::max(1, static_cast<int>(side / 32.0));
+		for (int k = 0; k < 4; ++k) {
+			const auto a = m.corners[static_cast<std::size_t>(k)];
+			const auto b = m.corners[static_cast<std::size_t>((k + 1) & 3)];
+			canvas.haloLine(a.x, a.y, b.x, b.y, thickness, colours::outline);
+		}
+		/* The first corner (top-left in the marker's orientation). */
+		const int r = std::max(2, static_cast<int>(side / 24.0));
+		const int cx = static_cast<int>(std::lround(m.corners[0].x));
+		const int cy = static_cast<int>(std::lround(m.corners[0].y));
+		canvas.fillRect(cx - r - 1, cy - r - 1, cx + r + 1, cy + r + 1, colours::black);
+		canvas.fillRect(cx - r, cy - r, cx + r, cy + r, colours::firstCorner);
+
+		if (poses[i]) {
+			const double h = markerSize / 2.0;
+			const auto p = projectPoints({ { 0, 0, 0 }, { h, 0, 0 }, { 0, h, 0 }, { 0, 0, h } },
+						     *poses[i], camera);
+			if (p.size() == 4) {
+				canvas.haloLine(p[0].x, p[0].y, p[1].x, p[1].y, thickness, colours::axisX);
+				canvas.haloLine(p[0].x, p[0].y, p[2].x, p[2].y, thickness, colours::axisY);
+				canvas.haloLine(p[0].x, p[0].y, p[3].x, p[3].y, thickness, colours::axisZ);
+			}
+		}
+
+		/* The id between the centre and the first corner: the quadrant of
+		 * the marker frame (-x, +y) that the axes leave free. */
+		double mx = 0.0, my = 0.0;
+		for (const auto &c : m.corners) {
+			mx += c.x / 4.0;
+			my += c.y / 4.0;
+		}
+		mx = (mx * 3.0 + m.corners[0].x * 2.0) / 5.0;
+		my = (my * 3.0 + m.corners[0].y * 2.0) / 5.0;
+		canvas.number(m.id, mx, my, std::max(1, static_cast<int>(side / 24.0)));
+	}
+}
+
 } // namespace frappe::gst

@@ -8,8 +8,14 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
+#include <vector>
 
 #include <gst/video/video.h>
+
+#include <frappe/detector.h>
+
+#include "pose.h"
 
 namespace frappe::gst {
 
@@ -59,5 +65,11 @@ constexpr Yuv axisX{ 82, 90, 240 };   // red
 constexpr Yuv axisY{ 145, 54, 34 };   // green
 constexpr Yuv axisZ{ 41, 240, 110 };  // blue
 } // namespace colours
+
+/// What frappedetect's annotate property draws for a frame's markers:
+/// outlines, first corners, ids and, where `poses` has one, the axes of a
+/// marker of side `markerSize` (metres).
+void annotateMarkers(GstVideoFrame *frame, const Result &result, const std::vector<std::optional<Pose>> &poses,
+		     double markerSize, const Camera &camera);
 
 } // namespace frappe::gst

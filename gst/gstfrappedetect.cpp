@@ -65,6 +65,10 @@
  * gap, stream-start and DRAIN queries, and drops it on flush.
  * Every buffer comes out once, in order, with its own metas.
  *
+ * When detection fails on a frame the element posts an error and returns
+ * a flow error, pipelined or not (pipelined, when the held frame is
+ * finished: at the next buffer or a drain); that buffer does not come out.
+ *
  * ## Example launch lines
  * |[
  * gst-launch-1.0 -m videotestsrc num-buffers=10 ! video/x-raw,format=GRAY8 ! frappedetect ! fakesink
@@ -83,270 +87,36 @@
 
 #include "gstfrappedetect.h"
 
-#include <algorithm>
-#include <atomic>
-#include <cmath>
-#include <condition_variable>
-#include <cstdio>
-#include <cstring>
+#include <cstdint>
 #include <exception>
-#include <functional>
 #include <memory>
-#include <mutex>
 #include <optional>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include <gst/allocators/gstdmabuf.h>
 #include <gst/video/video.h>
 
 #include <frappe/frappe.h>
-#ifdef FRAPPE_HAVE_VC4
-#include "frontend/backend.hpp"
-#endif
 
 #include "annotate.h"
-#include "gstfrappemeta.h"
+#include "frappebackend.h"
+#include "gstfrappeenums.h"
+#include "gstfrappeoutput.h"
+#include "gstfrappesettings.h"
+#include "gstfrappeworker.h"
 #include "pose.h"
 
-GST_DEBUG_CATEGORY_STATIC(gst_frappe_detect_debug);
+/* Not static: the settings log through it too. */
+GST_DEBUG_CATEGORY(gst_frappe_detect_debug);
 #define GST_CAT_DEFAULT gst_frappe_detect_debug
 
-/* -------------------------------------------------------------------------
- * Properties
- */
-
-enum {
-	PROP_0,
-	PROP_DICTIONARY,
-	PROP_MODE,
-	PROP_EDGE_THRESHOLD,
-	PROP_CORNER_THRESHOLD,
-	PROP_REGION_CONTRAST,
-	PROP_MAX_HAMMING,
-	PROP_SCALED_SIZE,
-	PROP_MAX_SCALED_FRAMES,
-	PROP_ANNOTATE,
-	PROP_POST_MESSAGES,
-	PROP_PIPELINED,
-	PROP_BACKEND,
-	PROP_MARKER_SIZE,
-	PROP_CAMERA_MATRIX,
-	PROP_DISTORTION,
-	PROP_STATS,
-};
-
-typedef enum {
-	GST_FRAPPE_MODE_NORMAL,
-	GST_FRAPPE_MODE_ASCALE,
-} GstFrappeMode;
-
-typedef enum {
-	GST_FRAPPE_BACKEND_AUTO,
-	GST_FRAPPE_BACKEND_CPU,
-	GST_FRAPPE_BACKEND_VC4,
-	GST_FRAPPE_BACKEND_VC4_EMU,
-} GstFrappeBackend;
-
-#define DEFAULT_DICTIONARY_NAME "aruco_mip_36h12"
-#define DEFAULT_MODE GST_FRAPPE_MODE_NORMAL
-#define DEFAULT_EDGE_THRESHOLD 0.27f
-#define DEFAULT_CORNER_THRESHOLD 0.19f
-#define DEFAULT_REGION_CONTRAST (frappe::Config{}.region_contrast)
-#define DEFAULT_MAX_HAMMING -1
-#define DEFAULT_SCALED_SIZE 28.0f
-#define DEFAULT_MAX_SCALED_FRAMES 5
-#define DEFAULT_ANNOTATE FALSE
-#define DEFAULT_POST_MESSAGES TRUE
-#define DEFAULT_PIPELINED FALSE
-#define DEFAULT_BACKEND GST_FRAPPE_BACKEND_AUTO
-#define DEFAULT_MARKER_SIZE 0.0
-/* The largest max-hamming any built-in dictionary accepts (7x7: 49 / 2). */
-#define MAX_MAX_HAMMING 24
-
-#define GST_TYPE_FRAPPE_MODE (gst_frappe_mode_get_type())
-static GType gst_frappe_mode_get_type(void)
-{
-	static GType type = 0;
-	static const GEnumValue values[] = {
-		{ GST_FRAPPE_MODE_NORMAL, "Every frame at full resolution", "normal" },
-		{ GST_FRAPPE_MODE_ASCALE,
-		  "Scale frames down from the size of the markers of the previous frame", "ascale" },
-		{ 0, nullptr, nullptr },
-	};
-	if (g_once_init_enter(&type)) {
-		GType t = g_enum_register_static("GstFrappeMode", values);
-		g_once_init_leave(&type, t);
-	}
-	return type;
-}
-
-#define GST_TYPE_FRAPPE_BACKEND (gst_frappe_backend_get_type())
-static GType gst_frappe_backend_get_type(void)
-{
-	static GType type = 0;
-	static const GEnumValue values[] = {
-		{ GST_FRAPPE_BACKEND_AUTO,
-		  "The Raspberry Pi's QPUs when they can be used, else the CPU (with one warning on a Pi)", "auto" },
-		{ GST_FRAPPE_BACKEND_CPU, "The reference CPU front end", "cpu" },
-		{ GST_FRAPPE_BACKEND_VC4, "The QPU kernels on the VideoCore IV GPU (Pi Zero, 1, 2, 3)", "vc4" },
-		{ GST_FRAPPE_BACKEND_VC4_EMU,
-		  "The QPU kernels on an emulator: bit-exact with vc4, slow; for testing", "vc4-emu" },
-		{ 0, nullptr, nullptr },
-	};
-	if (g_once_init_enter(&type)) {
-		GType t = g_enum_register_static("GstFrappeBackend", values);
-		g_once_init_leave(&type, t);
-	}
-	return type;
-}
-
-/* The dictionary enum: one value per built-in dictionary, in the library's
- * stable order; nicks are the dictionary names with dashes ("6x6-250"). */
-#define GST_TYPE_FRAPPE_DICTIONARY (gst_frappe_dictionary_get_type())
-static GType gst_frappe_dictionary_get_type(void)
-{
-	static GType type = 0;
-	if (g_once_init_enter(&type)) {
-		const auto dicts = frappe::dictionaries();
-		GEnumValue *values = g_new0(GEnumValue, dicts.size() + 1);
-		for (std::size_t i = 0; i < dicts.size(); ++i) {
-			std::string nick(dicts[i].name);
-			std::replace(nick.begin(), nick.end(), '_', '-');
-			const std::string desc = std::string(dicts[i].name) + " (" +
-						 std::to_string(dicts[i].size()) + " markers, " +
-						 std::to_string(dicts[i].bits) + "x" +
-						 std::to_string(dicts[i].bits) + " bits)";
-			values[i].value = static_cast<gint>(i);
-			values[i].value_name = g_intern_string(desc.c_str());
-			values[i].value_nick = g_intern_string(nick.c_str());
-		}
-		GType t = g_enum_register_static("GstFrappeDictionary", values);
-		g_once_init_leave(&type, t);
-	}
-	return type;
-}
-
-static gint default_dictionary_index()
-{
-	const auto dicts = frappe::dictionaries();
-	for (std::size_t i = 0; i < dicts.size(); ++i)
-		if (dicts[i].name == DEFAULT_DICTIONARY_NAME)
-			return static_cast<gint>(i);
-	return 0;
-}
+using frappe::gst::InFlight;
+using frappe::gst::Settings;
 
 /* -------------------------------------------------------------------------
  * Instance
  */
-
-namespace {
-
-/* Everything the properties set. Copied under the object lock by the
- * streaming thread at the start of each frame. */
-struct Settings {
-	gint dictionary = 0;
-	GstFrappeMode mode = DEFAULT_MODE;
-	gfloat edgeThreshold = DEFAULT_EDGE_THRESHOLD;
-	gfloat cornerThreshold = DEFAULT_CORNER_THRESHOLD;
-	gfloat regionContrast = DEFAULT_REGION_CONTRAST;
-	gint maxHamming = DEFAULT_MAX_HAMMING;
-	gfloat scaledSize = DEFAULT_SCALED_SIZE;
-	gint maxScaledFrames = DEFAULT_MAX_SCALED_FRAMES;
-	gboolean annotate = DEFAULT_ANNOTATE;
-	gboolean postMessages = DEFAULT_POST_MESSAGES;
-	gboolean pipelined = DEFAULT_PIPELINED;
-	GstFrappeBackend backend = DEFAULT_BACKEND;
-	gdouble markerSize = DEFAULT_MARKER_SIZE;
-	frappe::gst::Camera camera;
-
-	/* Whether a change between two settings needs a new Detector. */
-	bool sameDetector(const Settings &o) const
-	{
-		return dictionary == o.dictionary && mode == o.mode && edgeThreshold == o.edgeThreshold &&
-		       cornerThreshold == o.cornerThreshold && regionContrast == o.regionContrast &&
-		       maxHamming == o.maxHamming &&
-		       scaledSize == o.scaledSize && maxScaledFrames == o.maxScaledFrames &&
-		       backend == o.backend;
-	}
-};
-
-/* One job at a time on a second thread: the back end of the held frame. */
-class Worker {
-public:
-	~Worker() { stop(); }
-
-	void submit(std::function<void()> job)
-	{
-		std::unique_lock lock(mutex_);
-		if (!thread_.joinable())
-			thread_ = std::thread([this] { loop(); });
-		job_ = std::move(job);
-		busy_ = true;
-		cv_.notify_all();
-	}
-
-	void wait()
-	{
-		std::unique_lock lock(mutex_);
-		cv_.wait(lock, [this] { return !busy_; });
-	}
-
-	void stop()
-	{
-		{
-			std::unique_lock lock(mutex_);
-			if (!thread_.joinable())
-				return;
-			cv_.wait(lock, [this] { return !busy_; });
-			quit_ = true;
-			cv_.notify_all();
-		}
-		thread_.join();
-		quit_ = false;
-	}
-
-private:
-	void loop()
-	{
-		std::unique_lock lock(mutex_);
-		for (;;) {
-			cv_.wait(lock, [this] { return quit_ || busy_; });
-			if (busy_) {
-				auto job = std::move(job_);
-				lock.unlock();
-				job();
-				lock.lock();
-				busy_ = false;
-				cv_.notify_all();
-				continue;
-			}
-			if (quit_)
-				return;
-		}
-	}
-
-	std::mutex mutex_;
-	std::condition_variable cv_;
-	std::thread thread_;
-	std::function<void()> job_;
-	bool busy_ = false;
-	bool quit_ = false;
-};
-
-/* A buffer between its front end and its output. */
-struct InFlight {
-	GstBuffer *buffer = nullptr;  /* writable, owned */
-	GstVideoFrame frame{};        /* mapped until finished */
-	bool writable = false;        /* mapped for annotation */
-	int slot = 0;
-	frappe::ImageView image;
-	const frappe::Result *result = nullptr; /* set by the back end */
-	std::string error;                      /* set when the back end threw */
-};
-
-} // namespace
 
 struct FrappeDetectPrivate {
 	/* Under the object lock. */
@@ -358,13 +128,12 @@ struct FrappeDetectPrivate {
 	std::unique_ptr<frappe::Detector> detector;
 	std::optional<InFlight> held;
 	std::vector<GstBuffer *> output; /* finished, waiting for generate_output */
-	Worker worker;
+	frappe::gst::Worker worker;
 	bool loggedMemory = false;
 	bool warnedStride = false;
 	bool warnedFallback = false;
 	guint64 frames = 0;
-	frappe::StageTimes windowTimes; /* sums over the current 100 frames */
-	double windowPoseMs = 0.0;
+	frappe::gst::StatsWindow window;
 };
 
 struct _GstFrappeDetect {
@@ -389,63 +158,26 @@ static GstStaticPadTemplate src_template =
  * Detection
  */
 
-static frappe::Config make_config(const Settings &s)
-{
-	frappe::Config config;
-	const auto dicts = frappe::dictionaries();
-	const auto &dict = dicts[static_cast<std::size_t>(s.dictionary)];
-	config.dictionary = std::string(dict.name);
-	config.mode = s.mode == GST_FRAPPE_MODE_ASCALE ? frappe::Mode::AScale : frappe::Mode::Normal;
-	config.edge_threshold = s.edgeThreshold;
-	config.corner_threshold = s.cornerThreshold;
-	config.region_contrast = s.regionContrast;
-	config.max_hamming = std::min(s.maxHamming, dict.bits * dict.bits / 2);
-	config.scaled_size = s.scaledSize;
-	config.max_scaled_frames = s.maxScaledFrames;
-	config.threads = 1;
-	return config;
-}
-
-static const char *backend_name(GstFrappeBackend backend)
-{
-	GEnumClass *klass = G_ENUM_CLASS(g_type_class_ref(GST_TYPE_FRAPPE_BACKEND));
-	const GEnumValue *v = g_enum_get_value(klass, backend);
-	const char *name = v ? v->value_nick : "auto";
-	g_type_class_unref(klass);
-	return name;
-}
-
-/* Puts the front end the backend property asks for into the detector. The
- * element only names it; vc4/ decides what runs. */
+/* Puts the front end the backend property names into the detector. */
 static bool select_front_end(GstFrappeDetect *self, frappe::Detector &detector)
 {
 	FrappeDetectPrivate *priv = self->priv;
-	const GstFrappeBackend backend = priv->active.backend;
-	if (backend == GST_FRAPPE_BACKEND_CPU)
-		return true;
-	const char *name = backend_name(backend);
-#ifdef FRAPPE_HAVE_VC4
+	const char *name = gst_frappe_backend_nick(priv->active.backend);
 	try {
-		frappe::vc4::BackendChoice choice = frappe::vc4::selectFrontEnd(name, 1);
-		if (!choice.fallback.empty() && !priv->warnedFallback) {
+		const std::string fallback = frappe::selectBackend(detector, name, 1);
+		if (!fallback.empty() && !priv->warnedFallback) {
 			priv->warnedFallback = true;
 			GST_ELEMENT_WARNING(self, RESOURCE, NOT_FOUND, ("The GPU cannot be used; detecting on the CPU"),
-					    ("backend=auto: %s", choice.fallback.c_str()));
+					    ("backend=auto: %s", fallback.c_str()));
 		}
-		detector.setFrontEnd(std::move(choice.frontEnd));
-		detector.setWarper(std::move(choice.warper));
+	} catch (const frappe::BackendNotBuilt &) {
+		GST_ELEMENT_ERROR(self, LIBRARY, SETTINGS, ("Backend %s is not in this build", name),
+				  ("the plugin was built without vc4/"));
+		return false;
 	} catch (const std::exception &e) {
 		GST_ELEMENT_ERROR(self, RESOURCE, OPEN_READ, ("Backend %s cannot be used", name), ("%s", e.what()));
 		return false;
 	}
-#else
-	(void)detector;
-	if (backend != GST_FRAPPE_BACKEND_AUTO) {
-		GST_ELEMENT_ERROR(self, LIBRARY, SETTINGS, ("Backend %s is not in this build", name),
-				  ("the plugin was built without vc4/"));
-		return false;
-	}
-#endif
 	return true;
 }
 
@@ -454,7 +186,7 @@ static bool ensure_detector(GstFrappeDetect *self)
 	FrappeDetectPrivate *priv = self->priv;
 	if (priv->detector)
 		return true;
-	const frappe::Config config = make_config(priv->active);
+	const frappe::Config config = priv->active.config();
 	try {
 		priv->detector = std::make_unique<frappe::Detector>(config);
 	} catch (const std::exception &e) {
@@ -472,62 +204,18 @@ static bool ensure_detector(GstFrappeDetect *self)
 	return true;
 }
 
-static void add_double_array(GstStructure *s, const char *field, const double *v, int n)
-{
-	GValue array = G_VALUE_INIT;
-	gst_value_array_init(&array, static_cast<guint>(n));
-	for (int i = 0; i < n; ++i) {
-		GValue item = G_VALUE_INIT;
-		g_value_init(&item, G_TYPE_DOUBLE);
-		g_value_set_double(&item, v[i]);
-		gst_value_array_append_and_take_value(&array, &item);
-	}
-	gst_structure_take_value(s, field, &array);
-}
-
 static void update_stats(GstFrappeDetect *self, const frappe::Result &result, double poseMs)
 {
 	FrappeDetectPrivate *priv = self->priv;
-	GstStructure *s = gst_structure_new("frappe-stats", "frames", G_TYPE_UINT64, priv->frames,
-					    "markers", G_TYPE_UINT,
-					    static_cast<guint>(result.markers.size()), "candidates",
-					    G_TYPE_INT, result.candidates, "scale", G_TYPE_DOUBLE,
-					    static_cast<double>(result.scale), nullptr);
-	for (int i = 0; i < frappe::kStageCount; ++i) {
-		std::string name(frappe::stageName(static_cast<frappe::Stage>(i)));
-		std::replace(name.begin(), name.end(), '_', '-');
-		name += "-ms";
-		gst_structure_set(s, name.c_str(), G_TYPE_DOUBLE, result.times.ms[static_cast<std::size_t>(i)],
-				  nullptr);
-	}
-	gst_structure_set(s, "pose-ms", G_TYPE_DOUBLE, poseMs, "total-ms", G_TYPE_DOUBLE,
-			  result.times.total_ms + poseMs, "backend", G_TYPE_STRING,
-			  priv->detector ? priv->detector->frontEnd().name() : "cpu", "pipelined",
-			  G_TYPE_BOOLEAN, priv->active.pipelined, nullptr);
+	GstStructure *s = frappe::gst::statsStructure(priv->frames, result, poseMs,
+						      priv->detector ? priv->detector->frontEnd().name() : "cpu",
+						      priv->active.pipelined);
 
 	GST_LOG_OBJECT(self, "stats %" GST_PTR_FORMAT, static_cast<void *>(s));
 
-	/* Every 100 frames, the average cost per stage at INFO level, so
-	 * GST_DEBUG=frappedetect:4 shows the speed without any tooling. */
-	priv->windowTimes.total_ms += result.times.total_ms + poseMs;
-	for (std::size_t i = 0; i < result.times.ms.size(); ++i)
-		priv->windowTimes.ms[i] += result.times.ms[i];
-	priv->windowPoseMs += poseMs;
-	if (priv->frames % 100 == 0) {
-		std::string line;
-		for (int i = 0; i < frappe::kStageCount; ++i) {
-			char part[64];
-			std::snprintf(part, sizeof(part), "%s %.2f, ",
-				      std::string(frappe::stageName(static_cast<frappe::Stage>(i))).c_str(),
-				      priv->windowTimes.ms[static_cast<std::size_t>(i)] / 100.0);
-			line += part;
-		}
-		GST_INFO_OBJECT(self, "last 100 frames, ms per frame: %spose %.2f, total %.2f%s", line.c_str(),
-				priv->windowPoseMs / 100.0, priv->windowTimes.total_ms / 100.0,
+	if (const auto line = priv->window.add(priv->frames, result, poseMs))
+		GST_INFO_OBJECT(self, "last 100 frames, ms per frame: %s%s", line->c_str(),
 				priv->active.pipelined ? " (front end overlapped with the back end)" : "");
-		priv->windowTimes = {};
-		priv->windowPoseMs = 0.0;
-	}
 	GST_OBJECT_LOCK(self);
 	if (priv->stats)
 		gst_structure_free(priv->stats);
@@ -535,174 +223,36 @@ static void update_stats(GstFrappeDetect *self, const frappe::Result &result, do
 	GST_OBJECT_UNLOCK(self);
 }
 
-static void annotate_frame(GstVideoFrame *frame, const frappe::Result &result,
-			   const std::vector<std::optional<frappe::gst::Pose>> &poses, const Settings &s)
-{
-	frappe::gst::Canvas canvas(frame);
-	for (std::size_t i = 0; i < result.markers.size(); ++i) {
-		const frappe::Marker &m = result.markers[i];
-		double side = 0.0;
-		for (int k = 0; k < 4; ++k) {
-			const auto a = m.corners[static_cast<std::size_t>(k)];
-			const auto b = m.corners[static_cast<std::size_t>((k + 1) & 3)];
-			side += std::hypot(a.x - b.x, a.y - b.y) / 4.0;
-		}
-		const int thickness = std::max(1, static_cast<int>(side / 32.0));
-		for (int k = 0; k < 4; ++k) {
-			const auto a = m.corners[static_cast<std::size_t>(k)];
-			const auto b = m.corners[static_cast<std::size_t>((k + 1) & 3)];
-			canvas.haloLine(a.x, a.y, b.x, b.y, thickness, frappe::gst::colours::outline);
-		}
-		/* The first corner (top-left in the marker's orientation). */
-		const int r = std::max(2, static_cast<int>(side / 24.0));
-		const int cx = static_cast<int>(std::lround(m.corners[0].x));
-		const int cy = static_cast<int>(std::lround(m.corners[0].y));
-		canvas.fillRect(cx - r - 1, cy - r - 1, cx + r + 1, cy + r + 1, frappe::gst::colours::black);
-		canvas.fillRect(cx - r, cy - r, cx + r, cy + r, frappe::gst::colours::firstCorner);
-
-		if (poses[i]) {
-			const double h = s.markerSize / 2.0;
-			const auto p = frappe::gst::projectPoints({ { 0, 0, 0 }, { h, 0, 0 }, { 0, h, 0 }, { 0, 0, h } },
-								  *poses[i], s.camera);
-			if (p.size() == 4) {
-				canvas.haloLine(p[0].x, p[0].y, p[1].x, p[1].y, thickness, frappe::gst::colours::axisX);
-				canvas.haloLine(p[0].x, p[0].y, p[2].x, p[2].y, thickness, frappe::gst::colours::axisY);
-				canvas.haloLine(p[0].x, p[0].y, p[3].x, p[3].y, thickness, frappe::gst::colours::axisZ);
-			}
-		}
-
-		/* The id between the centre and the first corner: the quadrant of
-		 * the marker frame (-x, +y) that the axes leave free. */
-		double mx = 0.0, my = 0.0;
-		for (const auto &c : m.corners) {
-			mx += c.x / 4.0;
-			my += c.y / 4.0;
-		}
-		mx = (mx * 3.0 + m.corners[0].x * 2.0) / 5.0;
-		my = (my * 3.0 + m.corners[0].y * 2.0) / 5.0;
-		canvas.number(m.id, mx, my, std::max(1, static_cast<int>(side / 24.0)));
-	}
-}
-
 /* Attaches metas, draws, posts the message and releases the frame; the
- * buffer goes to the output list. */
-static void finish(GstFrappeDetect *self, InFlight &f)
+ * buffer goes to the output list. A back end that failed is an element
+ * error, pipelined or not, and the buffer is dropped. */
+static GstFlowReturn finish(GstFrappeDetect *self, InFlight &f)
 {
 	FrappeDetectPrivate *priv = self->priv;
-	GstBaseTransform *trans = GST_BASE_TRANSFORM(self);
 	const Settings &s = priv->active;
-	const auto &dict = priv->detector->dictionary();
-	const std::string dictName(dict.name);
 
-	static const frappe::Result empty;
-	const frappe::Result &result = f.result ? *f.result : empty;
-	if (!f.error.empty())
-		GST_WARNING_OBJECT(self, "detection failed on %" GST_PTR_FORMAT ": %s", static_cast<void *>(f.buffer),
-				   f.error.c_str());
-
-	/* Pose. */
-	const bool wantPose = s.markerSize > 0.0 && s.camera.valid();
-	std::vector<std::optional<frappe::gst::Pose>> poses(result.markers.size());
-	const gint64 t0 = g_get_monotonic_time();
-	if (wantPose) {
-		for (std::size_t i = 0; i < result.markers.size(); ++i) {
-			frappe::gst::Pose pose;
-			if (frappe::gst::estimatePose(result.markers[i], s.markerSize, s.camera, pose))
-				poses[i] = pose;
-		}
+	if (!f.error.empty() || !f.result) {
+		GST_ELEMENT_ERROR(self, STREAM, FAILED, ("Marker detection failed"), ("%s", f.error.c_str()));
+		f.discard();
+		return GST_FLOW_ERROR;
 	}
+	const frappe::Result &result = *f.result;
+	const std::string dictName(priv->detector->dictionary().name);
+
+	const gint64 t0 = g_get_monotonic_time();
+	const frappe::gst::Poses poses = frappe::gst::estimatePoses(result.markers, s.markerSize, s.camera);
 	const double poseMs = static_cast<double>(g_get_monotonic_time() - t0) / 1000.0;
 
-	GstStructure *msg = nullptr;
-	GValue list = G_VALUE_INIT;
-	if (s.postMessages)
-		g_value_init(&list, GST_TYPE_LIST);
-
-	for (std::size_t i = 0; i < result.markers.size(); ++i) {
-		const frappe::Marker &m = result.markers[i];
-		gfloat corners[8];
-		float minX = G_MAXFLOAT, minY = G_MAXFLOAT, maxX = -G_MAXFLOAT, maxY = -G_MAXFLOAT;
-		for (int k = 0; k < 4; ++k) {
-			const auto c = m.corners[static_cast<std::size_t>(k)];
-			corners[2 * k] = c.x;
-			corners[2 * k + 1] = c.y;
-			minX = std::min(minX, c.x);
-			minY = std::min(minY, c.y);
-			maxX = std::max(maxX, c.x);
-			maxY = std::max(maxY, c.y);
-		}
-		GstFrappeMarkerMeta *meta = gst_buffer_add_frappe_marker_meta(
-			f.buffer, m.id, dictName.c_str(), corners, static_cast<guint>(m.hamming));
-		if (meta)
-			meta->margin = m.margin;
-		if (meta && poses[i]) {
-			meta->has_pose = TRUE;
-			for (int k = 0; k < 3; ++k) {
-				meta->rvec[k] = poses[i]->rvec[static_cast<std::size_t>(k)];
-				meta->tvec[k] = poses[i]->tvec[static_cast<std::size_t>(k)];
-			}
-			meta->reprojection_error = poses[i]->reprojectionError;
-			meta->alternative_reprojection_error = poses[i]->alternativeError;
-		}
-
-		/* The ROI covers the pixels the corners touch, clipped to the frame. */
-		const gint width = GST_VIDEO_FRAME_WIDTH(&f.frame), height = GST_VIDEO_FRAME_HEIGHT(&f.frame);
-		const gint x0 = std::clamp(static_cast<gint>(std::floor(minX + 0.5f)), 0, width - 1);
-		const gint y0 = std::clamp(static_cast<gint>(std::floor(minY + 0.5f)), 0, height - 1);
-		const gint x1 = std::clamp(static_cast<gint>(std::ceil(maxX + 0.5f)), x0 + 1, width);
-		const gint y1 = std::clamp(static_cast<gint>(std::ceil(maxY + 0.5f)), y0 + 1, height);
-		GstVideoRegionOfInterestMeta *roi = gst_buffer_add_video_region_of_interest_meta(
-			f.buffer, GST_FRAPPE_ROI_TYPE, static_cast<guint>(x0), static_cast<guint>(y0),
-			static_cast<guint>(x1 - x0), static_cast<guint>(y1 - y0));
-		if (roi) {
-			roi->id = static_cast<gint>(i);
-			gst_video_region_of_interest_meta_add_param(
-				roi, gst_structure_new(GST_FRAPPE_ROI_TYPE, "id", G_TYPE_INT, m.id,
-						       "dictionary", G_TYPE_STRING, dictName.c_str(),
-						       "hamming", G_TYPE_UINT,
-						       static_cast<guint>(m.hamming), "margin", G_TYPE_DOUBLE,
-						       static_cast<gdouble>(m.margin), nullptr));
-		}
-
-		if (s.postMessages) {
-			GstStructure *ms = gst_structure_new("marker", "id", G_TYPE_INT, m.id, "dictionary",
-							     G_TYPE_STRING, dictName.c_str(), nullptr);
-			double dc[8];
-			for (int k = 0; k < 8; ++k)
-				dc[k] = corners[k];
-			add_double_array(ms, "corners", dc, 8);
-			gst_structure_set(ms, "hamming", G_TYPE_UINT, static_cast<guint>(m.hamming), "margin",
-					  G_TYPE_DOUBLE, static_cast<gdouble>(m.margin), nullptr);
-			if (poses[i]) {
-				add_double_array(ms, "rvec", poses[i]->rvec.data(), 3);
-				add_double_array(ms, "tvec", poses[i]->tvec.data(), 3);
-				gst_structure_set(ms, "reprojection-error", G_TYPE_DOUBLE,
-						  poses[i]->reprojectionError, "alternative-reprojection-error",
-						  G_TYPE_DOUBLE, poses[i]->alternativeError, nullptr);
-			}
-			GValue item = G_VALUE_INIT;
-			g_value_init(&item, GST_TYPE_STRUCTURE);
-			g_value_take_boxed(&item, ms);
-			gst_value_list_append_and_take_value(&list, &item);
-		}
-	}
-
+	frappe::gst::attachMarkerMetas(f.buffer, GST_VIDEO_FRAME_WIDTH(&f.frame), GST_VIDEO_FRAME_HEIGHT(&f.frame),
+				       result, poses, dictName.c_str());
 	if (f.writable && s.annotate && !result.markers.empty())
-		annotate_frame(&f.frame, result, poses, s);
+		frappe::gst::annotateMarkers(&f.frame, result, poses, s.markerSize, s.camera);
 
 	gst_video_frame_unmap(&f.frame);
 
 	if (s.postMessages) {
-		const GstClockTime pts = GST_BUFFER_PTS(f.buffer);
-		GstClockTime running = GST_CLOCK_TIME_NONE, stream = GST_CLOCK_TIME_NONE;
-		if (trans->segment.format == GST_FORMAT_TIME) {
-			running = gst_segment_to_running_time(&trans->segment, GST_FORMAT_TIME, pts);
-			stream = gst_segment_to_stream_time(&trans->segment, GST_FORMAT_TIME, pts);
-		}
-		msg = gst_structure_new("frappedetect", "timestamp", G_TYPE_UINT64, pts, "stream-time",
-					G_TYPE_UINT64, stream, "running-time", G_TYPE_UINT64, running,
-					"duration", G_TYPE_UINT64, GST_BUFFER_DURATION(f.buffer), nullptr);
-		gst_structure_take_value(msg, "markers", &list);
+		GstStructure *msg = frappe::gst::frameMessage(f.buffer, GST_BASE_TRANSFORM(self)->segment, result,
+							      poses, dictName.c_str());
 		gst_element_post_message(GST_ELEMENT(self), gst_message_new_element(GST_OBJECT(self), msg));
 	}
 
@@ -714,17 +264,19 @@ static void finish(GstFrappeDetect *self, InFlight &f)
 
 	priv->output.push_back(f.buffer);
 	f.buffer = nullptr;
+	return GST_FLOW_OK;
 }
 
 /* Waits for the held frame's back end and finishes it. */
-static void finish_held(GstFrappeDetect *self)
+static GstFlowReturn finish_held(GstFrappeDetect *self)
 {
 	FrappeDetectPrivate *priv = self->priv;
 	if (!priv->held)
-		return;
+		return GST_FLOW_OK;
 	priv->worker.wait();
-	finish(self, *priv->held);
+	const GstFlowReturn ret = finish(self, *priv->held);
 	priv->held.reset();
+	return ret;
 }
 
 /* Throws the held frame away (flush, stop). */
@@ -735,8 +287,7 @@ static void drop_held(GstFrappeDetect *self)
 		return;
 	priv->worker.wait();
 	GST_DEBUG_OBJECT(self, "dropping held %" GST_PTR_FORMAT, static_cast<void *>(priv->held->buffer));
-	gst_video_frame_unmap(&priv->held->frame);
-	gst_buffer_unref(priv->held->buffer);
+	priv->held->discard();
 	priv->held.reset();
 }
 
@@ -751,7 +302,7 @@ static void clear_output(GstFrappeDetect *self)
 static GstFlowReturn drain(GstFrappeDetect *self)
 {
 	FrappeDetectPrivate *priv = self->priv;
-	finish_held(self);
+	const GstFlowReturn held = finish_held(self);
 	GstFlowReturn ret = GST_FLOW_OK;
 	std::vector<GstBuffer *> out;
 	out.swap(priv->output);
@@ -763,11 +314,11 @@ static GstFlowReturn drain(GstFrappeDetect *self)
 			gst_buffer_unref(b);
 		}
 	}
-	return ret;
+	return ret != GST_FLOW_OK ? ret : held;
 }
 
 /* Picks up property changes; may finish the held frame first. */
-static void apply_settings(GstFrappeDetect *self)
+static GstFlowReturn apply_settings(GstFrappeDetect *self)
 {
 	FrappeDetectPrivate *priv = self->priv;
 	GST_OBJECT_LOCK(self);
@@ -776,8 +327,9 @@ static void apply_settings(GstFrappeDetect *self)
 
 	const bool rebuild = !next.sameDetector(priv->active);
 	const bool pipelineChange = next.pipelined != priv->active.pipelined;
+	GstFlowReturn ret = GST_FLOW_OK;
 	if (rebuild || pipelineChange)
-		finish_held(self);
+		ret = finish_held(self);
 	priv->active = next;
 	if (rebuild && priv->detector) {
 		GST_DEBUG_OBJECT(self, "settings changed, rebuilding the detector");
@@ -787,6 +339,7 @@ static void apply_settings(GstFrappeDetect *self)
 		GST_DEBUG_OBJECT(self, "pipelined now %d", next.pipelined);
 		gst_element_post_message(GST_ELEMENT(self), gst_message_new_latency(GST_OBJECT(self)));
 	}
+	return ret;
 }
 
 static void log_memory(GstFrappeDetect *self, GstBuffer *buffer)
@@ -819,7 +372,11 @@ static GstFlowReturn process(GstFrappeDetect *self, GstBuffer *input)
 	FrappeDetectPrivate *priv = self->priv;
 	GstVideoFilter *filter = GST_VIDEO_FILTER(self);
 
-	apply_settings(self);
+	GstFlowReturn ret = apply_settings(self);
+	if (ret != GST_FLOW_OK) {
+		gst_buffer_unref(input);
+		return ret;
+	}
 	if (!ensure_detector(self)) {
 		gst_buffer_unref(input);
 		return GST_FLOW_NOT_NEGOTIATED;
@@ -861,17 +418,16 @@ static GstFlowReturn process(GstFrappeDetect *self, GstBuffer *input)
 			detector.runFrontEnd(f.image, f.slot);
 		}
 	} catch (const std::exception &e) {
-		gst_video_frame_unmap(&f.frame);
-		gst_buffer_unref(f.buffer);
-		GST_ELEMENT_ERROR(self, STREAM, FAILED, ("Marker detection failed"), ("%s", e.what()));
-		return GST_FLOW_ERROR;
+		f.error = e.what();
 	}
-	if (!pipelined) {
-		finish(self, f);
-		return GST_FLOW_OK;
-	}
+	if (!pipelined || !f.error.empty())
+		return finish(self, f);
 
-	finish_held(self);
+	ret = finish_held(self);
+	if (ret != GST_FLOW_OK) {
+		f.discard();
+		return ret;
+	}
 	priv->held = std::move(f);
 	InFlight *h = &*priv->held;
 	frappe::Detector *d = &detector;
@@ -1013,8 +569,7 @@ static gboolean gst_frappe_detect_start(GstBaseTransform *trans)
 	self->priv->active = self->priv->props;
 	GST_OBJECT_UNLOCK(self);
 	self->priv->frames = 0;
-	self->priv->windowTimes = {};
-	self->priv->windowPoseMs = 0.0;
+	self->priv->window.reset();
 	self->priv->loggedMemory = false;
 	self->priv->warnedStride = false;
 	return TRUE;
@@ -1042,170 +597,28 @@ static gboolean gst_frappe_detect_set_info(GstVideoFilter *filter, GstCaps *, Gs
  * GObject
  */
 
-static void set_double_array(const GValue *value, std::vector<double> &out)
-{
-	out.clear();
-	const guint n = gst_value_array_get_size(value);
-	for (guint i = 0; i < n; ++i) {
-		const GValue *v = gst_value_array_get_value(value, i);
-		if (G_VALUE_HOLDS_DOUBLE(v))
-			out.push_back(g_value_get_double(v));
-		else if (G_VALUE_HOLDS_FLOAT(v))
-			out.push_back(g_value_get_float(v));
-		else if (G_VALUE_HOLDS_INT(v))
-			out.push_back(g_value_get_int(v));
-	}
-}
-
-static void get_double_array(GValue *value, const double *v, std::size_t n)
-{
-	for (std::size_t i = 0; i < n; ++i) {
-		GValue item = G_VALUE_INIT;
-		g_value_init(&item, G_TYPE_DOUBLE);
-		g_value_set_double(&item, v[i]);
-		gst_value_array_append_and_take_value(value, &item);
-	}
-}
-
 static void gst_frappe_detect_set_property(GObject *object, guint prop_id, const GValue *value, GParamSpec *pspec)
 {
 	GstFrappeDetect *self = GST_FRAPPE_DETECT(object);
-	Settings &p = self->priv->props;
 
 	GST_OBJECT_LOCK(self);
-	switch (prop_id) {
-	case PROP_DICTIONARY:
-		p.dictionary = g_value_get_enum(value);
-		break;
-	case PROP_MODE:
-		p.mode = static_cast<GstFrappeMode>(g_value_get_enum(value));
-		break;
-	case PROP_EDGE_THRESHOLD:
-		p.edgeThreshold = g_value_get_float(value);
-		break;
-	case PROP_CORNER_THRESHOLD:
-		p.cornerThreshold = g_value_get_float(value);
-		break;
-	case PROP_REGION_CONTRAST:
-		p.regionContrast = g_value_get_float(value);
-		break;
-	case PROP_MAX_HAMMING:
-		p.maxHamming = g_value_get_int(value);
-		break;
-	case PROP_SCALED_SIZE:
-		p.scaledSize = g_value_get_float(value);
-		break;
-	case PROP_MAX_SCALED_FRAMES:
-		p.maxScaledFrames = g_value_get_int(value);
-		break;
-	case PROP_ANNOTATE:
-		p.annotate = g_value_get_boolean(value);
-		break;
-	case PROP_POST_MESSAGES:
-		p.postMessages = g_value_get_boolean(value);
-		break;
-	case PROP_PIPELINED:
-		p.pipelined = g_value_get_boolean(value);
-		break;
-	case PROP_BACKEND:
-		p.backend = static_cast<GstFrappeBackend>(g_value_get_enum(value));
-		break;
-	case PROP_MARKER_SIZE:
-		p.markerSize = g_value_get_double(value);
-		break;
-	case PROP_CAMERA_MATRIX: {
-		std::vector<double> m;
-		set_double_array(value, m);
-		if (m.empty()) {
-			p.camera.matrix = {};
-		} else if (m.size() == 9) {
-			std::copy(m.begin(), m.end(), p.camera.matrix.begin());
-		} else {
-			GST_WARNING_OBJECT(self, "camera-matrix needs 9 numbers (row-major 3x3), got %zu; ignored",
-					   m.size());
-		}
-		break;
-	}
-	case PROP_DISTORTION: {
-		std::vector<double> d;
-		set_double_array(value, d);
-		const std::size_t n = d.size();
-		if (n == 0 || n == 4 || n == 5 || n == 8 || n == 12 || n == 14)
-			p.camera.distortion = d;
-		else
-			GST_WARNING_OBJECT(self, "distortion needs 4, 5, 8, 12 or 14 coefficients, got %zu; ignored",
-					   n);
-		break;
-	}
-	default:
+	if (!frappe::gst::setProperty(object, self->priv->props, prop_id, value))
 		G_OBJECT_WARN_INVALID_PROPERTY_ID(object, prop_id, pspec);
-		break;
-	}
 	GST_OBJECT_UNLOCK(self);
 }
 
 static void gst_frappe_detect_get_property(GObject *object, guint prop_id, GValue *value, GParamSpec *pspec)
 {
 	GstFrappeDetect *self = GST_FRAPPE_DETECT(object);
-	const Settings &p = self->priv->props;
 
 	GST_OBJECT_LOCK(self);
-	switch (prop_id) {
-	case PROP_DICTIONARY:
-		g_value_set_enum(value, p.dictionary);
-		break;
-	case PROP_MODE:
-		g_value_set_enum(value, p.mode);
-		break;
-	case PROP_EDGE_THRESHOLD:
-		g_value_set_float(value, p.edgeThreshold);
-		break;
-	case PROP_CORNER_THRESHOLD:
-		g_value_set_float(value, p.cornerThreshold);
-		break;
-	case PROP_REGION_CONTRAST:
-		g_value_set_float(value, p.regionContrast);
-		break;
-	case PROP_MAX_HAMMING:
-		g_value_set_int(value, p.maxHamming);
-		break;
-	case PROP_SCALED_SIZE:
-		g_value_set_float(value, p.scaledSize);
-		break;
-	case PROP_MAX_SCALED_FRAMES:
-		g_value_set_int(value, p.maxScaledFrames);
-		break;
-	case PROP_ANNOTATE:
-		g_value_set_boolean(value, p.annotate);
-		break;
-	case PROP_POST_MESSAGES:
-		g_value_set_boolean(value, p.postMessages);
-		break;
-	case PROP_PIPELINED:
-		g_value_set_boolean(value, p.pipelined);
-		break;
-	case PROP_BACKEND:
-		g_value_set_enum(value, p.backend);
-		break;
-	case PROP_MARKER_SIZE:
-		g_value_set_double(value, p.markerSize);
-		break;
-	case PROP_CAMERA_MATRIX:
-		if (p.camera.valid())
-			get_double_array(value, p.camera.matrix.data(), 9);
-		break;
-	case PROP_DISTORTION:
-		get_double_array(value, p.camera.distortion.data(), p.camera.distortion.size());
-		break;
-	case PROP_STATS:
+	if (prop_id == frappe::gst::PROP_STATS) {
 		if (self->priv->stats)
 			g_value_set_boxed(value, self->priv->stats);
 		else
 			g_value_take_boxed(value, gst_structure_new_empty("frappe-stats"));
-		break;
-	default:
+	} else if (!frappe::gst::getProperty(self->priv->props, prop_id, value)) {
 		G_OBJECT_WARN_INVALID_PROPERTY_ID(object, prop_id, pspec);
-		break;
 	}
 	GST_OBJECT_UNLOCK(self);
 }
@@ -1222,7 +635,6 @@ static void gst_frappe_detect_finalize(GObject *object)
 static void gst_frappe_detect_init(GstFrappeDetect *self)
 {
 	self->priv = new FrappeDetectPrivate();
-	self->priv->props.dictionary = default_dictionary_index();
 	self->priv->active = self->priv->props;
 	gst_base_transform_set_in_place(GST_BASE_TRANSFORM(self), TRUE);
 	gst_base_transform_set_passthrough(GST_BASE_TRANSFORM(self), FALSE);
@@ -1241,106 +653,7 @@ static void gst_frappe_detect_class_init(GstFrappeDetectClass *klass)
 	gobject_class->get_property = gst_frappe_detect_get_property;
 	gobject_class->finalize = gst_frappe_detect_finalize;
 
-	const auto rw = static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS);
-	const auto live = static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS |
-						   GST_PARAM_MUTABLE_PLAYING);
-
-	/**
-	 * GstFrappeDetect:dictionary:
-	 *
-	 * The marker family to look for.
-	 */
-	g_object_class_install_property(
-		gobject_class, PROP_DICTIONARY,
-		g_param_spec_enum("dictionary", "Dictionary", "Marker family to detect", GST_TYPE_FRAPPE_DICTIONARY,
-				  default_dictionary_index(), live));
-	g_object_class_install_property(
-		gobject_class, PROP_MODE,
-		g_param_spec_enum("mode", "Mode",
-				  "normal: every frame at full resolution; ascale: scale frames down from the "
-				  "size of the smallest marker of the previous frame (faster on video)",
-				  GST_TYPE_FRAPPE_MODE, DEFAULT_MODE, live));
-	g_object_class_install_property(
-		gobject_class, PROP_EDGE_THRESHOLD,
-		g_param_spec_float("edge-threshold", "Edge threshold",
-				   "Sobel gradient magnitude (intensities in [0, 1]) an edge pixel must exceed; "
-				   "lower finds fainter markers but costs more contour tracing",
-				   0.001f, 4.0f, DEFAULT_EDGE_THRESHOLD, live));
-	g_object_class_install_property(
-		gobject_class, PROP_CORNER_THRESHOLD,
-		g_param_spec_float("corner-threshold", "Corner threshold",
-				   "Shi-Tomasi minimum eigenvalue that marks an edge pixel as a corner; too high "
-				   "loses low-contrast markers, too low splits corners",
-				   0.0f, 100.0f, DEFAULT_CORNER_THRESHOLD, live));
-	g_object_class_install_property(
-		gobject_class, PROP_REGION_CONTRAST,
-		g_param_spec_float("region-contrast", "Region contrast",
-				   "Contrast (intensities in [0, 1]) around a pixel for the dark-region candidates "
-				   "that find blurred markers; lower finds fainter blurred markers but traces more "
-				   "clutter; 0 turns them off (edge candidates only, faster)",
-				   0.0f, 1.0f, DEFAULT_REGION_CONTRAST, live));
-	g_object_class_install_property(
-		gobject_class, PROP_MAX_HAMMING,
-		g_param_spec_int("max-hamming", "Max Hamming",
-				 "Most bit errors corrected among cells read clearly (-1 = the dictionary's "
-				 "careful default; clamped to half the bits of the dictionary)",
-				 -1, MAX_MAX_HAMMING, DEFAULT_MAX_HAMMING, live));
-	g_object_class_install_property(
-		gobject_class, PROP_SCALED_SIZE,
-		g_param_spec_float("scaled-size", "Scaled size",
-				   "ascale: target side in pixels of the smallest marker after scaling",
-				   8.0f, 1000.0f, DEFAULT_SCALED_SIZE, live));
-	g_object_class_install_property(
-		gobject_class, PROP_MAX_SCALED_FRAMES,
-		g_param_spec_int("max-scaled-frames", "Max scaled frames",
-				 "ascale: at most this many scaled frames in a row before one at full resolution",
-				 0, 1000, DEFAULT_MAX_SCALED_FRAMES, live));
-	g_object_class_install_property(
-		gobject_class, PROP_ANNOTATE,
-		g_param_spec_boolean("annotate", "Annotate",
-				     "Draw outlines, first corners, ids and pose axes into the frame "
-				     "(maps the frame writable)",
-				     DEFAULT_ANNOTATE, live));
-	g_object_class_install_property(
-		gobject_class, PROP_POST_MESSAGES,
-		g_param_spec_boolean("post-messages", "Post messages",
-				     "Post a frappedetect element message per frame", DEFAULT_POST_MESSAGES, live));
-	g_object_class_install_property(
-		gobject_class, PROP_PIPELINED,
-		g_param_spec_boolean("pipelined", "Pipelined",
-				     "Overlap the front end of the next frame with the back end of this one "
-				     "(holds one buffer: one frame of extra latency)",
-				     DEFAULT_PIPELINED, live));
-	g_object_class_install_property(
-		gobject_class, PROP_BACKEND,
-		g_param_spec_enum("backend", "Backend", "Where the front end runs", GST_TYPE_FRAPPE_BACKEND,
-				  DEFAULT_BACKEND, live));
-	g_object_class_install_property(
-		gobject_class, PROP_MARKER_SIZE,
-		g_param_spec_double("marker-size", "Marker size",
-				    "Side of the markers' black square in metres, for the pose (0 = no pose)",
-				    0.0, 1000.0, DEFAULT_MARKER_SIZE, live));
-	g_object_class_install_property(
-		gobject_class, PROP_CAMERA_MATRIX,
-		gst_param_spec_array("camera-matrix", "Camera matrix",
-				     "Camera intrinsics for the pose, 9 numbers row-major: "
-				     "<fx, 0, cx, 0, fy, cy, 0, 0, 1> (empty = no pose)",
-				     g_param_spec_double("element", "Element", "A matrix element", -G_MAXDOUBLE,
-							 G_MAXDOUBLE, 0.0, rw),
-				     live));
-	g_object_class_install_property(
-		gobject_class, PROP_DISTORTION,
-		gst_param_spec_array("distortion", "Distortion",
-				     "Lens distortion in OpenCV's order <k1, k2, p1, p2[, k3[, k4, k5, k6"
-				     "[, s1, s2, s3, s4[, tx, ty]]]]> (empty = none)",
-				     g_param_spec_double("coefficient", "Coefficient", "A distortion coefficient",
-							 -G_MAXDOUBLE, G_MAXDOUBLE, 0.0, rw),
-				     live));
-	g_object_class_install_property(
-		gobject_class, PROP_STATS,
-		g_param_spec_boxed("stats", "Statistics",
-				   "Per-stage timings (ms) and counts of the last frame", GST_TYPE_STRUCTURE,
-				   static_cast<GParamFlags>(G_PARAM_READABLE | G_PARAM_STATIC_STRINGS)));
+	frappe::gst::installProperties(gobject_class);
 
 	gst_element_class_set_static_metadata(element_class, "Frappe fiducial marker detector",
 					      "Filter/Analyzer/Video",

@@ -106,4 +106,18 @@ std::vector<Point2f> projectPoints(const std::vector<std::array<double, 3>> &poi
 	return out;
 }
 
+std::vector<std::optional<Pose>> estimatePoses(const std::vector<Marker> &markers, double size,
+					       const Camera &camera)
+{
+	std::vector<std::optional<Pose>> poses(markers.size());
+	if (!(size > 0.0) || !camera.valid())
+		return poses;
+	for (std::size_t i = 0; i < markers.size(); ++i) {
+		Pose pose;
+		if (estimatePose(markers[i], size, camera, pose))
+			poses[i] = pose;
+	}
+	return poses;
+}
+
 } // namespace frappe::gst

@@ -11,6 +11,7 @@
 #pragma once
 
 #include <array>
+#include <optional>
 #include <vector>
 
 #include <frappe/marker.h>
@@ -36,6 +37,11 @@ struct Pose {
 /// Solves the pose of a marker of side `size` (metres). False when OpenCV
 /// finds no solution.
 bool estimatePose(const Marker &marker, double size, const Camera &camera, Pose &pose);
+
+/// The poses of a frame's markers, in their order: all empty unless `size`
+/// is positive and the camera valid; empty for a marker with no solution.
+std::vector<std::optional<Pose>> estimatePoses(const std::vector<Marker> &markers, double size,
+					       const Camera &camera);
 
 /// Projects marker-frame points into the image with the pose.
 std::vector<Point2f> projectPoints(const std::vector<std::array<double, 3>> &points, const Pose &pose,

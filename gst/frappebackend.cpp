@@ -1,0 +1,36 @@
+/* SPDX-License-Identifier: MIT
+ *
+ * frappebackend.cpp: the front end a user names put into a detector.
+ */
+#include "frappebackend.h"
+
+#include <utility>
+
+#ifdef FRAPPE_HAVE_VC4
+#include "frontend/backend.hpp"
+#endif
+
+namespace frappe {
+
+std::string selectBackend(Detector &detector, std::string_view name, int threads)
+{
+	/* The detector's own front end already is the CPU one. */
+	if (name == "cpu")
+		return {};
+#ifdef FRAPPE_HAVE_VC4
+	vc4::BackendChoice choice = vc4::selectFrontEnd(name, threads);
+	detector.setFrontEnd(std::move(choice.frontEnd));
+	detector.setWarper(std::move(choice.warper));
+	return choice.fallback;
+#else
+	(void)detector;
+	(void)threads;
+	if (name == "auto")
+		return {};
+	if (name == "vc4" || name == "vc4-emu")
+		throw BackendNotBuilt("backend " + std::string(name) + " needs vc4/, which this build lacks");
+	throw std::invalid_argument("unknown backend '" + std::string(name) + "' (auto, cpu, vc4, vc4-emu)");
+#endif
+}
+
+} /* namespace frappe */

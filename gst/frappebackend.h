@@ -1,0 +1,36 @@
+/* SPDX-License-Identifier: MIT
+ *
+ * frappebackend.h: the front end a user names (the element's backend
+ * property, the CLI's --backend) put into a detector. No GStreamer types,
+ * so that any program can call it.
+ */
+#pragma once
+
+#include <stdexcept>
+#include <string>
+#include <string_view>
+
+#include <frappe/detector.h>
+
+namespace frappe {
+
+/* Thrown for vc4 and vc4-emu when this build has no vc4/. */
+class BackendNotBuilt : public std::runtime_error
+{
+public:
+	using std::runtime_error::runtime_error;
+};
+
+/*
+ * Puts the front end named `name` into `detector`: "cpu" keeps the CPU front
+ * end the detector has; "vc4", "vc4-emu" and "auto" go to vc4/, which decides
+ * what runs ("auto" without vc4/ in the build keeps the CPU). `threads` are
+ * the bands of a CPU front end that "auto" falls back to.
+ *
+ * Returns why "auto" fell back to the CPU, in one sentence for a single
+ * warning, or an empty string. Throws std::invalid_argument for an unknown
+ * name, BackendNotBuilt, and std::runtime_error when the QPUs cannot be used.
+ */
+std::string selectBackend(Detector &detector, std::string_view name, int threads);
+
+} /* namespace frappe */

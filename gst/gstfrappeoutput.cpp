@@ -1,0 +1,179 @@
+/* SPDX-License-Identifier: MIT
+ *
+ * gstfrappeoutput.cpp: frappedetect's metas, message and statistics.
+ */
+#include "gstfrappeoutput.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <cstdio>
+#include <string>
+
+#include <gst/video/video.h>
+
+#include "gstfrappemeta.h"
+
+namespace frappe::gst {
+
+namespace {
+
+void addDoubleArray(GstStructure *s, const char *field, const double *v, int n)
+{
+	GValue array = G_VALUE_INIT;
+	gst_value_array_init(&array, static_cast<guint>(n));
+	for (int i = 0; i < n; ++i) {
+		GValue item = G_VALUE_INIT;
+		g_value_init(&item, G_TYPE_DOUBLE);
+		g_value_set_double(&item, v[i]);
+		gst_value_array_append_and_take_value(&array, &item);
+	}
+	gst_structure_take_value(s, field, &array);
+}
+
+GstStructure *markerStructure(const Marker &m, const std::optional<Pose> &pose, const char *dictionary)
+{
+	GstStructure *ms = gst_structure_new("marker", "id", G_TYPE_INT, m.id, "dictionary", G_TYPE_STRING,
+					     dictionary, nullptr);
+	double corners[8];
+	for (int k = 0; k < 4; ++k) {
+		corners[2 * k] = m.corners[static_cast<std::size_t>(k)].x;
+		corners[2 * k + 1] = m.corners[static_cast<std::size_t>(k)].y;
+	}
+	addDoubleArray(ms, "corners", corners, 8);
+	gst_structure_set(ms, "hamming", G_TYPE_UINT, static_cast<guint>(m.hamming), "margin", G_TYPE_DOUBLE,
+			  static_cast<gdouble>(m.margin), nullptr);
+	if (pose) {
+		addDoubleArray(ms, "rvec", pose->rvec.data(), 3);
+		addDoubleArray(ms, "tvec", pose->tvec.data(), 3);
+		gst_structure_set(ms, "reprojection-error", G_TYPE_DOUBLE, pose->reprojectionError,
+				  "alternative-reprojection-error", G_TYPE_DOUBLE, pose->alternativeError, nullptr);
+	}
+	return ms;
+}
+
+} /* namespace */
+
+void attachMarkerMetas(GstBuffer *buffer, gint width, gint height, const Result &result, const Poses &poses,
+		       const char *dictionary)
+{
+	for (std::size_t i = 0; i < result.markers.size(); ++i) {
+		const Marker &m = result.markers[i];
+		gfloat corners[8];
+		float minX = G_MAXFLOAT, minY = G_MAXFLOAT, maxX = -G_MAXFLOAT, maxY = -G_MAXFLOAT;
+		for (int k = 0; k < 4; ++k) {
+			const auto c = m.corners[static_cast<std::size_t>(k)];
+			corners[2 * k] = c.x;
+			corners[2 * k + 1] = c.y;
+			minX = std::min(minX, c.x);
+			minY = std::min(minY, c.y);
+			maxX = std::max(maxX, c.x);
+			maxY = std::max(maxY, c.y);
+		}
+		GstFrappeMarkerMeta *meta = gst_buffer_add_frappe_marker_meta(buffer, m.id, dictionary, corners,
+									      static_cast<guint>(m.hamming));
+		if (meta)
+			meta->margin = m.margin;
+		if (meta && poses[i]) {
+			meta->has_pose = TRUE;
+			for (int k = 0; k < 3; ++k) {
+				meta->rvec[k] = poses[i]->rvec[static_cast<std::size_t>(k)];
+				meta->tvec[k] = poses[i]->tvec[static_cast<std::size_t>(k)];
+			}
+			meta->reprojection_error = poses[i]->reprojectionError;
+			meta->alternative_reprojection_error = poses[i]->alternativeError;
+		}
+
+		/* The ROI covers the pixels the corners touch, clipped to the frame. */
+		const gint x0 = std::clamp(static_cast<gint>(std::floor(minX + 0.5f)), 0, width - 1);
+		const gint y0 = std::clamp(static_cast<gint>(std::floor(minY + 0.5f)), 0, height - 1);
+		const gint x1 = std::clamp(static_cast<gint>(std::ceil(maxX + 0.5f)), x0 + 1, width);
+		const gint y1 = std::clamp(static_cast<gint>(std::ceil(maxY + 0.5f)), y0 + 1, height);
+		GstVideoRegionOfInterestMeta *roi = gst_buffer_add_video_region_of_interest_meta(
+			buffer, GST_FRAPPE_ROI_TYPE, static_cast<guint>(x0), static_cast<guint>(y0),
+			static_cast<guint>(x1 - x0), static_cast<guint>(y1 - y0));
+		if (roi) {
+			roi->id = static_cast<gint>(i);
+			gst_video_region_of_interest_meta_add_param(
+				roi, gst_structure_new(GST_FRAPPE_ROI_TYPE, "id", G_TYPE_INT, m.id, "dictionary",
+						       G_TYPE_STRING, dictionary, "hamming", G_TYPE_UINT,
+						       static_cast<guint>(m.hamming), "margin", G_TYPE_DOUBLE,
+						       static_cast<gdouble>(m.margin), nullptr));
+		}
+	}
+}
+
+GstStructure *frameMessage(GstBuffer *buffer, const GstSegment &segment, const Result &result,
+			   const Poses &poses, const char *dictionary)
+{
+	GValue list = G_VALUE_INIT;
+	g_value_init(&list, GST_TYPE_LIST);
+	for (std::size_t i = 0; i < result.markers.size(); ++i) {
+		GValue item = G_VALUE_INIT;
+		g_value_init(&item, GST_TYPE_STRUCTURE);
+		g_value_take_boxed(&item, markerStructure(result.markers[i], poses[i], dictionary));
+		gst_value_list_append_and_take_value(&list, &item);
+	}
+
+	const GstClockTime pts = GST_BUFFER_PTS(buffer);
+	GstClockTime running = GST_CLOCK_TIME_NONE, stream = GST_CLOCK_TIME_NONE;
+	if (segment.format == GST_FORMAT_TIME) {
+		running = gst_segment_to_running_time(&segment, GST_FORMAT_TIME, pts);
+		stream = gst_segment_to_stream_time(&segment, GST_FORMAT_TIME, pts);
+	}
+	GstStructure *msg = gst_structure_new("frappedetect", "timestamp", G_TYPE_UINT64, pts, "stream-time",
+					      G_TYPE_UINT64, stream, "running-time", G_TYPE_UINT64, running,
+					      "duration", G_TYPE_UINT64, GST_BUFFER_DURATION(buffer), nullptr);
+	gst_structure_take_value(msg, "markers", &list);
+	return msg;
+}
+
+GstStructure *statsStructure(guint64 frames, const Result &result, double poseMs, const char *backend,
+			     bool pipelined)
+{
+	GstStructure *s = gst_structure_new("frappe-stats", "frames", G_TYPE_UINT64, frames, "markers",
+					    G_TYPE_UINT, static_cast<guint>(result.markers.size()), "candidates",
+					    G_TYPE_INT, result.candidates, "scale", G_TYPE_DOUBLE,
+					    static_cast<double>(result.scale), nullptr);
+	for (int i = 0; i < kStageCount; ++i) {
+		std::string name(stageName(static_cast<Stage>(i)));
+		std::replace(name.begin(), name.end(), '_', '-');
+		name += "-ms";
+		gst_structure_set(s, name.c_str(), G_TYPE_DOUBLE, result.times.ms[static_cast<std::size_t>(i)],
+				  nullptr);
+	}
+	gst_structure_set(s, "pose-ms", G_TYPE_DOUBLE, poseMs, "total-ms", G_TYPE_DOUBLE,
+			  result.times.total_ms + poseMs, "backend", G_TYPE_STRING, backend, "pipelined",
+			  G_TYPE_BOOLEAN, static_cast<gboolean>(pipelined), nullptr);
+	return s;
+}
+
+std::optional<std::string> StatsWindow::add(guint64 frames, const Result &result, double poseMs)
+{
+	times_.total_ms += result.times.total_ms + poseMs;
+	for (std::size_t i = 0; i < result.times.ms.size(); ++i)
+		times_.ms[i] += result.times.ms[i];
+	poseMs_ += poseMs;
+	if (frames % 100 != 0)
+		return std::nullopt;
+
+	std::string line;
+	char part[64];
+	for (int i = 0; i < kStageCount; ++i) {
+		std::snprintf(part, sizeof(part), "%s %.2f, ", std::string(stageName(static_cast<Stage>(i))).c_str(),
+			      times_.ms[static_cast<std::size_t>(i)] / 100.0);
+		line += part;
+	}
+	std::snprintf(part, sizeof(part), "pose %.2f, total %.2f", poseMs_ / 100.0, times_.total_ms / 100.0);
+	line += part;
+	reset();
+	return line;
+}
+
+void StatsWindow::reset()
+{
+	times_ = {};
+	poseMs_ = 0.0;
+}
+
+} /* namespace frappe::gst */

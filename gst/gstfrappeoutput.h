@@ -1,0 +1,53 @@
+/* SPDX-License-Identifier: MIT
+ *
+ * gstfrappeoutput.h: what frappedetect makes of a frame's markers: the
+ * metas on its buffer, the `frappedetect` element message and the `stats`
+ * structure. The element's documentation block describes their fields.
+ */
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <gst/gst.h>
+
+#include <frappe/detector.h>
+
+#include "pose.h"
+
+namespace frappe::gst {
+
+using Poses = std::vector<std::optional<Pose>>;
+
+/* A GstFrappeMarkerMeta and a "fiducial" GstVideoRegionOfInterestMeta per
+ * marker, on a writable buffer of a frame of width x height. */
+void attachMarkerMetas(GstBuffer *buffer, gint width, gint height, const Result &result, const Poses &poses,
+		       const char *dictionary);
+
+/* The `frappedetect` element message's structure; running and stream time
+ * come from `segment` when it is in time. */
+GstStructure *frameMessage(GstBuffer *buffer, const GstSegment &segment, const Result &result,
+			   const Poses &poses, const char *dictionary);
+
+/* The `stats` property's structure for the last frame. */
+GstStructure *statsStructure(guint64 frames, const Result &result, double poseMs, const char *backend,
+			     bool pipelined);
+
+/* Sums of the stage times over 100 frames, for one INFO line per 100
+ * frames: GST_DEBUG=frappedetect:4 shows the speed without any tooling. */
+class StatsWindow
+{
+public:
+	/* Adds frame number `frames` (from 1); at every 100th, returns the
+	 * average ms per frame of each stage, the pose and the total, and
+	 * starts again. */
+	std::optional<std::string> add(guint64 frames, const Result &result, double poseMs);
+	void reset();
+
+private:
+	StageTimes times_;
+	double poseMs_ = 0.0;
+};
+
+} /* namespace frappe::gst */

@@ -1,0 +1,330 @@
+/* SPDX-License-Identifier: MIT
+ *
+ * gstfrappesettings.cpp: frappedetect's properties.
+ */
+#include "gstfrappesettings.h"
+
+#include <algorithm>
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include <frappe/dictionary.h>
+
+GST_DEBUG_CATEGORY_EXTERN(gst_frappe_detect_debug);
+#define GST_CAT_DEFAULT gst_frappe_detect_debug
+
+namespace frappe::gst {
+
+namespace {
+
+/*
+ * The ranges frappe::Config's validation (the Detector constructor)
+ * accepts. The library does not export them; test-gst-settings builds a
+ * Detector at both ends of every range to keep the two in step. A
+ * GParamSpec range is closed, so edge_threshold's (0, 4] starts at 0.001.
+ */
+constexpr gfloat kEdgeThresholdMin = 0.001f, kEdgeThresholdMax = 4.0f;
+constexpr gfloat kCornerThresholdMin = 0.0f, kCornerThresholdMax = 100.0f;
+constexpr gfloat kRegionContrastMin = 0.0f, kRegionContrastMax = 1.0f;
+constexpr gfloat kScaledSizeMin = 8.0f, kScaledSizeMax = 1000.0f;
+constexpr gint kMaxScaledFramesMax = 1000;
+/* The element's own: the pose's marker side in metres. */
+constexpr gdouble kMarkerSizeMax = 1000.0;
+
+/* max_hamming goes up to half the bits of the dictionary: the largest any
+ * built-in dictionary accepts (24 for 7x7). */
+gint maxMaxHamming()
+{
+	gint most = 0;
+	for (const auto &d : frappe::dictionaries())
+		most = std::max(most, d.bits * d.bits / 2);
+	return most;
+}
+
+void setDoubleArray(const GValue *value, std::vector<double> &out)
+{
+	out.clear();
+	const guint n = gst_value_array_get_size(value);
+	for (guint i = 0; i < n; ++i) {
+		const GValue *v = gst_value_array_get_value(value, i);
+		if (G_VALUE_HOLDS_DOUBLE(v))
+			out.push_back(g_value_get_double(v));
+		else if (G_VALUE_HOLDS_FLOAT(v))
+			out.push_back(g_value_get_float(v));
+		else if (G_VALUE_HOLDS_INT(v))
+			out.push_back(g_value_get_int(v));
+	}
+}
+
+void getDoubleArray(GValue *value, const double *v, std::size_t n)
+{
+	for (std::size_t i = 0; i < n; ++i) {
+		GValue item = G_VALUE_INIT;
+		g_value_init(&item, G_TYPE_DOUBLE);
+		g_value_set_double(&item, v[i]);
+		gst_value_array_append_and_take_value(value, &item);
+	}
+}
+
+} /* namespace */
+
+bool Settings::sameDetector(const Settings &o) const
+{
+	return dictionary == o.dictionary && mode == o.mode && edgeThreshold == o.edgeThreshold &&
+	       cornerThreshold == o.cornerThreshold && regionContrast == o.regionContrast &&
+	       maxHamming == o.maxHamming &&
+	       scaledSize == o.scaledSize && maxScaledFrames == o.maxScaledFrames &&
+	       backend == o.backend;
+}
+
+frappe::Config Settings::config() const
+{
+	frappe::Config config;
+	const auto dicts = frappe::dictionaries();
+	const auto &dict = dicts[static_cast<std::size_t>(dictionary)];
+	config.dictionary = std::string(dict.name);
+	config.mode = gst_frappe_mode_to_library(mode);
+	config.edge_threshold = edgeThreshold;
+	config.corner_threshold = cornerThreshold;
+	config.region_contrast = regionContrast;
+	config.max_hamming = std::min(maxHamming, dict.bits * dict.bits / 2);
+	config.scaled_size = scaledSize;
+	config.max_scaled_frames = maxScaledFrames;
+	config.threads = 1;
+	return config;
+}
+
+void installProperties(GObjectClass *gobject_class)
+{
+	const Settings defaults;
+	const auto rw = static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS);
+	const auto live = static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS |
+						   GST_PARAM_MUTABLE_PLAYING);
+
+	/**
+	 * GstFrappeDetect:dictionary:
+	 *
+	 * The marker family to look for.
+	 */
+	g_object_class_install_property(
+		gobject_class, PROP_DICTIONARY,
+		g_param_spec_enum("dictionary", "Dictionary", "Marker family to detect", GST_TYPE_FRAPPE_DICTIONARY,
+				  defaults.dictionary, live));
+	g_object_class_install_property(
+		gobject_class, PROP_MODE,
+		g_param_spec_enum("mode", "Mode",
+				  "normal: every frame at full resolution; ascale: scale frames down from the "
+				  "size of the smallest marker of the previous frame (faster on video)",
+				  GST_TYPE_FRAPPE_MODE, defaults.mode, live));
+	g_object_class_install_property(
+		gobject_class, PROP_EDGE_THRESHOLD,
+		g_param_spec_float("edge-threshold", "Edge threshold",
+				   "Sobel gradient magnitude (intensities in [0, 1]) an edge pixel must exceed; "
+				   "lower finds fainter markers but costs more contour tracing",
+				   kEdgeThresholdMin, kEdgeThresholdMax, defaults.edgeThreshold, live));
+	g_object_class_install_property(
+		gobject_class, PROP_CORNER_THRESHOLD,
+		g_param_spec_float("corner-threshold", "Corner threshold",
+				   "Shi-Tomasi minimum eigenvalue that marks an edge pixel as a corner; too high "
+				   "loses low-contrast markers, too low splits corners",
+				   kCornerThresholdMin, kCornerThresholdMax, defaults.cornerThreshold, live));
+	g_object_class_install_property(
+		gobject_class, PROP_REGION_CONTRAST,
+		g_param_spec_float("region-contrast", "Region contrast",
+				   "Contrast (intensities in [0, 1]) around a pixel for the dark-region candidates "
+				   "that find blurred markers; lower finds fainter blurred markers but traces more "
+				   "clutter; 0 turns them off (edge candidates only, faster)",
+				   kRegionContrastMin, kRegionContrastMax, defaults.regionContrast, live));
+	g_object_class_install_property(
+		gobject_class, PROP_MAX_HAMMING,
+		g_param_spec_int("max-hamming", "Max Hamming",
+				 "Most bit errors corrected among cells read clearly (-1 = the dictionary's "
+				 "careful default; clamped to half the bits of the dictionary)",
+				 -1, maxMaxHamming(), defaults.maxHamming, live));
+	g_object_class_install_property(
+		gobject_class, PROP_SCALED_SIZE,
+		g_param_spec_float("scaled-size", "Scaled size",
+				   "ascale: target side in pixels of the smallest marker after scaling",
+				   kScaledSizeMin, kScaledSizeMax, defaults.scaledSize, live));
+	g_object_class_install_property(
+		gobject_class, PROP_MAX_SCALED_FRAMES,
+		g_param_spec_int("max-scaled-frames", "Max scaled frames",
+				 "ascale: at most this many scaled frames in a row before one at full resolution",
+				 0, kMaxScaledFramesMax, defaults.maxScaledFrames, live));
+	g_object_class_install_property(
+		gobject_class, PROP_ANNOTATE,
+		g_param_spec_boolean("annotate", "Annotate",
+				     "Draw outlines, first corners, ids and pose axes into the frame "
+				     "(maps the frame writable)",
+				     defaults.annotate, live));
+	g_object_class_install_property(
+		gobject_class, PROP_POST_MESSAGES,
+		g_param_spec_boolean("post-messages", "Post messages",
+				     "Post a frappedetect element message per frame", defaults.postMessages, live));
+	g_object_class_install_property(
+		gobject_class, PROP_PIPELINED,
+		g_param_spec_boolean("pipelined", "Pipelined",
+				     "Overlap the front end of the next frame with the back end of this one "
+				     "(holds one buffer: one frame of extra latency)",
+				     defaults.pipelined, live));
+	g_object_class_install_property(
+		gobject_class, PROP_BACKEND,
+		g_param_spec_enum("backend", "Backend", "Where the front end runs", GST_TYPE_FRAPPE_BACKEND,
+				  defaults.backend, live));
+	g_object_class_install_property(
+		gobject_class, PROP_MARKER_SIZE,
+		g_param_spec_double("marker-size", "Marker size",
+				    "Side of the markers' black square in metres, for the pose (0 = no pose)",
+				    0.0, kMarkerSizeMax, defaults.markerSize, live));
+	g_object_class_install_property(
+		gobject_class, PROP_CAMERA_MATRIX,
+		gst_param_spec_array("camera-matrix", "Camera matrix",
+				     "Camera intrinsics for the pose, 9 numbers row-major: "
+				     "<fx, 0, cx, 0, fy, cy, 0, 0, 1> (empty = no pose)",
+				     g_param_spec_double("element", "Element", "A matrix element", -G_MAXDOUBLE,
+							 G_MAXDOUBLE, 0.0, rw),
+				     live));
+	g_object_class_install_property(
+		gobject_class, PROP_DISTORTION,
+		gst_param_spec_array("distortion", "Distortion",
+				     "Lens distortion in OpenCV's order <k1, k2, p1, p2[, k3[, k4, k5, k6"
+				     "[, s1, s2, s3, s4[, tx, ty]]]]> (empty = none)",
+				     g_param_spec_double("coefficient", "Coefficient", "A distortion coefficient",
+							 -G_MAXDOUBLE, G_MAXDOUBLE, 0.0, rw),
+				     live));
+	g_object_class_install_property(
+		gobject_class, PROP_STATS,
+		g_param_spec_boxed("stats", "Statistics",
+				   "Per-stage timings (ms) and counts of the last frame", GST_TYPE_STRUCTURE,
+				   static_cast<GParamFlags>(G_PARAM_READABLE | G_PARAM_STATIC_STRINGS)));
+}
+
+bool setProperty(GObject *self, Settings &p, guint propId, const GValue *value)
+{
+	switch (propId) {
+	case PROP_DICTIONARY:
+		p.dictionary = g_value_get_enum(value);
+		break;
+	case PROP_MODE:
+		p.mode = static_cast<GstFrappeMode>(g_value_get_enum(value));
+		break;
+	case PROP_EDGE_THRESHOLD:
+		p.edgeThreshold = g_value_get_float(value);
+		break;
+	case PROP_CORNER_THRESHOLD:
+		p.cornerThreshold = g_value_get_float(value);
+		break;
+	case PROP_REGION_CONTRAST:
+		p.regionContrast = g_value_get_float(value);
+		break;
+	case PROP_MAX_HAMMING:
+		p.maxHamming = g_value_get_int(value);
+		break;
+	case PROP_SCALED_SIZE:
+		p.scaledSize = g_value_get_float(value);
+		break;
+	case PROP_MAX_SCALED_FRAMES:
+		p.maxScaledFrames = g_value_get_int(value);
+		break;
+	case PROP_ANNOTATE:
+		p.annotate = g_value_get_boolean(value);
+		break;
+	case PROP_POST_MESSAGES:
+		p.postMessages = g_value_get_boolean(value);
+		break;
+	case PROP_PIPELINED:
+		p.pipelined = g_value_get_boolean(value);
+		break;
+	case PROP_BACKEND:
+		p.backend = static_cast<GstFrappeBackend>(g_value_get_enum(value));
+		break;
+	case PROP_MARKER_SIZE:
+		p.markerSize = g_value_get_double(value);
+		break;
+	case PROP_CAMERA_MATRIX: {
+		std::vector<double> m;
+		setDoubleArray(value, m);
+		if (m.empty()) {
+			p.camera.matrix = {};
+		} else if (m.size() == 9) {
+			std::copy(m.begin(), m.end(), p.camera.matrix.begin());
+		} else {
+			GST_WARNING_OBJECT(self, "camera-matrix needs 9 numbers (row-major 3x3), got %zu; ignored",
+					   m.size());
+		}
+		break;
+	}
+	case PROP_DISTORTION: {
+		std::vector<double> d;
+		setDoubleArray(value, d);
+		const std::size_t n = d.size();
+		if (n == 0 || n == 4 || n == 5 || n == 8 || n == 12 || n == 14)
+			p.camera.distortion = d;
+		else
+			GST_WARNING_OBJECT(self, "distortion needs 4, 5, 8, 12 or 14 coefficients, got %zu; ignored",
+					   n);
+		break;
+	}
+	default:
+		return false;
+	}
+	return true;
+}
+
+bool getProperty(const Settings &p, guint propId, GValue *value)
+{
+	switch (propId) {
+	case PROP_DICTIONARY:
+		g_value_set_enum(value, p.dictionary);
+		break;
+	case PROP_MODE:
+		g_value_set_enum(value, p.mode);
+		break;
+	case PROP_EDGE_THRESHOLD:
+		g_value_set_float(value, p.edgeThreshold);
+		break;
+	case PROP_CORNER_THRESHOLD:
+		g_value_set_float(value, p.cornerThreshold);
+		break;
+	case PROP_REGION_CONTRAST:
+		g_value_set_float(value, p.regionContrast);
+		break;
+	case PROP_MAX_HAMMING:
+		g_value_set_int(value, p.maxHamming);
+		break;
+	case PROP_SCALED_SIZE:
+		g_value_set_float(value, p.scaledSize);
+		break;
+	case PROP_MAX_SCALED_FRAMES:
+		g_value_set_int(value, p.maxScaledFrames);
+		break;
+	case PROP_ANNOTATE:
+		g_value_set_boolean(value, p.annotate);
+		break;
+	case PROP_POST_MESSAGES:
+		g_value_set_boolean(value, p.postMessages);
+		break;
+	case PROP_PIPELINED:
+		g_value_set_boolean(value, p.pipelined);
+		break;
+	case PROP_BACKEND:
+		g_value_set_enum(value, p.backend);
+		break;
+	case PROP_MARKER_SIZE:
+		g_value_set_double(value, p.markerSize);
+		break;
+	case PROP_CAMERA_MATRIX:
+		if (p.camera.valid())
+			getDoubleArray(value, p.camera.matrix.data(), 9);
+		break;
+	case PROP_DISTORTION:
+		getDoubleArray(value, p.camera.distortion.data(), p.camera.distortion.size());
+		break;
+	default:
+		return false;
+	}
+	return true;
+}
+
+} /* namespace frappe::gst */

@@ -1,0 +1,161 @@
+// SPDX-License-Identifier: MIT
+// frappedetect: a back end that fails is an element error and a flow error,
+// pipelined or not; no buffer leaves without its markers.
+//
+// The failure is injected without a hook in the element: this program
+// defines frappe::Detector::runBackEnd itself and exports it, so the
+// plugin's calls reach this definition first (ELF interposition), which
+// throws from the call numbered failFrom on and otherwise calls the
+// library's. Where
+// interposition does not happen (a static libfrappe-core) the tests skip.
+#include <atomic>
+#include <climits>
+#include <stdexcept>
+#include <string>
+
+#include <dlfcn.h>
+
+#include <gst/check/gstharness.h>
+#include <gst/gst.h>
+#include <gtest/gtest.h>
+
+#include <frappe/detector.h>
+
+#include "helpers.h"
+
+using namespace frappe::gsttest;
+
+static auto *const gstEnv = ::testing::AddGlobalTestEnvironment(new GstEnvironment);
+
+namespace {
+
+/* Calls are numbered from 0; the pipelined back end runs on a worker
+ * thread, so the tests name the call that fails, not the moment. */
+std::atomic<int> backEndCalls{ 0 };
+std::atomic<int> failFrom{ INT_MAX };
+
+using RunBackEnd = const frappe::Result &(*)(frappe::Detector *, const frappe::ImageView &, int);
+
+RunBackEnd libraryRunBackEnd()
+{
+	static const auto fn = reinterpret_cast<RunBackEnd>(
+		dlsym(RTLD_NEXT, "_ZN6frappe8Detector10runBackEndERKNS_9ImageViewEi"));
+	return fn;
+}
+
+} // namespace
+
+const frappe::Result &frappe::Detector::runBackEnd(const ImageView &image, int slot)
+{
+	if (backEndCalls++ >= failFrom)
+		throw std::runtime_error("injected back-end failure");
+	return libraryRunBackEnd()(this, image, slot);
+}
+
+namespace {
+
+const FrameSpec kSpec;
+
+GstBuffer *frame(int i)
+{
+	return makeFrame(kSpec, { square(i, 100.0f, 80.0f, 150.0f) }, dict("aruco_mip_36h12"),
+			 static_cast<GstClockTime>(i) * (GST_SECOND / 30));
+}
+
+/* The one ERROR message on the bus says detection failed and why. */
+void expectDetectionError(GstBus *bus)
+{
+	GstMessage *msg = gst_bus_pop_filtered(bus, GST_MESSAGE_ERROR);
+	ASSERT_NE(msg, nullptr) << "no element error";
+	GError *err = nullptr;
+	gchar *debug = nullptr;
+	gst_message_parse_error(msg, &err, &debug);
+	EXPECT_TRUE(g_error_matches(err, GST_STREAM_ERROR, GST_STREAM_ERROR_FAILED)) << err->message;
+	EXPECT_EQ(std::string(err->message), "Marker detection failed");
+	EXPECT_NE(std::string(debug ? debug : "").find("injected back-end failure"), std::string::npos);
+	g_error_free(err);
+	g_free(debug);
+	gst_message_unref(msg);
+	EXPECT_EQ(gst_bus_pop_filtered(bus, GST_MESSAGE_ERROR), nullptr);
+}
+
+struct Harness {
+	explicit Harness(const char *launch)
+		: h(gst_harness_new_parse(launch)), bus(gst_bus_new())
+	{
+		gst_harness_set_src_caps_str(h, capsString(kSpec).c_str());
+		gst_element_set_bus(h->element, bus);
+	}
+	~Harness()
+	{
+		failFrom = INT_MAX;
+		gst_object_unref(bus);
+		gst_harness_teardown(h);
+	}
+	GstHarness *h;
+	GstBus *bus;
+};
+
+/* Whether the plugin's back end calls come here. */
+bool interposed()
+{
+	if (!libraryRunBackEnd())
+		return false;
+	Harness t("frappedetect");
+	const int before = backEndCalls;
+	if (gst_harness_push(t.h, frame(0)) != GST_FLOW_OK)
+		return false;
+	gst_buffer_unref(gst_harness_pull(t.h));
+	return backEndCalls > before;
+}
+
+} // namespace
+
+TEST(Errors, BackEndFailureIsAnErrorUnpipelined)
+{
+	if (!interposed())
+		GTEST_SKIP() << "frappe::Detector::runBackEnd cannot be interposed in this build";
+	Harness t("frappedetect");
+	failFrom = backEndCalls + 1;
+	ASSERT_EQ(gst_harness_push(t.h, frame(0)), GST_FLOW_OK);
+	EXPECT_EQ(gst_harness_push(t.h, frame(1)), GST_FLOW_ERROR);
+	expectDetectionError(t.bus);
+	/* Frame 0 came out with its marker; frame 1 did not come out. */
+	GstBuffer *out = gst_harness_try_pull(t.h);
+	ASSERT_NE(out, nullptr);
+	EXPECT_EQ(markerMetas(out).size(), 1u);
+	gst_buffer_unref(out);
+	EXPECT_EQ(gst_harness_try_pull(t.h), nullptr);
+}
+
+TEST(Errors, BackEndFailureIsAnErrorPipelined)
+{
+	if (!interposed())
+		GTEST_SKIP() << "frappe::Detector::runBackEnd cannot be interposed in this build";
+	Harness t("frappedetect pipelined=true");
+	failFrom = backEndCalls + 1;
+	ASSERT_EQ(gst_harness_push(t.h, frame(0)), GST_FLOW_OK);
+	/* Frame 0 comes out now; frame 1's back end runs on the worker and
+	 * fails; frame 2 finishes frame 1 and gets the error. */
+	ASSERT_EQ(gst_harness_push(t.h, frame(1)), GST_FLOW_OK);
+	EXPECT_EQ(gst_harness_push(t.h, frame(2)), GST_FLOW_ERROR);
+	expectDetectionError(t.bus);
+	GstBuffer *out = gst_harness_try_pull(t.h);
+	ASSERT_NE(out, nullptr);
+	EXPECT_EQ(GST_BUFFER_PTS(out), 0u);
+	EXPECT_EQ(markerMetas(out).size(), 1u);
+	gst_buffer_unref(out);
+	EXPECT_EQ(gst_harness_try_pull(t.h), nullptr) << "a buffer left without its markers";
+}
+
+TEST(Errors, BackEndFailureOfTheHeldBufferAtEosIsAnError)
+{
+	if (!interposed())
+		GTEST_SKIP() << "frappe::Detector::runBackEnd cannot be interposed in this build";
+	Harness t("frappedetect pipelined=true");
+	failFrom = backEndCalls.load();
+	ASSERT_EQ(gst_harness_push(t.h, frame(0)), GST_FLOW_OK);
+	gst_harness_push_event(t.h, gst_event_new_eos());
+	expectDetectionError(t.bus);
+	EXPECT_EQ(gst_harness_try_pull(t.h), nullptr) << "a buffer left without its markers";
+}
