@@ -100,7 +100,7 @@
 #include <frappe/frappe.h>
 
 #include "annotate.h"
-#include "frappebackend.h"
+#include "frappe_backend.h"
 #include "gstfrappeenums.h"
 #include "gstfrappeoutput.h"
 #include "gstfrappesettings.h"

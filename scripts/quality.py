@@ -72,7 +72,7 @@ def main():
     ap.add_argument('--keep', help='keep the detections (JSONL) in this folder')
     a = ap.parse_args()
 
-    detect = os.path.join(a.build, 'frappe-core', 'cli', 'frappe-detect')
+    detect = os.path.join(a.build, 'tools', 'frappe-detect')
     sweep = os.path.join(a.build, 'tests', 'frappe-sweep')
     bench = os.path.join(a.build, 'tests', 'bench', 'frappe-bench')
     for exe in (detect, sweep, bench):

@@ -18,9 +18,7 @@
 
 #include "annotate.h"
 #include "frappe/frappe.h"
-#ifdef FRAPPE_HAVE_VC4
-#include "frontend/backend.hpp"
-#endif
+#include "frappe_backend.h"
 
 namespace {
 
@@ -241,24 +239,17 @@ int main(int argc, char **argv)
 	std::unique_ptr<Detector> detector;
 	try {
 		detector = std::make_unique<Detector>(opt.config);
-		if (opt.backend != "cpu") {
-#ifdef FRAPPE_HAVE_VC4
-			frappe::vc4::BackendChoice choice;
-			try {
-				choice = frappe::vc4::selectFrontEnd(opt.backend, opt.config.threads);
-			} catch (const std::exception &e) {
-				throw std::runtime_error("backend " + opt.backend + " cannot be used: " + e.what());
-			}
-			if (!choice.fallback.empty())
-				std::cerr << "frappe-detect: the QPUs cannot be used (" << choice.fallback
-					  << "); using the CPU front end\n";
-			detector->setFrontEnd(std::move(choice.frontEnd));
-			detector->setWarper(std::move(choice.warper));
-#else
-			if (opt.backend != "auto")
-				throw std::runtime_error("backend " + opt.backend + " needs the vc4 part, which this build lacks");
-#endif
+		std::string fallback;
+		try {
+			fallback = frappe::selectBackend(*detector, opt.backend, opt.config.threads);
+		} catch (const frappe::BackendNotBuilt &) {
+			throw std::runtime_error("backend " + opt.backend + " needs the vc4 part, which this build lacks");
+		} catch (const std::exception &e) {
+			throw std::runtime_error("backend " + opt.backend + " cannot be used: " + e.what());
 		}
+		if (!fallback.empty())
+			std::cerr << "frappe-detect: the QPUs cannot be used (" << fallback
+				  << "); using the CPU front end\n";
 	} catch (const std::exception &e) {
 		std::cerr << "frappe-detect: " << e.what() << "\n";
 		return 2;

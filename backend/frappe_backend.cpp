@@ -1,8 +1,8 @@
 /* SPDX-License-Identifier: MIT
  *
- * frappebackend.cpp: the front end a user names put into a detector.
+ * frappe_backend.cpp: the front end a user names put into a detector.
  */
-#include "frappebackend.h"
+#include "frappe_backend.h"
 
 #include <utility>
 

@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT
  *
- * frappebackend.h: the front end a user names (the element's backend
+ * frappe_backend.h: the front end a user names (the element's backend
  * property, the CLI's --backend) put into a detector. No GStreamer types,
  * so that any program can call it.
  */
