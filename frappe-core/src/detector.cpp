@@ -15,6 +15,8 @@
 #include "corner_refine.h"
 #include "decode.h"
 #include "front_end_rows.h"
+#include "marker_set.h"
+#include "quad_geometry.h"
 #include "region_map.h"
 #include "verify.h"
 
@@ -28,6 +30,12 @@ double msSince(Clock::time_point t0)
 {
 	return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
 }
+
+using detail::bigEnough;
+using detail::cellSide;
+using detail::quadArea;
+using detail::sidesAtLeast;
+using detail::toFullResolution;
 
 void validate(const Config &c, const Dictionary &d)
 {
@@ -55,73 +63,6 @@ void validate(const Config &c, const Dictionary &d)
 		fail("threads must be in [0, 256], got " + std::to_string(c.threads));
 }
 
-
-/* The square of the shortest of a quad's four sides. */
-float shortestSide2(const std::array<Point2f, 4> &q)
-{
-	float side2 = INFINITY;
-	for (int i = 0; i < 4; ++i) {
-		const float dx = q[i].x - q[(i + 1) & 3].x, dy = q[i].y - q[(i + 1) & 3].y;
-		side2 = std::min(side2, dx * dx + dy * dy);
-	}
-	return side2;
-}
-
-bool sidesAtLeast(const std::array<Point2f, 4> &q, float side)
-{
-	return shortestSide2(q) >= side * side;
-}
-
-/* Large enough to read: sides of minSide on average, none under 0.6 of it
- * (a marker tilted 65 degrees is read across its foreshortened sides). */
-bool bigEnough(const std::array<Point2f, 4> &q, float minSide)
-{
-	float sum = 0.0f;
-	for (int i = 0; i < 4; ++i) {
-		const float dx = q[i].x - q[(i + 1) & 3].x, dy = q[i].y - q[(i + 1) & 3].y;
-		const float side = std::sqrt(dx * dx + dy * dy);
-		if (side < 0.6f * minSide)
-			return false;
-		sum += side;
-	}
-	return sum >= 4.0f * minSide;
-}
-
-float quadArea(const std::array<Point2f, 4> &q)
-{
-	float twice = 0.0f;
-	for (int i = 0; i < 4; ++i)
-		twice += q[i].x * q[(i + 1) & 3].y - q[(i + 1) & 3].x * q[i].y;
-	return 0.5f * std::abs(twice);
-}
-
-Point2f quadCentre(const std::array<Point2f, 4> &q)
-{
-	return { 0.25f * (q[0].x + q[1].x + q[2].x + q[3].x), 0.25f * (q[0].y + q[1].y + q[2].y + q[3].y) };
-}
-
-/* A candidate around an already decoded marker, of about its size: the
- * outline of its quiet zone, which would decode to the same marker again.
- * Not one whose traced frame read dark (probeRead, when the probe saw it):
- * that is a marker's own border, around what decoded inside it. */
-bool surroundsDecoded(const std::array<Point2f, 4> &q, float area, int probeRead, int bits,
-		      const std::vector<Marker> &found)
-{
-	if (probeRead >= 0 && probeRead <= detail::allowedBorderErrors(bits))
-		return false;
-	const Point2f c = quadCentre(q);
-	for (const Marker &m : found) {
-		const float am = quadArea(m.corners);
-		if (area > 3.0f * am || 3.0f * area < am)
-			continue;
-		const Point2f cm = quadCentre(m.corners);
-		const float dx = c.x - cm.x, dy = c.y - cm.y;
-		if (dx * dx + dy * dy < 0.12f * am)
-			return true;
-	}
-	return false;
-}
-
 /* Cells under 4 px along some side of the quad: there warpMarker's
  * samples, a quarter cell from the cell's edges, lie within a pixel of the
  * neighbouring cells, and blur of a pixel mixes them in. */
@@ -141,12 +82,6 @@ bool smallCells(const std::array<Point2f, 4> &q, int bits)
 constexpr float kReadCell = 6.0f;
 constexpr int kMaxReadBlock = 8;
 
-/* A quad's cell size, along its shortest side. */
-float cellSide(const std::array<Point2f, 4> &q, int bits)
-{
-	return std::sqrt(shortestSide2(q)) / static_cast<float>(bits + 2);
-}
-
 /* The block (1: the frame itself) a candidate with cells of `cell` pixels
  * is read at. */
 int readBlock(float cell)
@@ -155,13 +90,6 @@ int readBlock(float cell)
 	while (2 * f <= kMaxReadBlock && cell >= static_cast<float>(2 * f) * kReadCell)
 		f *= 2;
 	return f;
-}
-
-/* A point of the traced (possibly scaled) frame in full-resolution pixels;
- * pixel centres are at integers in both. */
-Point2f toFullResolution(Point2f p, float scale)
-{
-	return { (p.x + 0.5f) / scale - 0.5f, (p.y + 0.5f) / scale - 0.5f };
 }
 
 /* Reads a traced quad as a marker, so that the tracer can skip the
@@ -193,8 +121,7 @@ public:
 		 * inside the quad (markers on a dark panel, say), and with a small
 		 * dictionary and a generous max_hamming a third of all bit patterns
 		 * are within reach of some codeword. */
-		return b.contrast >= 10.0f && b.border_errors <= detail::allowedBorderErrors(dict_.bits) &&
-		       codes_.decode(b.code, 0).id >= 0;
+		return detail::readable(b, dict_.bits) && codes_.decode(b.code, 0).id >= 0;
 	}
 
 private:
@@ -343,7 +270,7 @@ void Detector::Impl::trace(Slot &slot)
 		const float toEdges = scale / regions.scale;
 		for (detail::Quad q : regionQuads) {
 			for (Point2f &p : q.corners)
-				p = { (p.x + 0.5f) * toEdges - 0.5f, (p.y + 0.5f) * toEdges - 0.5f };
+				p = detail::toScaled(p, toEdges);
 			q.fromRegion = true;
 			quads.push_back(q);
 		}
@@ -529,7 +456,7 @@ void Detector::Impl::finish(const ImageView &image, Slot &slot)
 		detail::Quad &q = slot.quads[k];
 		t = Clock::now();
 		const std::array<Point2f, 4> tracedOutline = batched ? batch.outlines[k] : q.corners;
-		if (surroundsDecoded(tracedOutline, quadArea(tracedOutline), q.probeRead, bits, res.markers)) {
+		if (detail::surroundsMarker(tracedOutline, quadArea(tracedOutline), q.probeRead, bits, res.markers)) {
 			refineMs += msSince(t);
 			continue;
 		}
@@ -620,7 +547,7 @@ void Detector::Impl::finish(const ImageView &image, Slot &slot)
 			}
 			decodeMs += msSince(t);
 		} else if (readable) {
-			if (b.contrast >= 10.0f && b.border_errors <= borderAllowance)
+			if (detail::readable(b, bits))
 				read = detail::readMarker(img, q.corners, *codes, policy, *samples, b);
 			decodeMs += msSince(t);
 			if (!read.ok() && refined && b.border_errors < whiteFrame) {
@@ -629,7 +556,7 @@ void Detector::Impl::finish(const ImageView &image, Slot &slot)
 				t = Clock::now();
 				if (detail::warpMarker(img, outline, bits, warped)) {
 					const detail::Binarised bt = detail::binarise(warped, bits);
-					if (bt.contrast >= 10.0f && bt.border_errors <= borderAllowance) {
+					if (detail::readable(bt, bits)) {
 						read = detail::readMarker(img, outline, *codes, policy, warped, bt);
 						if (read.ok())
 							q.corners = outline;
@@ -662,25 +589,7 @@ void Detector::Impl::finish(const ImageView &image, Slot &slot)
 		m.margin = read.margin;
 		for (int i = 0; i < 4; ++i)
 			m.corners[i] = q.corners[(i + d.rotation) & 3];
-
-		/* The same marker reached twice (e.g. through two nested borders):
-		 * keep the better decode. */
-		bool duplicate = false;
-		for (Marker &other : res.markers) {
-			if (other.id != m.id)
-				continue;
-			const float dx = other.corners[0].x - m.corners[0].x;
-			const float dy = other.corners[0].y - m.corners[0].y;
-			const float sx = m.corners[1].x - m.corners[0].x, sy = m.corners[1].y - m.corners[0].y;
-			if (dx * dx + dy * dy < 0.25f * (sx * sx + sy * sy)) {
-				duplicate = true;
-				if (m.hamming < other.hamming)
-					other = m;
-				break;
-			}
-		}
-		if (!duplicate)
-			res.markers.push_back(m);
+		detail::keepMarker(res.markers, m);
 	}
 	/* Smallest first, a block of a marker's code cells decoded before the
 	 * marker around it did: now that both are known, drop it. */
