@@ -2,7 +2,6 @@
 // The Detector: runs the stages of Algorithm 1 in order and times each.
 #include "frappe/detector.h"
 
-#include <chrono>
 #include <algorithm>
 #include <cmath>
 #include <mutex>
@@ -18,23 +17,18 @@
 #include "marker_set.h"
 #include "quad_geometry.h"
 #include "region_map.h"
+#include "stage_timer.h"
 #include "verify.h"
 
 namespace frappe {
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
-double msSince(Clock::time_point t0)
-{
-	return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
-
 using detail::bigEnough;
 using detail::cellSide;
 using detail::quadArea;
 using detail::sidesAtLeast;
+using detail::StageTimer;
 using detail::toFullResolution;
 
 void validate(const Config &c, const Dictionary &d)
@@ -215,7 +209,7 @@ struct Detector::Impl {
 	void trace(Slot &slot);
 	void finish(const ImageView &image, Slot &slot);
 	bool refineQuad(const ImageView &image, const Slot &slot, detail::Quad &q, float search, int block) const;
-	void refineAndWarpAll(const ImageView &image, Slot &slot, float search, double &refineMs, double &warpMs);
+	void refineAndWarpAll(const ImageView &image, Slot &slot, float search);
 	Slot &slotAt(int slot)
 	{
 		return const_cast<Slot &>(static_cast<const Impl *>(this)->slotAt(slot));
@@ -248,7 +242,8 @@ void Detector::Impl::trace(Slot &slot)
 	const EdgeMap &edges = slot.edges;
 	const float scale = edges.scale;
 	std::vector<detail::Quad> &quads = slot.quads;
-	const auto t = Clock::now();
+	slot.result.times[Stage::Trace] = 0.0;
+	StageTimer timer(slot.result.times, Stage::Trace);
 	detail::TraceParams tp;
 	tp.cluster_radius = config.corner_cluster_radius;
 	tp.min_side = std::max(4.0f, config.min_marker_side * scale);
@@ -281,7 +276,6 @@ void Detector::Impl::trace(Slot &slot)
 	std::sort(quads.begin(), quads.end(), [](const detail::Quad &a, const detail::Quad &b) {
 		return quadArea(a.corners) < quadArea(b.corners);
 	});
-	slot.result.times[Stage::Trace] = msSince(t);
 }
 
 /* Refines a candidate's corners in place. A region outline lies up to a
@@ -373,15 +367,14 @@ Detector::Impl::BlockView Detector::Impl::blockView(const ImageView &image, int 
 }
 
 /* Batch mode: every candidate refined, then all warped in one call. */
-void Detector::Impl::refineAndWarpAll(const ImageView &image, Slot &slot, float search, double &refineMs,
-				      double &warpMs)
+void Detector::Impl::refineAndWarpAll(const ImageView &image, Slot &slot, float search)
 {
 	const std::size_t n = slot.quads.size();
 	batch.outlines.resize(n);
 	batch.refined.resize(n);
 	batch.place.resize(n);
 	batch.quads.clear();
-	auto t = Clock::now();
+	StageTimer timer(slot.result.times, Stage::Refine);
 	for (std::size_t k = 0; k < n; ++k) {
 		std::array<Point2f, 4> &corners = slot.quads[k].corners;
 		batch.outlines[k] = corners;
@@ -395,14 +388,12 @@ void Detector::Impl::refineAndWarpAll(const ImageView &image, Slot &slot, float 
 			batch.quads.push_back(corners);
 		}
 	}
-	refineMs += msSince(t);
-	t = Clock::now();
+	timer.lap(Stage::Warp);
 	const std::size_t m = batch.quads.size();
 	batch.warpedOk.assign(m, 0);
 	batch.samples.resize(std::max(batch.samples.size(), m));
 	warper->warp(image, batch.quads, (dict->bits + 2) * detail::kSamplesPerCell,
 		     std::span(batch.samples).first(m), batch.warpedOk);
-	warpMs += msSince(t);
 }
 
 void Detector::Impl::finish(const ImageView &image, Slot &slot)
@@ -411,7 +402,7 @@ void Detector::Impl::finish(const ImageView &image, Slot &slot)
 	const float scale = slot.edges.scale;
 	res.markers.clear();
 	res.candidates = 0;
-	auto t = Clock::now();
+	res.times[Stage::Refine] = res.times[Stage::Warp] = res.times[Stage::Decode] = 0.0;
 	++finishedFrames; /* halved frames made before are stale */
 	blockPatchRead = 0;
 
@@ -444,27 +435,24 @@ void Detector::Impl::finish(const ImageView &image, Slot &slot)
 			return (traced > mixedFrame && traced < whiteFrame) || q.probeContrast < flatRegion;
 		return traced > mixedFrame && traced < whiteFrame && sidesAtLeast(outline, sureSide);
 	};
-	double refineMs = 0, warpMs = 0, decodeMs = 0;
-	for (detail::Quad &q : slot.quads)
-		for (Point2f &p : q.corners)
-			p = toFullResolution(p, scale);
-	refineMs += msSince(t);
+	{
+		StageTimer timer(res.times, Stage::Refine);
+		for (detail::Quad &q : slot.quads)
+			for (Point2f &p : q.corners)
+				p = toFullResolution(p, scale);
+	}
 	const bool batched = warper != nullptr;
 	if (batched)
-		refineAndWarpAll(image, slot, search, refineMs, warpMs);
+		refineAndWarpAll(image, slot, search);
 	for (std::size_t k = 0; k < slot.quads.size(); ++k) {
 		detail::Quad &q = slot.quads[k];
-		t = Clock::now();
+		StageTimer timer(res.times, Stage::Refine);
 		const std::array<Point2f, 4> tracedOutline = batched ? batch.outlines[k] : q.corners;
-		if (detail::surroundsMarker(tracedOutline, quadArea(tracedOutline), q.probeRead, bits, res.markers)) {
-			refineMs += msSince(t);
+		if (detail::surroundsMarker(tracedOutline, quadArea(tracedOutline), q.probeRead, bits, res.markers))
 			continue;
-		}
 		const int traced = q.probeRead;
-		if (isClutter(q, tracedOutline)) {
-			refineMs += msSince(t);
+		if (isClutter(q, tracedOutline))
 			continue;
-		}
 		/* Large cells are read on the frame halved f times, in its pixels
 		 * (readBlock()), with at least the frame's search: blur spreads a
 		 * large marker's edges over as many of them as a small one's over
@@ -494,12 +482,11 @@ void Detector::Impl::finish(const ImageView &image, Slot &slot)
 		bool refined = inBatch ? batch.refined[k] != 0
 				       : traced < whiteFrame &&
 						 refineQuad(img, slot, q, std::max(search / ff, kSearch), f);
-		refineMs += msSince(t);
 		detail::Binarised b;
 		const detail::WarpedMarker *samples = &warped;
 		if (refined && bigEnough(q.corners, minSide)) {
 			++res.candidates;
-			t = Clock::now();
+			timer.lap(Stage::Warp);
 			if (inBatch) {
 				const int j = batch.place[k];
 				refined = batch.warpedOk[static_cast<std::size_t>(j)] != 0;
@@ -507,11 +494,9 @@ void Detector::Impl::finish(const ImageView &image, Slot &slot)
 			} else {
 				refined = detail::warpMarker(img, q.corners, bits, warped);
 			}
-			warpMs += msSince(t);
-			t = Clock::now();
+			timer.lap(Stage::Decode);
 			if (refined)
 				b = detail::binarise(*samples, bits);
-			decodeMs += msSince(t);
 		}
 		bool readable = true;
 		if (!refined || b.border_errors >= whiteFrame) {
@@ -519,20 +504,18 @@ void Detector::Impl::finish(const ImageView &image, Slot &slot)
 			 * the outline of the quiet zone (the marker's own outline merged
 			 * with its code's edges, as on small or blurred markers). The
 			 * marker would lie one cell inside. */
-			t = Clock::now();
+			timer.lap(Stage::Refine);
 			q.corners = outline;
 			const bool inset = detail::insetQuad(img, q.corners, bits, warped);
-			refineMs += msSince(t);
 			readable = inset && bigEnough(q.corners, minSide);
 			if (readable) {
 				++res.candidates;
-				t = Clock::now();
+				timer.lap(Stage::Decode);
 				samples = &warped;
 				b = detail::binarise(warped, bits);
-				decodeMs += msSince(t);
 			}
 		}
-		t = Clock::now();
+		timer.lap(Stage::Decode);
 		detail::MarkerRead read;
 		if (readable && smallCells(q.corners, bits)) {
 			/* Quarter-cell samples of small cells lie within a pixel of
@@ -545,15 +528,12 @@ void Detector::Impl::finish(const ImageView &image, Slot &slot)
 				if (read.ok())
 					q.corners = outline;
 			}
-			decodeMs += msSince(t);
 		} else if (readable) {
 			if (detail::readable(b, bits))
 				read = detail::readMarker(img, q.corners, *codes, policy, *samples, b);
-			decodeMs += msSince(t);
 			if (!read.ok() && refined && b.border_errors < whiteFrame) {
 				/* Refinement can pull a blurred marker's sides onto its
 				 * code's edges; the traced outline may still read. */
-				t = Clock::now();
 				if (detail::warpMarker(img, outline, bits, warped)) {
 					const detail::Binarised bt = detail::binarise(warped, bits);
 					if (detail::readable(bt, bits)) {
@@ -562,15 +542,12 @@ void Detector::Impl::finish(const ImageView &image, Slot &slot)
 							q.corners = outline;
 					}
 				}
-				decodeMs += msSince(t);
 			}
 			if (!read.ok()) {
 				/* Blur of about a cell (a blurred marker, or a small one
 				 * upsampled) reaches the quarter-cell samples of cells of
 				 * any size. */
-				t = Clock::now();
 				read = detail::readCellCentres(img, q.corners, *codes, policy, warped);
-				decodeMs += msSince(t);
 			}
 		}
 		if (!read.ok())
@@ -593,12 +570,8 @@ void Detector::Impl::finish(const ImageView &image, Slot &slot)
 	}
 	/* Smallest first, a block of a marker's code cells decoded before the
 	 * marker around it did: now that both are known, drop it. */
-	t = Clock::now();
+	StageTimer timer(res.times, Stage::Decode);
 	detail::dropNestedMarkers(res.markers, bits);
-	decodeMs += msSince(t);
-	res.times[Stage::Refine] = refineMs;
-	res.times[Stage::Warp] = warpMs;
-	res.times[Stage::Decode] = decodeMs;
 }
 
 Detector::Detector(const Config &config) : impl_(std::make_unique<Impl>())
@@ -641,7 +614,8 @@ void Detector::runFrontEnd(const ImageView &image, int slot)
 	Impl &d = *impl_;
 	d.checkImage(image);
 	Impl::Slot &s = d.slotAt(slot);
-	const auto t0 = Clock::now();
+	s.result.times = {};
+	StageTimer timer(s.result.times, Stage::AdaptiveScale);
 	float scale;
 	{
 		std::lock_guard<std::mutex> lock(d.adaptiveLock);
@@ -651,9 +625,7 @@ void Detector::runFrontEnd(const ImageView &image, int slot)
 	if (scaledLength(image.width, scale) < 32 || scaledLength(image.height, scale) < 32)
 		scale = 1.0f;
 	s.image = image;
-	s.result.times = {};
-	s.result.times[Stage::AdaptiveScale] = msSince(t0);
-	const auto t1 = Clock::now();
+	timer.lap(Stage::FrontEnd);
 	d.frontEnd->run(image, scale, d.params, s.edges);
 	if (!d.frontEnd->makesRegionMap()) {
 		/* A front end without a region map (the QPUs, for now): the
@@ -662,7 +634,6 @@ void Detector::runFrontEnd(const ImageView &image, int slot)
 		 * region_contrast is 0. */
 		detail::regionMap(image, 1.0f, d.params.region_contrast, s.edges.regions, d.regionScratch);
 	}
-	s.result.times[Stage::FrontEnd] = msSince(t1);
 	s.result.scale = s.edges.scale;
 }
 
