@@ -14,7 +14,9 @@
 // a candidate's extreme points, box and side coverage) are trace_kernels.cpp,
 // vectorised where Highway is built in; the walk itself is follow().
 #include "contour_trace.h"
+#include "quad_geometry.h"
 #include "rounding.h"
+#include "suppression.h"
 #include "trace_kernels.h"
 
 #include <algorithm>
@@ -190,12 +192,6 @@ float pseudoAngle(float y, float x)
 	if (x >= 0.0f)
 		return p;
 	return std::signbit(y) ? -2.0f - p : 2.0f - p;
-}
-
-float dist2(Point2f a, Point2f b)
-{
-	const float dx = a.x - b.x, dy = a.y - b.y;
-	return dx * dx + dy * dy;
 }
 
 #ifdef FRAPPE_HAVE_ARMV6_TRACE
@@ -579,7 +575,9 @@ bool ContourTracer::spansAtLeast(float span, float maxWinding) const
 }
 
 /* Groups the last border's corner pixels, in the order it met them: a
- * pixel within the cluster radius of a cluster's first member joins it. */
+ * pixel within the cluster radius of a cluster's first member joins it.
+ * Not suppression.h's rule for repeats: the members are averaged into the
+ * corner, not dropped, in integers (the ARMv6 walk's pixels). */
 void ContourTracer::clusterCorners()
 {
 	clusters_.clear();
@@ -948,18 +946,21 @@ bool ContourTracer::acceptQuad(const TraceParams &params, int w, int h, Quad &qu
 void removeDuplicateQuads(std::vector<Quad> &quads, float tolerance)
 {
 	const float tol2 = tolerance * tolerance;
+	/* Every corner within the tolerance of one of the kept quad's, in
+	 * the same order from any start. */
+	auto same = [tol2](const Quad &kept, const Quad &q) {
+		for (int shift = 0; shift < 4; ++shift) {
+			bool all = true;
+			for (int k = 0; k < 4 && all; ++k)
+				all = dist2(q.corners[k], kept.corners[(k + shift) & 3]) <= tol2;
+			if (all)
+				return true;
+		}
+		return false;
+	};
 	std::size_t kept = 0;
 	for (std::size_t i = 0; i < quads.size(); ++i) {
-		bool dup = false;
-		for (std::size_t j = 0; j < kept && !dup; ++j) {
-			for (int shift = 0; shift < 4 && !dup; ++shift) {
-				bool all = true;
-				for (int k = 0; k < 4 && all; ++k)
-					all = dist2(quads[i].corners[k], quads[j].corners[(k + shift) & 3]) <= tol2;
-				dup = all;
-			}
-		}
-		if (!dup)
+		if (!firstRepeated(std::span(quads).first(kept), quads[i], same))
 			quads[kept++] = quads[i];
 	}
 	quads.resize(kept);

@@ -141,7 +141,8 @@ private:
 };
 
 /// Drops quads whose corners all lie within `tolerance` of an earlier quad's
-/// (under some cyclic alignment), keeping the first; in place.
+/// (under some cyclic alignment), keeping the first; in place. The back
+/// end's one suppression rule (firstRepeated(), suppression.h).
 void removeDuplicateQuads(std::vector<Quad> &quads, float tolerance);
 
 } // namespace frappe::detail

@@ -3,7 +3,6 @@
 #include "frappe/detector.h"
 #include "frappe/version.h"
 
-#include <chrono>
 #include <algorithm>
 #include <cmath>
 #include <mutex>
@@ -16,19 +15,22 @@
 #include "corner_refine.h"
 #include "decode.h"
 #include "front_end_rows.h"
+#include "marker_set.h"
+#include "quad_geometry.h"
 #include "region_map.h"
+#include "stage_timer.h"
 #include "verify.h"
 
 namespace frappe {
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
-double msSince(Clock::time_point t0)
-{
-	return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
+using detail::bigEnough;
+using detail::cellSide;
+using detail::quadArea;
+using detail::sidesAtLeast;
+using detail::StageTimer;
+using detail::toFullResolution;
 
 void validate(const Config &c, const Dictionary &d)
 {
@@ -56,73 +58,6 @@ void validate(const Config &c, const Dictionary &d)
 		fail("threads must be in [0, 256], got " + std::to_string(c.threads));
 }
 
-
-/* The square of the shortest of a quad's four sides. */
-float shortestSide2(const std::array<Point2f, 4> &q)
-{
-	float side2 = INFINITY;
-	for (int i = 0; i < 4; ++i) {
-		const float dx = q[i].x - q[(i + 1) & 3].x, dy = q[i].y - q[(i + 1) & 3].y;
-		side2 = std::min(side2, dx * dx + dy * dy);
-	}
-	return side2;
-}
-
-bool sidesAtLeast(const std::array<Point2f, 4> &q, float side)
-{
-	return shortestSide2(q) >= side * side;
-}
-
-/* Large enough to read: sides of minSide on average, none under 0.6 of it
- * (a marker tilted 65 degrees is read across its foreshortened sides). */
-bool bigEnough(const std::array<Point2f, 4> &q, float minSide)
-{
-	float sum = 0.0f;
-	for (int i = 0; i < 4; ++i) {
-		const float dx = q[i].x - q[(i + 1) & 3].x, dy = q[i].y - q[(i + 1) & 3].y;
-		const float side = std::sqrt(dx * dx + dy * dy);
-		if (side < 0.6f * minSide)
-			return false;
-		sum += side;
-	}
-	return sum >= 4.0f * minSide;
-}
-
-float quadArea(const std::array<Point2f, 4> &q)
-{
-	float twice = 0.0f;
-	for (int i = 0; i < 4; ++i)
-		twice += q[i].x * q[(i + 1) & 3].y - q[(i + 1) & 3].x * q[i].y;
-	return 0.5f * std::abs(twice);
-}
-
-Point2f quadCentre(const std::array<Point2f, 4> &q)
-{
-	return { 0.25f * (q[0].x + q[1].x + q[2].x + q[3].x), 0.25f * (q[0].y + q[1].y + q[2].y + q[3].y) };
-}
-
-/* A candidate around an already decoded marker, of about its size: the
- * outline of its quiet zone, which would decode to the same marker again.
- * Not one whose traced frame read dark (probeRead, when the probe saw it):
- * that is a marker's own border, around what decoded inside it. */
-bool surroundsDecoded(const std::array<Point2f, 4> &q, float area, int probeRead, int bits,
-		      const std::vector<Marker> &found)
-{
-	if (probeRead >= 0 && probeRead <= detail::allowedBorderErrors(bits))
-		return false;
-	const Point2f c = quadCentre(q);
-	for (const Marker &m : found) {
-		const float am = quadArea(m.corners);
-		if (area > 3.0f * am || 3.0f * area < am)
-			continue;
-		const Point2f cm = quadCentre(m.corners);
-		const float dx = c.x - cm.x, dy = c.y - cm.y;
-		if (dx * dx + dy * dy < 0.12f * am)
-			return true;
-	}
-	return false;
-}
-
 /* Cells under 4 px along some side of the quad: there warpMarker's
  * samples, a quarter cell from the cell's edges, lie within a pixel of the
  * neighbouring cells, and blur of a pixel mixes them in. */
@@ -142,12 +77,6 @@ bool smallCells(const std::array<Point2f, 4> &q, int bits)
 constexpr float kReadCell = 6.0f;
 constexpr int kMaxReadBlock = 8;
 
-/* A quad's cell size, along its shortest side. */
-float cellSide(const std::array<Point2f, 4> &q, int bits)
-{
-	return std::sqrt(shortestSide2(q)) / static_cast<float>(bits + 2);
-}
-
 /* The block (1: the frame itself) a candidate with cells of `cell` pixels
  * is read at. */
 int readBlock(float cell)
@@ -156,13 +85,6 @@ int readBlock(float cell)
 	while (2 * f <= kMaxReadBlock && cell >= static_cast<float>(2 * f) * kReadCell)
 		f *= 2;
 	return f;
-}
-
-/* A point of the traced (possibly scaled) frame in full-resolution pixels;
- * pixel centres are at integers in both. */
-Point2f toFullResolution(Point2f p, float scale)
-{
-	return { (p.x + 0.5f) / scale - 0.5f, (p.y + 0.5f) / scale - 0.5f };
 }
 
 /* Reads a traced quad as a marker, so that the tracer can skip the
@@ -194,8 +116,7 @@ public:
 		 * inside the quad (markers on a dark panel, say), and with a small
 		 * dictionary and a generous max_hamming a third of all bit patterns
 		 * are within reach of some codeword. */
-		return b.contrast >= 10.0f && b.border_errors <= detail::allowedBorderErrors(dict_.bits) &&
-		       codes_.decode(b.code, 0).id >= 0;
+		return detail::readable(b, dict_.bits) && codes_.decode(b.code, 0).id >= 0;
 	}
 
 private:
@@ -208,6 +129,9 @@ private:
 
 /* The corner refinement window for cells large enough (refineQuad). */
 constexpr detail::RefineWindow kBlurWindow{ 6, 64, true, 2 };
+
+/* The traced outline lies within 2.5 traced pixels of the marker's. */
+constexpr float kSearch = 2.5f;
 
 /* Largest image side accepted: contour coordinates are ints and buffers are
  * sized from width * height. */
@@ -285,11 +209,38 @@ struct FRAPPE_HIDDEN Detector::Impl {
 		std::vector<CandidateSamples> samples;
 	} batch;
 
+	/* One candidate as finish() reads it, on the frame or on the frame
+	 * halved into blocks of f pixels (readBlock()), in that image's
+	 * pixels. */
+	struct Reading {
+		BlockView block;
+		int f = 1;
+		bool inBatch = false;   /* refined and warped by refineAndWarpAll() */
+		float minSide = 0.0f;   /* config.min_marker_side, in block pixels */
+		std::array<Point2f, 4> outline; /* the traced one */
+		bool refined = false;   /* then: and warped */
+		bool readable = true;
+		detail::Binarised b;
+		const detail::WarpedMarker *samples = nullptr;
+	};
+
 	void checkImage(const ImageView &image) const;
 	void trace(Slot &slot);
 	void finish(const ImageView &image, Slot &slot);
 	bool refineQuad(const ImageView &image, const Slot &slot, detail::Quad &q, float search, int block) const;
-	void refineAndWarpAll(const ImageView &image, Slot &slot, float search, double &refineMs, double &warpMs);
+	void refineAndWarpAll(const ImageView &image, Slot &slot, float search);
+	/* Reading one candidate, in finish()'s order. */
+	bool readCandidate(const ImageView &image, Slot &slot, std::size_t k, float search, StageTimer &timer,
+			   Marker &m);
+	bool skipCandidate(const detail::Quad &q, const std::array<Point2f, 4> &tracedOutline,
+			   const std::vector<Marker> &found) const;
+	Reading placeCandidate(const ImageView &image, detail::Quad &q, const std::array<Point2f, 4> &tracedOutline);
+	void sampleRefined(Reading &r, const detail::Quad &q, std::size_t k, Result &res, StageTimer &timer);
+	void readInset(Reading &r, detail::Quad &q, Result &res, StageTimer &timer);
+	detail::MarkerRead decodeCandidate(const Reading &r, detail::Quad &q);
+	/* Border cells that make a white frame: three quarters of the
+	 * 4(n+1). */
+	int whiteFrame() const { return 3 * dict->bits + 3; }
 	Slot &slotAt(int slot)
 	{
 		return const_cast<Slot &>(static_cast<const Impl *>(this)->slotAt(slot));
@@ -322,7 +273,8 @@ void Detector::Impl::trace(Slot &slot)
 	const EdgeMap &edges = slot.edges;
 	const float scale = edges.scale;
 	std::vector<detail::Quad> &quads = slot.quads;
-	const auto t = Clock::now();
+	slot.result.times[Stage::Trace] = 0.0;
+	StageTimer timer(slot.result.times, Stage::Trace);
 	detail::TraceParams tp;
 	tp.cluster_radius = config.corner_cluster_radius;
 	tp.min_side = std::max(4.0f, config.min_marker_side * scale);
@@ -344,7 +296,7 @@ void Detector::Impl::trace(Slot &slot)
 		const float toEdges = scale / regions.scale;
 		for (detail::Quad q : regionQuads) {
 			for (Point2f &p : q.corners)
-				p = { (p.x + 0.5f) * toEdges - 0.5f, (p.y + 0.5f) * toEdges - 0.5f };
+				p = detail::toScaled(p, toEdges);
 			q.fromRegion = true;
 			quads.push_back(q);
 		}
@@ -355,7 +307,6 @@ void Detector::Impl::trace(Slot &slot)
 	std::sort(quads.begin(), quads.end(), [](const detail::Quad &a, const detail::Quad &b) {
 		return quadArea(a.corners) < quadArea(b.corners);
 	});
-	slot.result.times[Stage::Trace] = msSince(t);
 }
 
 /* Refines a candidate's corners in place. A region outline lies up to a
@@ -447,15 +398,14 @@ Detector::Impl::BlockView Detector::Impl::blockView(const ImageView &image, int 
 }
 
 /* Batch mode: every candidate refined, then all warped in one call. */
-void Detector::Impl::refineAndWarpAll(const ImageView &image, Slot &slot, float search, double &refineMs,
-				      double &warpMs)
+void Detector::Impl::refineAndWarpAll(const ImageView &image, Slot &slot, float search)
 {
 	const std::size_t n = slot.quads.size();
 	batch.outlines.resize(n);
 	batch.refined.resize(n);
 	batch.place.resize(n);
 	batch.quads.clear();
-	auto t = Clock::now();
+	StageTimer timer(slot.result.times, Stage::Refine);
 	for (std::size_t k = 0; k < n; ++k) {
 		std::array<Point2f, 4> &corners = slot.quads[k].corners;
 		batch.outlines[k] = corners;
@@ -469,228 +419,226 @@ void Detector::Impl::refineAndWarpAll(const ImageView &image, Slot &slot, float 
 			batch.quads.push_back(corners);
 		}
 	}
-	refineMs += msSince(t);
-	t = Clock::now();
+	timer.lap(Stage::Warp);
 	const std::size_t m = batch.quads.size();
 	batch.warpedOk.assign(m, 0);
 	batch.samples.resize(std::max(batch.samples.size(), m));
 	warper->warp(image, batch.quads, (dict->bits + 2) * detail::kSamplesPerCell,
 		     std::span(batch.samples).first(m), batch.warpedOk);
-	warpMs += msSince(t);
 }
 
-void Detector::Impl::finish(const ImageView &image, Slot &slot)
+/* Candidates not worth refining: the outline of a decoded marker's quiet
+ * zone, and clutter as the probe's read at the traced outline shows it. */
+bool Detector::Impl::skipCandidate(const detail::Quad &q, const std::array<Point2f, 4> &tracedOutline,
+				   const std::vector<Marker> &found) const
 {
-	Result &res = slot.result;
-	const float scale = slot.edges.scale;
-	res.markers.clear();
-	res.candidates = 0;
-	auto t = Clock::now();
-	++finishedFrames; /* halved frames made before are stale */
-	blockPatchRead = 0;
-
-	/* The traced outline lies within 2.5 traced pixels of the marker's. */
-	constexpr float kSearch = 2.5f;
-	const float search = kSearch / scale;
 	const int bits = dict->bits;
-	const int borderAllowance = detail::allowedBorderErrors(bits);
-	const int whiteFrame = 3 * bits + 3; /* three quarters of the 4(n+1) border cells */
+	const int traced = q.probeRead;
+	if (detail::surroundsMarker(tracedOutline, quadArea(tracedOutline), traced, bits, found))
+		return true;
 	/* The probe's read at the traced outline decides two things before
 	 * refinement. A frame with more white cells than twice what decode
 	 * forgives, on a quad of at least 4 px a cell (where the traced outline
 	 * lies well within a cell of the refined one), is clutter: nothing to
-	 * refine. A white frame goes straight to the inset read below, which
-	 * starts from the traced outline anyway.
+	 * refine. A white frame goes straight to the inset read (readInset()),
+	 * which starts from the traced outline anyway.
 	 * A region outline lies inside the marker's, so its frame samples fall
 	 * on the border cells at any size: a mixed frame is clutter there
 	 * whatever the size. So is a region whose samples spread less than the
 	 * contrast that made it a dark region: a patch of dark texture, not a
 	 * code. (Together they drop two thirds of the region quads that used
 	 * to be refined for nothing, at the cost of no marker.) */
-	const int mixedFrame = 2 * borderAllowance;
-	const float sureSide = 4.0f * static_cast<float>(bits + 2);
-	const auto flatRegion = static_cast<float>(params.region_contrast);
-	auto isClutter = [&](const detail::Quad &q, const std::array<Point2f, 4> &outline) {
-		const int traced = q.probeRead;
-		if (traced < 0)
-			return false;
-		if (q.fromRegion)
-			return (traced > mixedFrame && traced < whiteFrame) || q.probeContrast < flatRegion;
-		return traced > mixedFrame && traced < whiteFrame && sidesAtLeast(outline, sureSide);
-	};
-	double refineMs = 0, warpMs = 0, decodeMs = 0;
-	for (detail::Quad &q : slot.quads)
-		for (Point2f &p : q.corners)
-			p = toFullResolution(p, scale);
-	refineMs += msSince(t);
-	const bool batched = warper != nullptr;
-	if (batched)
-		refineAndWarpAll(image, slot, search, refineMs, warpMs);
-	for (std::size_t k = 0; k < slot.quads.size(); ++k) {
-		detail::Quad &q = slot.quads[k];
-		t = Clock::now();
-		const std::array<Point2f, 4> tracedOutline = batched ? batch.outlines[k] : q.corners;
-		if (surroundsDecoded(tracedOutline, quadArea(tracedOutline), q.probeRead, bits, res.markers)) {
-			refineMs += msSince(t);
-			continue;
+	if (traced < 0)
+		return false;
+	const int mixedFrame = 2 * detail::allowedBorderErrors(bits);
+	const bool mixed = traced > mixedFrame && traced < whiteFrame();
+	if (q.fromRegion)
+		return mixed || q.probeContrast < static_cast<float>(params.region_contrast);
+	return mixed && sidesAtLeast(tracedOutline, 4.0f * static_cast<float>(bits + 2));
+}
+
+/* Large cells are read on the frame halved f times, in its pixels
+ * (readBlock()). The patch reaches what refinement reads across a side (its
+ * search and profile: 13 pixels of the halved frame at most) and the reads'
+ * ring a cell outside the border; a white frame is only read inside
+ * (insetQuad()). Leaves q's corners in the block's pixels. */
+Detector::Impl::Reading Detector::Impl::placeCandidate(const ImageView &image, detail::Quad &q,
+							const std::array<Point2f, 4> &tracedOutline)
+{
+	Reading r;
+	const float cellPx = cellSide(tracedOutline, dict->bits);
+	r.f = readBlock(cellPx);
+	r.inBatch = warper != nullptr && r.f == 1;
+	const float ff = static_cast<float>(r.f);
+	r.block = r.f == 1 ? BlockView{ image }
+			   : blockView(image, r.f, tracedOutline,
+				       q.probeRead >= whiteFrame() ? ff : std::max(14.0f * ff, cellPx + 2.0f * ff));
+	r.minSide = config.min_marker_side / ff;
+	r.outline = tracedOutline;
+	if (r.f > 1) {
+		const Point2f origin{ static_cast<float>(r.block.ox), static_cast<float>(r.block.oy) };
+		for (int i = 0; i < 4; ++i) {
+			r.outline[i] = toFullResolution({ r.outline[i].x - origin.x, r.outline[i].y - origin.y }, ff);
+			q.corners[i] = r.outline[i];
 		}
-		const int traced = q.probeRead;
-		if (isClutter(q, tracedOutline)) {
-			refineMs += msSince(t);
-			continue;
+	}
+	return r;
+}
+
+/* Warps and binarises a refined candidate large enough to read. */
+void Detector::Impl::sampleRefined(Reading &r, const detail::Quad &q, std::size_t k, Result &res,
+				   StageTimer &timer)
+{
+	r.samples = &warped;
+	if (!r.refined || !bigEnough(q.corners, r.minSide))
+		return;
+	++res.candidates;
+	timer.lap(Stage::Warp);
+	if (r.inBatch) {
+		const int j = batch.place[k];
+		r.refined = batch.warpedOk[static_cast<std::size_t>(j)] != 0;
+		r.samples = &batch.samples[static_cast<std::size_t>(j)];
+	} else {
+		r.refined = detail::warpMarker(r.block.view, q.corners, dict->bits, warped);
+	}
+	timer.lap(Stage::Decode);
+	if (r.refined)
+		r.b = detail::binarise(*r.samples, dict->bits);
+}
+
+/* No dark frame inside the outline, or a white one: this may be the outline
+ * of the quiet zone (the marker's own outline merged with its code's edges,
+ * as on small or blurred markers). The marker would lie one cell inside. */
+void Detector::Impl::readInset(Reading &r, detail::Quad &q, Result &res, StageTimer &timer)
+{
+	timer.lap(Stage::Refine);
+	q.corners = r.outline;
+	const bool inset = detail::insetQuad(r.block.view, q.corners, dict->bits, warped);
+	r.readable = inset && bigEnough(q.corners, r.minSide);
+	if (!r.readable)
+		return;
+	++res.candidates;
+	timer.lap(Stage::Decode);
+	r.samples = &warped;
+	r.b = detail::binarise(warped, dict->bits);
+}
+
+/* Decodes a sampled candidate, trying what else may read when its samples
+ * do not; on a read at the traced outline, q takes that outline. */
+detail::MarkerRead Detector::Impl::decodeCandidate(const Reading &r, detail::Quad &q)
+{
+	const ImageView &img = r.block.view;
+	const int bits = dict->bits;
+	detail::MarkerRead read;
+	if (!r.readable)
+		return read;
+	if (smallCells(q.corners, bits)) {
+		/* Quarter-cell samples of small cells lie within a pixel of
+		 * their neighbours: read the cells at their centres, at the
+		 * refined corners, else at the traced ones. */
+		if (bigEnough(q.corners, r.minSide))
+			read = detail::readCellCentres(img, q.corners, *codes, policy, warped);
+		if (!read.ok() && r.refined && bigEnough(r.outline, r.minSide)) {
+			read = detail::readCellCentres(img, r.outline, *codes, policy, warped);
+			if (read.ok())
+				q.corners = r.outline;
 		}
-		/* Large cells are read on the frame halved f times, in its pixels
-		 * (readBlock()), with at least the frame's search: blur spreads a
-		 * large marker's edges over as many of them as a small one's over
-		 * the frame's. The patch reaches what refinement reads across a
-		 * side (its search and profile: 13 pixels of the halved frame at
-		 * most) and the reads' ring a cell outside the border; a white
-		 * frame is only read inside (insetQuad()). The corners come back
-		 * to the frame at the end. */
-		const float cellPx = cellSide(tracedOutline, bits);
-		const int f = readBlock(cellPx);
-		const bool inBatch = batched && f == 1;
-		const float ff = static_cast<float>(f);
-		const BlockView block =
-			f == 1 ? BlockView{ image }
-			       : blockView(image, f, tracedOutline,
-					   traced >= whiteFrame ? ff : std::max(14.0f * ff, cellPx + 2.0f * ff));
-		const ImageView &img = block.view;
-		const Point2f origin{ static_cast<float>(block.ox), static_cast<float>(block.oy) };
-		const float minSide = config.min_marker_side / ff;
-		std::array<Point2f, 4> outline = tracedOutline;
-		if (f > 1) {
-			for (int i = 0; i < 4; ++i) {
-				outline[i] = toFullResolution({ outline[i].x - origin.x, outline[i].y - origin.y }, ff);
-				q.corners[i] = outline[i];
-			}
-		}
-		bool refined = inBatch ? batch.refined[k] != 0
-				       : traced < whiteFrame &&
-						 refineQuad(img, slot, q, std::max(search / ff, kSearch), f);
-		refineMs += msSince(t);
-		detail::Binarised b;
-		const detail::WarpedMarker *samples = &warped;
-		if (refined && bigEnough(q.corners, minSide)) {
-			++res.candidates;
-			t = Clock::now();
-			if (inBatch) {
-				const int j = batch.place[k];
-				refined = batch.warpedOk[static_cast<std::size_t>(j)] != 0;
-				samples = &batch.samples[static_cast<std::size_t>(j)];
-			} else {
-				refined = detail::warpMarker(img, q.corners, bits, warped);
-			}
-			warpMs += msSince(t);
-			t = Clock::now();
-			if (refined)
-				b = detail::binarise(*samples, bits);
-			decodeMs += msSince(t);
-		}
-		bool readable = true;
-		if (!refined || b.border_errors >= whiteFrame) {
-			/* No dark frame inside the outline, or a white one: this may be
-			 * the outline of the quiet zone (the marker's own outline merged
-			 * with its code's edges, as on small or blurred markers). The
-			 * marker would lie one cell inside. */
-			t = Clock::now();
-			q.corners = outline;
-			const bool inset = detail::insetQuad(img, q.corners, bits, warped);
-			refineMs += msSince(t);
-			readable = inset && bigEnough(q.corners, minSide);
-			if (readable) {
-				++res.candidates;
-				t = Clock::now();
-				samples = &warped;
-				b = detail::binarise(warped, bits);
-				decodeMs += msSince(t);
-			}
-		}
-		t = Clock::now();
-		detail::MarkerRead read;
-		if (readable && smallCells(q.corners, bits)) {
-			/* Quarter-cell samples of small cells lie within a pixel of
-			 * their neighbours: read the cells at their centres, at the
-			 * refined corners, else at the traced ones. */
-			if (bigEnough(q.corners, minSide))
-				read = detail::readCellCentres(img, q.corners, *codes, policy, warped);
-			if (!read.ok() && refined && bigEnough(outline, minSide)) {
-				read = detail::readCellCentres(img, outline, *codes, policy, warped);
+		return read;
+	}
+	if (detail::readable(r.b, bits))
+		read = detail::readMarker(img, q.corners, *codes, policy, *r.samples, r.b);
+	if (!read.ok() && r.refined && r.b.border_errors < whiteFrame()) {
+		/* Refinement can pull a blurred marker's sides onto its code's
+		 * edges; the traced outline may still read. */
+		if (detail::warpMarker(img, r.outline, bits, warped)) {
+			const detail::Binarised bt = detail::binarise(warped, bits);
+			if (detail::readable(bt, bits)) {
+				read = detail::readMarker(img, r.outline, *codes, policy, warped, bt);
 				if (read.ok())
-					q.corners = outline;
-			}
-			decodeMs += msSince(t);
-		} else if (readable) {
-			if (b.contrast >= 10.0f && b.border_errors <= borderAllowance)
-				read = detail::readMarker(img, q.corners, *codes, policy, *samples, b);
-			decodeMs += msSince(t);
-			if (!read.ok() && refined && b.border_errors < whiteFrame) {
-				/* Refinement can pull a blurred marker's sides onto its
-				 * code's edges; the traced outline may still read. */
-				t = Clock::now();
-				if (detail::warpMarker(img, outline, bits, warped)) {
-					const detail::Binarised bt = detail::binarise(warped, bits);
-					if (bt.contrast >= 10.0f && bt.border_errors <= borderAllowance) {
-						read = detail::readMarker(img, outline, *codes, policy, warped, bt);
-						if (read.ok())
-							q.corners = outline;
-					}
-				}
-				decodeMs += msSince(t);
-			}
-			if (!read.ok()) {
-				/* Blur of about a cell (a blurred marker, or a small one
-				 * upsampled) reaches the quarter-cell samples of cells of
-				 * any size. */
-				t = Clock::now();
-				read = detail::readCellCentres(img, q.corners, *codes, policy, warped);
-				decodeMs += msSince(t);
+					q.corners = r.outline;
 			}
 		}
-		if (!read.ok())
-			continue;
-		if (f > 1) {
-			for (Point2f &p : q.corners) {
-				p = toFullResolution(p, 1.0f / ff);
-				p = { p.x + origin.x, p.y + origin.y };
-			}
-		}
+	}
+	if (!read.ok()) {
+		/* Blur of about a cell (a blurred marker, or a small one
+		 * upsampled) reaches the quarter-cell samples of cells of any
+		 * size. */
+		read = detail::readCellCentres(img, q.corners, *codes, policy, warped);
+	}
+	return read;
+}
 
-		const detail::Decoded &d = read.decoded;
+/* Reads candidate k: refine, warp, binarise; the inset read when that finds
+ * no dark frame; then decoding and its fallbacks. A marker read is left in
+ * `m`, its corners in frame pixels from the code's first. */
+bool Detector::Impl::readCandidate(const ImageView &image, Slot &slot, std::size_t k, float search,
+				   StageTimer &timer, Marker &m)
+{
+	detail::Quad &q = slot.quads[k];
+	const std::array<Point2f, 4> tracedOutline = warper ? batch.outlines[k] : q.corners;
+	if (skipCandidate(q, tracedOutline, slot.result.markers))
+		return false;
+	Reading r = placeCandidate(image, q, tracedOutline);
+	/* With at least the frame's search on a halved frame: blur spreads a
+	 * large marker's edges over as many of its pixels as a small one's
+	 * over the frame's. */
+	const float ff = static_cast<float>(r.f);
+	r.refined = r.inBatch ? batch.refined[k] != 0
+			      : q.probeRead < whiteFrame() &&
+					refineQuad(r.block.view, slot, q, std::max(search / ff, kSearch), r.f);
+	sampleRefined(r, q, k, slot.result, timer);
+	if (!r.refined || r.b.border_errors >= whiteFrame())
+		readInset(r, q, slot.result, timer);
+	timer.lap(Stage::Decode);
+	const detail::MarkerRead read = decodeCandidate(r, q);
+	if (!read.ok())
+		return false;
+	if (r.f > 1) {
+		const Point2f origin{ static_cast<float>(r.block.ox), static_cast<float>(r.block.oy) };
+		for (Point2f &p : q.corners) {
+			p = toFullResolution(p, 1.0f / ff);
+			p = { p.x + origin.x, p.y + origin.y };
+		}
+	}
+	const detail::Decoded &d = read.decoded;
+	m.id = d.id;
+	m.hamming = d.hamming;
+	m.margin = read.margin;
+	for (int i = 0; i < 4; ++i)
+		m.corners[i] = q.corners[(i + d.rotation) & 3];
+	return true;
+}
+
+/* The candidates in order, smallest first: each read, each marker kept
+ * once. */
+void Detector::Impl::finish(const ImageView &image, Slot &slot)
+{
+	Result &res = slot.result;
+	res.markers.clear();
+	res.candidates = 0;
+	res.times[Stage::Refine] = res.times[Stage::Warp] = res.times[Stage::Decode] = 0.0;
+	++finishedFrames; /* halved frames made before are stale */
+	blockPatchRead = 0;
+	const float scale = slot.edges.scale;
+	const float search = kSearch / scale;
+	{
+		StageTimer timer(res.times, Stage::Refine);
+		for (detail::Quad &q : slot.quads)
+			for (Point2f &p : q.corners)
+				p = toFullResolution(p, scale);
+	}
+	if (warper)
+		refineAndWarpAll(image, slot, search);
+	for (std::size_t k = 0; k < slot.quads.size(); ++k) {
+		StageTimer timer(res.times, Stage::Refine);
 		Marker m;
-		m.id = d.id;
-		m.hamming = d.hamming;
-		m.margin = read.margin;
-		for (int i = 0; i < 4; ++i)
-			m.corners[i] = q.corners[(i + d.rotation) & 3];
-
-		/* The same marker reached twice (e.g. through two nested borders):
-		 * keep the better decode. */
-		bool duplicate = false;
-		for (Marker &other : res.markers) {
-			if (other.id != m.id)
-				continue;
-			const float dx = other.corners[0].x - m.corners[0].x;
-			const float dy = other.corners[0].y - m.corners[0].y;
-			const float sx = m.corners[1].x - m.corners[0].x, sy = m.corners[1].y - m.corners[0].y;
-			if (dx * dx + dy * dy < 0.25f * (sx * sx + sy * sy)) {
-				duplicate = true;
-				if (m.hamming < other.hamming)
-					other = m;
-				break;
-			}
-		}
-		if (!duplicate)
-			res.markers.push_back(m);
+		if (readCandidate(image, slot, k, search, timer, m))
+			detail::keepMarker(res.markers, m);
 	}
 	/* Smallest first, a block of a marker's code cells decoded before the
 	 * marker around it did: now that both are known, drop it. */
-	t = Clock::now();
-	detail::dropNestedMarkers(res.markers, bits);
-	decodeMs += msSince(t);
-	res.times[Stage::Refine] = refineMs;
-	res.times[Stage::Warp] = warpMs;
-	res.times[Stage::Decode] = decodeMs;
+	StageTimer timer(res.times, Stage::Decode);
+	detail::dropNestedMarkers(res.markers, dict->bits);
 }
 
 Detector::Detector(const Config &config) : impl_(std::make_unique<Impl>())
@@ -733,7 +681,8 @@ void Detector::runFrontEnd(const ImageView &image, int slot)
 	Impl &d = *impl_;
 	d.checkImage(image);
 	Impl::Slot &s = d.slotAt(slot);
-	const auto t0 = Clock::now();
+	s.result.times = {};
+	StageTimer timer(s.result.times, Stage::AdaptiveScale);
 	float scale;
 	{
 		std::lock_guard<std::mutex> lock(d.adaptiveLock);
@@ -743,9 +692,7 @@ void Detector::runFrontEnd(const ImageView &image, int slot)
 	if (scaledLength(image.width, scale) < 32 || scaledLength(image.height, scale) < 32)
 		scale = 1.0f;
 	s.image = image;
-	s.result.times = {};
-	s.result.times[Stage::AdaptiveScale] = msSince(t0);
-	const auto t1 = Clock::now();
+	timer.lap(Stage::FrontEnd);
 	d.frontEnd->run(image, scale, d.params, s.edges);
 	if (!d.frontEnd->makesRegionMap()) {
 		/* A front end without a region map (the QPUs, for now): the
@@ -754,7 +701,6 @@ void Detector::runFrontEnd(const ImageView &image, int slot)
 		 * region_contrast is 0. */
 		detail::regionMap(image, 1.0f, d.params.region_contrast, s.edges.regions, d.regionScratch);
 	}
-	s.result.times[Stage::FrontEnd] = msSince(t1);
 	s.result.scale = s.edges.scale;
 }
 

@@ -141,6 +141,11 @@ bool borderIsBlack(const Binarised &b, int bits)
 	return b.border_errors <= allowedBorderErrors(bits);
 }
 
+bool readable(const Binarised &b, int bits)
+{
+	return b.contrast >= kMinContrast && borderIsBlack(b, bits);
+}
+
 Scrutiny scrutinyFor(const Dictionary &dict, int hamming)
 {
 	return dict.randomDecodeChance(hamming) > kStrongRead ? Scrutiny::Strict : Scrutiny::Tolerant;
@@ -276,7 +281,7 @@ MarkerRead readCellCentres(const ImageView &image, const std::array<Point2f, 4> 
 		return {};
 	const Binarised b = binarise(scratch, bits);
 	const float lo = b.threshold - 0.5f * b.contrast, hi = b.threshold + 0.5f * b.contrast;
-	if (b.contrast < kMinContrast || !borderIsBlack(b, bits) || !(lo < reference && hi > reference))
+	if (!readable(b, bits) || !(lo < reference && hi > reference))
 		return {};
 	MarkerRead r = readMarker(image, corners, codes, policy, scratch, b);
 	if (!r.ok())

@@ -58,6 +58,11 @@ int allowedBorderErrors(int bits);
 /// The border cells that read white are at most allowedBorderErrors().
 bool borderIsBlack(const Binarised &b, int bits);
 
+/// Worth decoding: the payload spans at least 10 grey levels and the
+/// border is black. The detector's rule for every read (the tracer's
+/// probe, readMarker's callers, readCellCentres).
+bool readable(const Binarised &b, int bits);
+
 /// How much a read needs its frame and cells to vouch for it. A code that
 /// chance alone reads often (every 4x4 code, or a 6x6 code three bits
 /// away) is only believed on a clean frame; a strong code is also believed
@@ -93,7 +98,10 @@ bool unambiguous(const Decoded &d, const Dictionary &dict);
 bool insideCodeArea(const std::array<Point2f, 4> &inner, const std::array<Point2f, 4> &marker, int bits);
 
 /// Drops the markers that lie inside another marker's code area: blocks of
-/// code cells that read as a marker. In place, without allocating.
+/// code cells that read as a marker. In place, without allocating. Not a
+/// repeat of the kind suppression.h drops (what it drops is no copy of
+/// the marker around it, and is known only once every candidate is read):
+/// it runs once on the frame's whole marker set.
 void dropNestedMarkers(std::vector<Marker> &markers, int bits);
 
 /// What a detector corrects.

@@ -1,0 +1,91 @@
+// SPDX-License-Identifier: MIT
+// The measures of a quadrilateral that the back end's stages share: its
+// sides, area, centre and cell size, and the mapping of its corners between
+// the scales a frame is read at.
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+#include "frappe/image.h"
+
+namespace frappe::detail {
+
+/* Corners clockwise on screen, or anticlockwise: the measures below do not
+ * depend on the direction. */
+using QuadCorners = std::array<Point2f, 4>;
+
+inline float dist2(Point2f a, Point2f b)
+{
+	const float dx = a.x - b.x, dy = a.y - b.y;
+	return dx * dx + dy * dy;
+}
+
+/* The square of the shortest of a quad's four sides. */
+inline float shortestSide2(const QuadCorners &q)
+{
+	float side2 = INFINITY;
+	for (int i = 0; i < 4; ++i) {
+		const float dx = q[i].x - q[(i + 1) & 3].x, dy = q[i].y - q[(i + 1) & 3].y;
+		side2 = std::min(side2, dx * dx + dy * dy);
+	}
+	return side2;
+}
+
+inline bool sidesAtLeast(const QuadCorners &q, float side)
+{
+	return shortestSide2(q) >= side * side;
+}
+
+/* Large enough to read: sides of minSide on average, none under 0.6 of it
+ * (a marker tilted 65 degrees is read across its foreshortened sides). */
+inline bool bigEnough(const QuadCorners &q, float minSide)
+{
+	float sum = 0.0f;
+	for (int i = 0; i < 4; ++i) {
+		const float dx = q[i].x - q[(i + 1) & 3].x, dy = q[i].y - q[(i + 1) & 3].y;
+		const float side = std::sqrt(dx * dx + dy * dy);
+		if (side < 0.6f * minSide)
+			return false;
+		sum += side;
+	}
+	return sum >= 4.0f * minSide;
+}
+
+inline float quadArea(const QuadCorners &q)
+{
+	float twice = 0.0f;
+	for (int i = 0; i < 4; ++i)
+		twice += q[i].x * q[(i + 1) & 3].y - q[(i + 1) & 3].x * q[i].y;
+	return 0.5f * std::abs(twice);
+}
+
+inline Point2f quadCentre(const QuadCorners &q)
+{
+	return { 0.25f * (q[0].x + q[1].x + q[2].x + q[3].x), 0.25f * (q[0].y + q[1].y + q[2].y + q[3].y) };
+}
+
+/* A quad's cell size, along its shortest side, for a code of bits x bits
+ * cells inside a border of one. */
+inline float cellSide(const QuadCorners &q, int bits)
+{
+	return std::sqrt(shortestSide2(q)) / static_cast<float>(bits + 2);
+}
+
+/* A point of a frame scaled by `scale` (traced, or halved into blocks) in
+ * the frame's own pixels; pixel centres are at integers in both. */
+inline Point2f toFullResolution(Point2f p, float scale)
+{
+	return { (p.x + 0.5f) / scale - 0.5f, (p.y + 0.5f) / scale - 0.5f };
+}
+
+/* The other way round, by a factor: a point in the pixels of the frame
+ * scaled by `factor`. (Not toFullResolution(p, 1 / factor): the
+ * reciprocal would round, and move corners by an ulp.) */
+inline Point2f toScaled(Point2f p, float factor)
+{
+	return { (p.x + 0.5f) * factor - 0.5f, (p.y + 0.5f) * factor - 0.5f };
+}
+
+} // namespace frappe::detail

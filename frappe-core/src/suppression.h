@@ -1,0 +1,29 @@
+// SPDX-License-Identifier: MIT
+// The back end's one rule for dropping repeats: a quad or marker found
+// again is compared with those already kept, in the order they were kept.
+#pragma once
+
+#include <span>
+
+namespace frappe::detail {
+
+/* The first of `kept` that `item` repeats (same(kept, item)), or nullptr.
+ * Greedy, in arrival order: the back end meets its candidates in an order
+ * that puts the one to keep first (the tracer's scan; then smallest first,
+ * a marker's own outline before its quiet zone's), so the caller keeps the
+ * earlier one unless it has a better reason (a lower Hamming distance).
+ * What counts as a repeat is the caller's: quads that coincide corner for
+ * corner (removeDuplicateQuads()), a marker read twice (keepMarker()), the
+ * outline of a decoded marker's quiet zone (surroundsMarker()). Quadratic
+ * in the items kept, a few dozen at most; allocates nothing. */
+template<typename Kept, typename Item, typename Same>
+Kept *firstRepeated(std::span<Kept> kept, const Item &item, Same same)
+{
+	for (Kept &k : kept) {
+		if (same(k, item))
+			return &k;
+	}
+	return nullptr;
+}
+
+} // namespace frappe::detail
