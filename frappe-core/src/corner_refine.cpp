@@ -398,9 +398,9 @@ inline void addCrossing(Sums &s, int U, std::int32_t vFix, int vc, int wMass, in
 /* Measures one side from a to b (clockwise quad, so the marker interior is
  * on the right of a->b on screen). */
 bool fitSide(const ImageView &img, Point2f a, Point2f b, float search, int maxPoints, const RefineWindow &win,
-	     Line &line)
+	     RefineKernels kernels, Line &line)
 {
-	const int kRun = win.run, kWindow16 = win.window16;
+	const int kRun = win.run;
 	const float dx = b.x - a.x, dy = b.y - a.y;
 	const float len = std::sqrt(dx * dx + dy * dy);
 	if (len < 2.0f || img.width < 1 || img.height < 1)
@@ -453,84 +453,91 @@ bool fitSide(const ImageView &img, Point2f a, Point2f b, float search, int maxPo
 
 	Sums sums;
 #if FRAPPE_HAVE_HWY
-	/* The columns' geometry and search ranges first, for the rows of
-	 * pixels to gather; then all of them measured at once. */
-	Columns cols;
-	int Us[kFinePoints];
-	std::int32_t vFixes[kFinePoints];
-	cols.run = kRun;
-	cols.window16 = kWindow16;
-	cols.symmetric = win.symmetric;
-	cols.passes = win.passes;
-	cols.kLoMin = kMaxReach;
-	cols.kHiMax = -kMaxReach;
-	for (int i = 0; i < nPoints; ++i, accFix += stepFix) {
-		const ColumnAt c = columnAt(accFix >> 16, vFix0, slopeFix, dir, peakFix);
-		Us[i] = c.U;
-		vFixes[i] = c.vFix;
-		cols.kLo[i] = c.kLo;
-		cols.kHi[i] = c.kHi;
-		cols.kLoMin = std::min(cols.kLoMin, c.kLo);
-		cols.kHiMax = std::max(cols.kHiMax, c.kHi);
-	}
-	/* No column has a step to look for. */
-	if (cols.kLoMin > cols.kHiMax)
-		return false;
-	const int j0 = cols.kLoMin - kRun - 1, rows = cols.kHiMax + kRun + 2 - j0;
-	for (int i = 0; i < nPoints; ++i) {
-		const int u = u0 + Us[i];
-		const int vc = (vFixes[i] + 32768) >> 16;
-		if (u >= 0 && u < uDim && vc - half >= 0 && vc + half < vDim) {
-			const std::uint8_t *px = img.data + u * uStep + vc * vStep + j0 * step;
-			/* Four at a time: the copy is a fifth of the time. */
-			int r = 0;
-			for (; r + 4 <= rows; r += 4, px += 4 * step) {
-				cols.p[r][i] = px[0];
-				cols.p[r + 1][i] = px[step];
-				cols.p[r + 2][i] = px[2 * step];
-				cols.p[r + 3][i] = px[3 * step];
+	if (kernels == RefineKernels::Best) {
+		/* The columns' geometry and search ranges first, for the rows of
+		 * pixels to gather; then all of them measured at once. */
+		Columns cols;
+		int Us[kFinePoints];
+		std::int32_t vFixes[kFinePoints];
+		cols.run = kRun;
+		cols.window16 = win.window16;
+		cols.symmetric = win.symmetric;
+		cols.passes = win.passes;
+		cols.kLoMin = kMaxReach;
+		cols.kHiMax = -kMaxReach;
+		for (int i = 0; i < nPoints; ++i, accFix += stepFix) {
+			const ColumnAt c = columnAt(accFix >> 16, vFix0, slopeFix, dir, peakFix);
+			Us[i] = c.U;
+			vFixes[i] = c.vFix;
+			cols.kLo[i] = c.kLo;
+			cols.kHi[i] = c.kHi;
+			cols.kLoMin = std::min(cols.kLoMin, c.kLo);
+			cols.kHiMax = std::max(cols.kHiMax, c.kHi);
+		}
+		/* No column has a step to look for. */
+		if (cols.kLoMin > cols.kHiMax)
+			return false;
+		const int j0 = cols.kLoMin - kRun - 1, rows = cols.kHiMax + kRun + 2 - j0;
+		for (int i = 0; i < nPoints; ++i) {
+			const int u = u0 + Us[i];
+			const int vc = (vFixes[i] + 32768) >> 16;
+			if (u >= 0 && u < uDim && vc - half >= 0 && vc + half < vDim) {
+				const std::uint8_t *px = img.data + u * uStep + vc * vStep + j0 * step;
+				/* Four at a time: the copy is a fifth of the time. */
+				int r = 0;
+				for (; r + 4 <= rows; r += 4, px += 4 * step) {
+					cols.p[r][i] = px[0];
+					cols.p[r + 1][i] = px[step];
+					cols.p[r + 2][i] = px[2 * step];
+					cols.p[r + 3][i] = px[3 * step];
+				}
+				for (; r < rows; ++r, px += step)
+					cols.p[r][i] = *px;
+			} else {
+				/* Clamped to the image, as a bilinear sampler would. */
+				const int uc = std::clamp(u, 0, uDim - 1);
+				for (int r = 0; r < rows; ++r)
+					cols.p[r][i] = img.data[uc * uStep + std::clamp(vc + dir * (j0 + r), 0, vDim - 1) * vStep];
 			}
-			for (; r < rows; ++r, px += step)
-				cols.p[r][i] = *px;
-		} else {
-			/* Clamped to the image, as a bilinear sampler would. */
-			const int uc = std::clamp(u, 0, uDim - 1);
-			for (int r = 0; r < rows; ++r)
-				cols.p[r][i] = img.data[uc * uStep + std::clamp(vc + dir * (j0 + r), 0, vDim - 1) * vStep];
 		}
-	}
-	/* Empty searches to whole vectors. */
-	cols.n = (nPoints + Columns::kPad - 1) / Columns::kPad * Columns::kPad;
-	for (int i = nPoints; i < cols.n; ++i) {
-		cols.kLo[i] = 1;
-		cols.kHi[i] = 0;
-	}
-	static_assert(kFinePoints + Columns::kPad <= Columns::kLanes);
-	for (int r = 0; r < rows; ++r)
-		std::memset(&cols.p[r][nPoints], 0, Columns::kPad);
-	HWY_DYNAMIC_DISPATCH(MeasureColumns)(cols);
-	addColumns(sums, cols, nPoints, Us, vFixes, dir, vRef, reachFix);
+		/* Empty searches to whole vectors. */
+		cols.n = (nPoints + Columns::kPad - 1) / Columns::kPad * Columns::kPad;
+		for (int i = nPoints; i < cols.n; ++i) {
+			cols.kLo[i] = 1;
+			cols.kHi[i] = 0;
+		}
+		static_assert(kFinePoints + Columns::kPad <= Columns::kLanes);
+		for (int r = 0; r < rows; ++r)
+			std::memset(&cols.p[r][nPoints], 0, Columns::kPad);
+		HWY_DYNAMIC_DISPATCH(MeasureColumns)(cols);
+		addColumns(sums, cols, nPoints, Us, vFixes, dir, vRef, reachFix);
+	} else
 #else
-	int buf[kMaxProfile];
-	int *const p = buf + half; /* near the image border: p[j], the pixel j steps inwards of the side, clamped */
-	for (int i = 0; i < nPoints; ++i, accFix += stepFix) {
-		const auto [U, vFix, vc, kLo, kHi] = columnAt(accFix >> 16, vFix0, slopeFix, dir, peakFix);
-		const int u = u0 + U;
-		int wMass, wMoment2 = 0;
-		if (u >= 0 && u < uDim && vc - half >= 0 && vc + half < vDim) {
-			const std::uint8_t *px = img.data + u * uStep + vc * vStep;
-			wMass = measureColumn([px, step](int j) { return static_cast<int>(px[j * step]); }, kLo, kHi,
-					      win, wMoment2);
-		} else {
-			/* Clamped to the image, as a bilinear sampler would. */
-			const int uc = std::clamp(u, 0, uDim - 1);
-			for (int j = -half; j <= half; ++j)
-				p[j] = img.data[uc * uStep + std::clamp(vc + dir * j, 0, vDim - 1) * vStep];
-			wMass = measureColumn([p](int j) { return p[j]; }, kLo, kHi, win, wMoment2);
-		}
-		addCrossing(sums, U, vFix, vc, wMass, wMoment2, dir, vRef, reachFix);
-	}
+	(void)kernels;
 #endif
+	{
+		/* The scalar reference, one column at a time (the ARMv6 build's path;
+		 * with Highway, what the tests hold the vector kernel to). */
+		int buf[kMaxProfile];
+		int *const p = buf + half; /* near the image border: p[j], the pixel j steps inwards of the side, clamped */
+		for (int i = 0; i < nPoints; ++i, accFix += stepFix) {
+			const auto [U, vFix, vc, kLo, kHi] = columnAt(accFix >> 16, vFix0, slopeFix, dir, peakFix);
+			const int u = u0 + U;
+			int wMass, wMoment2 = 0;
+			if (u >= 0 && u < uDim && vc - half >= 0 && vc + half < vDim) {
+				const std::uint8_t *px = img.data + u * uStep + vc * vStep;
+				wMass = measureColumn([px, step](int j) { return static_cast<int>(px[j * step]); }, kLo, kHi,
+						      win, wMoment2);
+			} else {
+				/* Clamped to the image, as a bilinear sampler would. */
+				const int uc = std::clamp(u, 0, uDim - 1);
+				for (int j = -half; j <= half; ++j)
+					p[j] = img.data[uc * uStep + std::clamp(vc + dir * j, 0, vDim - 1) * vStep];
+				wMass = measureColumn([p](int j) { return p[j]; }, kLo, kHi, win, wMoment2);
+			}
+			addCrossing(sums, U, vFix, vc, wMass, wMoment2, dir, vRef, reachFix);
+		}
+	}
 	const std::int64_t sw = sums.sw, su = sums.su, suu = sums.suu, sq = sums.sq, suq = sums.suq;
 	if (sums.used < 3 || sums.used * 2 < nPoints)
 		return false;
@@ -561,11 +568,11 @@ bool intersect(const Line &l1, const Line &l2, Point2f &p)
 }
 
 bool refineOnce(const ImageView &img, std::array<Point2f, 4> &q, float search, int maxPoints,
-		const RefineWindow &win)
+		const RefineWindow &win, RefineKernels kernels)
 {
 	Line lines[4];
 	for (int i = 0; i < 4; ++i) {
-		if (!fitSide(img, q[i], q[(i + 1) & 3], search, maxPoints, win, lines[i]))
+		if (!fitSide(img, q[i], q[(i + 1) & 3], search, maxPoints, win, kernels, lines[i]))
 			return false;
 	}
 	std::array<Point2f, 4> r;
@@ -583,7 +590,8 @@ bool refineOnce(const ImageView &img, std::array<Point2f, 4> &q, float search, i
 
 } // namespace
 
-bool refineCorners(const ImageView &image, std::array<Point2f, 4> &corners, float search, const RefineWindow &window)
+bool refineCorners(const ImageView &image, std::array<Point2f, 4> &corners, float search, const RefineWindow &window,
+		   RefineKernels kernels)
 {
 	RefineWindow win = window;
 	win.run = std::clamp(win.run, 1, kMaxRun);
@@ -591,11 +599,11 @@ bool refineCorners(const ImageView &image, std::array<Point2f, 4> &corners, floa
 	win.passes = std::clamp(win.passes, 1, 4);
 	std::array<Point2f, 4> q = corners;
 	/* The wide first pass only has to place the sides roughly: few points. */
-	if (!refineOnce(image, q, search, kCoarsePoints, win))
+	if (!refineOnce(image, q, search, kCoarsePoints, win, kernels))
 		return false;
 	/* A second, narrow pass: the sides are now well placed, so the
 	 * measurement points avoid the corners exactly and the window shrinks. */
-	refineOnce(image, q, std::min(search, 1.5f), kFinePoints, win);
+	refineOnce(image, q, std::min(search, 1.5f), kFinePoints, win, kernels);
 	corners = q;
 	return true;
 }

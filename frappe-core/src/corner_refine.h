@@ -29,6 +29,14 @@ struct RefineWindow {
 	int passes = 1; ///< 1..4
 };
 
+/// Which code measures the sides' columns: the vector kernel (Highway's best
+/// target, where the library is built with it) or the scalar reference,
+/// always compiled. Both give the same corners to the bit.
+enum class RefineKernels {
+	Best,
+	Scalar,
+};
+
 /// Refines the corners of a clockwise quadrilateral on the full-resolution
 /// image. Each side is re-measured: along its normal, at points spread over
 /// the side, the strongest light-to-dark step going inwards is located to a
@@ -41,6 +49,6 @@ struct RefineWindow {
 /// Returns false when a side cannot be measured; the corners are then
 /// unchanged.
 bool refineCorners(const ImageView &image, std::array<Point2f, 4> &corners, float search,
-		   const RefineWindow &window = {});
+		   const RefineWindow &window = {}, RefineKernels kernels = RefineKernels::Best);
 
 } // namespace frappe::detail

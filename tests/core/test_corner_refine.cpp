@@ -153,30 +153,33 @@ TEST(CornerRefine, ASymmetricWindowStaysOnEdgesBetweenNarrowBands)
 	EXPECT_LT(errSymmetric, 0.9 * errPlain);
 }
 
-TEST(CornerRefine, EveryTargetGivesTheSameBits)
+/* Every Highway target (the vector kernel) gives the scalar reference's
+ * corners to the bit, with every window; so does a build without Highway
+ * (the ARMv6 one), which runs the reference itself. */
+TEST(CornerRefine, EveryTargetGivesTheScalarReferenceBits)
 {
 	const std::vector<Case> cases = makeCases();
 	for (const detail::RefineWindow window :
 	     { detail::RefineWindow{}, detail::RefineWindow{ 6, 64 }, detail::RefineWindow{ 6, 64, true, 2 } }) {
-	std::vector<std::array<Point2f, 4>> first;
-	std::vector<int> firstOk;
-	onEveryTarget([&](const char *target) {
-		std::vector<std::array<Point2f, 4>> got;
-		std::vector<int> ok;
+		std::vector<std::array<Point2f, 4>> reference;
+		std::vector<int> referenceOk;
+		int refined = 0;
 		for (const Case &c : cases) {
 			std::array<Point2f, 4> q = c.start;
-			ok.push_back(detail::refineCorners(c.image.view(), q, c.search, window));
-			got.push_back(q);
+			referenceOk.push_back(
+				detail::refineCorners(c.image.view(), q, c.search, window, detail::RefineKernels::Scalar));
+			reference.push_back(q);
+			refined += referenceOk.back();
 		}
-		if (first.empty()) {
-			first = got;
-			firstOk = ok;
-			return;
-		}
-		for (std::size_t k = 0; k < cases.size(); ++k) {
-			ASSERT_EQ(ok[k], firstOk[k]) << target << " case " << k;
-			ASSERT_EQ(std::memcmp(&got[k], &first[k], sizeof got[k]), 0) << target << " case " << k;
-		}
-	});
+		/* The comparison means something only where the corners moved. */
+		ASSERT_GE(refined, static_cast<int>(cases.size()) * 3 / 4);
+		onEveryTarget([&](const char *target) {
+			for (std::size_t k = 0; k < cases.size(); ++k) {
+				std::array<Point2f, 4> q = cases[k].start;
+				const bool ok = detail::refineCorners(cases[k].image.view(), q, cases[k].search, window);
+				ASSERT_EQ(ok, referenceOk[k] != 0) << target << " case " << k;
+				ASSERT_EQ(std::memcmp(&q, &reference[k], sizeof q), 0) << target << " case " << k;
+			}
+		});
 	}
 }
