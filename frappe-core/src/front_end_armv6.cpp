@@ -817,6 +817,14 @@ const RowKernels &armv6RowKernels()
 	return kArmv6;
 }
 
+const BandKernels &armv6BandKernels()
+{
+	static constexpr BandKernels kArmv6{ "armv6-simd32", [](const BandJob &job) {
+		runBandRows(armv6RowKernels(), job);
+	} };
+	return kArmv6;
+}
+
 } // namespace frappe::detail
 
 #endif

@@ -65,7 +65,7 @@ namespace {
 class CpuFrontEnd final : public FrontEnd
 {
 public:
-	CpuFrontEnd(int threads, const detail::RowKernels &kernels)
+	CpuFrontEnd(int threads, const detail::BandKernels &kernels)
 		: threads_(threads), kernels_(kernels)
 	{
 	}
@@ -78,7 +78,7 @@ private:
 	void runBand(const detail::BandJob &job);
 
 	int threads_;
-	const detail::RowKernels &kernels_;
+	const detail::BandKernels &kernels_;
 	std::vector<std::uint8_t> scaled_;
 	std::vector<detail::RowScratch> scratch_;
 	detail::RegionScratch regionScratch_;
@@ -152,20 +152,17 @@ void CpuFrontEnd::run(const ImageView &image, float scale, const FrontEndParams 
 /* Edge rows y0 .. y1-1 (1 <= y0, y1 <= h-1), and the means rows of the job. */
 void CpuFrontEnd::runBand(const detail::BandJob &job)
 {
-	if (kernels_.band)
-		kernels_.band(job);
-	else
-		detail::runBandRows(kernels_, job);
+	kernels_.band(job);
 }
 
 } // namespace
 
 std::unique_ptr<FrontEnd> makeCpuFrontEnd(int threads)
 {
-	return std::make_unique<CpuFrontEnd>(threads, detail::bestRowKernels());
+	return std::make_unique<CpuFrontEnd>(threads, detail::bestBandKernels());
 }
 
-std::unique_ptr<FrontEnd> detail::makeCpuFrontEnd(int threads, const RowKernels &kernels)
+std::unique_ptr<FrontEnd> detail::makeCpuFrontEnd(int threads, const BandKernels &kernels)
 {
 	return std::make_unique<CpuFrontEnd>(threads, kernels);
 }

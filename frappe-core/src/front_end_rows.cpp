@@ -172,13 +172,21 @@ const RowKernels &scalarRowKernels()
 	return kScalar;
 }
 
+const BandKernels &scalarBandKernels()
+{
+	static constexpr BandKernels kScalar{ "scalar", [](const BandJob &job) {
+		runBandRows(scalarRowKernels(), job);
+	} };
+	return kScalar;
+}
+
 #ifndef FRAPPE_HAVE_HWY
-const RowKernels &bestRowKernels()
+const BandKernels &bestBandKernels()
 {
 #ifdef FRAPPE_HAVE_ARMV6_KERNELS
-	return armv6RowKernels();
+	return armv6BandKernels();
 #else
-	return scalarRowKernels();
+	return scalarBandKernels();
 #endif
 }
 

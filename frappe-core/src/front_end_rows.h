@@ -89,9 +89,8 @@ struct BandJob {
 	int hy0 = 0, hy1 = 0;
 };
 
-/// The row kernels one front end uses: the portable scalar ones above (or
-/// the ARMv6 ones), run by runBandRows; or a band loop of vectorised twins,
-/// which must produce the same bytes, with the row kernels null.
+/// A set of row kernels: the portable scalar ones above (the reference), or
+/// their ARMv6 SIMD32 twins; runBandRows runs them over a band.
 struct RowKernels {
 	const char *name;
 	void (*smooth)(const std::uint8_t *a, const std::uint8_t *b, const std::uint8_t *c, int w,
@@ -99,17 +98,26 @@ struct RowKernels {
 	void (*gradient)(const std::uint8_t *a, const std::uint8_t *b, const std::uint8_t *c, int w,
 			 std::int16_t *gx, std::int16_t *gy, std::int32_t *mag, std::int16_t *tmp);
 	bool (*edge)(const GradRows &rows, int w, const FrontEndParams &params, std::uint8_t *out);
-	/// runBandRows over kernels called directly, dispatched once per band
-	/// rather than three or four times per row; null for the row kernels.
-	void (*band)(const BandJob &job) = nullptr;
 };
 
-/// The scalar kernels: the reference, and the ARMv6 path.
+/// What a CPU front end runs: one band of rows at a time. For the scalar and
+/// ARMv6 sets, runBandRows over their RowKernels; for Highway, a band loop
+/// of vectorised twins whose kernels are called directly, dispatched once
+/// per band rather than three or four times a row. Every set produces the
+/// scalar set's bytes.
+struct BandKernels {
+	const char *name;
+	void (*band)(const BandJob &job);
+};
+
+/// The scalar row kernels: the reference.
 const RowKernels &scalarRowKernels();
-/// The fastest kernels for this CPU (Highway's runtime dispatch), or the
-/// ARMv6 SIMD32 ones, or the scalar ones.
-const RowKernels &bestRowKernels();
-/// What bestRowKernels() runs on this CPU (frappe::simdTarget()).
+/// runBandRows over scalarRowKernels().
+const BandKernels &scalarBandKernels();
+/// The fastest for this CPU: Highway's runtime dispatch, or the ARMv6
+/// SIMD32 kernels, or the scalar ones.
+const BandKernels &bestBandKernels();
+/// What bestBandKernels() runs on this CPU (frappe::simdTarget()).
 const char *simdTargetName();
 
 #if defined(__ARM_FEATURE_SIMD32) && defined(__ARM_FEATURE_DSP) && defined(__ARMEL__)
@@ -118,6 +126,8 @@ const char *simdTargetName();
 /// but their own row layouts: the smoothed rows lane-split (below), and the
 /// gradient row's (gx, gy) as int16 pairs in `gx` (`gy` unused).
 const RowKernels &armv6RowKernels();
+/// runBandRows over armv6RowKernels().
+const BandKernels &armv6BandKernels();
 /// markTiles by LDM where the row is word aligned (front_end_armv6.cpp).
 void markTilesV6(const std::uint8_t *edgeRow, int w, std::uint8_t *tileRow);
 /// Where the ARMv6 smoothing stores pixel x of a row: as a uint16, per four
@@ -129,7 +139,7 @@ inline std::size_t armv6SmoothedOffset(int x)
 #endif
 
 /// A CPU front end with the given kernels (tests compare them).
-std::unique_ptr<FrontEnd> makeCpuFrontEnd(int threads, const RowKernels &kernels);
+std::unique_ptr<FrontEnd> makeCpuFrontEnd(int threads, const BandKernels &kernels);
 
 /// The streamed row loop of one band: smoothed and gradient rows in rings,
 /// an edge row per image row, the tile mask. Kernels has RowKernels'

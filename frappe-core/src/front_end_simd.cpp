@@ -426,10 +426,10 @@ void bandDispatch(const BandJob &job)
 
 } // namespace
 
-const RowKernels &bestRowKernels()
+const BandKernels &bestBandKernels()
 {
-	/* Only the band loop: each target's loop calls its own row kernels. */
-	static constexpr RowKernels kSimd{ "highway", nullptr, nullptr, nullptr, bandDispatch };
+	/* Each target's band loop calls its own row kernels. */
+	static constexpr BandKernels kSimd{ "highway", bandDispatch };
 	return kSimd;
 }
 

@@ -229,8 +229,8 @@ void compareTracers(const TraceMap &map, const char *what)
 
 std::size_t compareFrontEnds(const Gray &g, const FrontEndParams &params, float scale, const char *what)
 {
-	auto ref = makeCpuFrontEnd(1, scalarRowKernels());
-	auto v6 = makeCpuFrontEnd(1, armv6RowKernels());
+	auto ref = makeCpuFrontEnd(1, scalarBandKernels());
+	auto v6 = makeCpuFrontEnd(1, armv6BandKernels());
 	EdgeMap e1, e2;
 	const ImageView view(g.px.data(), g.w, g.h, g.w);
 	ref->run(view, scale, params, e1);
@@ -469,7 +469,7 @@ int main(int argc, char **argv)
 	}
 	const RowKernels &ref = scalarRowKernels();
 	const RowKernels &k = armv6RowKernels();
-	CHECK(&bestRowKernels() == &k, "bestRowKernels() is not the ARMv6 set on this build");
+	CHECK(&bestBandKernels() == &armv6BandKernels(), "bestBandKernels() is not the ARMv6 set on this build");
 
 	int rowCases = 0;
 	for (int w = 1; w <= 96; ++w)

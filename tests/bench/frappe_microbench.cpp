@@ -65,7 +65,7 @@ FrontEndParams params()
 	return Detector(Config{}).frontEndParams();
 }
 
-void frontEnd(benchmark::State &state, const detail::RowKernels &kernels)
+void frontEnd(benchmark::State &state, const detail::BandKernels &kernels)
 {
 	const Scene &s = scene(static_cast<int>(state.range(0)));
 	auto fe = detail::makeCpuFrontEnd(1, kernels);
@@ -79,8 +79,8 @@ void frontEnd(benchmark::State &state, const detail::RowKernels &kernels)
 	state.SetLabel(kernels.name);
 }
 
-void BM_FrontEndScalar(benchmark::State &state) { frontEnd(state, detail::scalarRowKernels()); }
-void BM_FrontEndBest(benchmark::State &state) { frontEnd(state, detail::bestRowKernels()); }
+void BM_FrontEndScalar(benchmark::State &state) { frontEnd(state, detail::scalarBandKernels()); }
+void BM_FrontEndBest(benchmark::State &state) { frontEnd(state, detail::bestBandKernels()); }
 
 void BM_Trace(benchmark::State &state)
 {

@@ -216,8 +216,8 @@ TEST(FrontEnd, ScalingSamplesTheNearestPixel)
  * Highway 1.0.3 has had a wrong operation on one of them). */
 void expectVectorKernelsMatchScalar(const char *target)
 {
-	const detail::RowKernels &best = detail::bestRowKernels();
-	const detail::RowKernels &scalar = detail::scalarRowKernels();
+	const detail::BandKernels &best = detail::bestBandKernels();
+	const detail::BandKernels &scalar = detail::scalarBandKernels();
 	auto scalarFe = detail::makeCpuFrontEnd(1, scalar);
 	auto bestFe = detail::makeCpuFrontEnd(1, best);
 	SCOPED_TRACE(target);
@@ -266,7 +266,7 @@ void expectVectorKernelsMatchScalar(const char *target)
 
 TEST(FrontEnd, VectorKernelsMatchTheScalarOnesByteForByte)
 {
-	if (&detail::bestRowKernels() == &detail::scalarRowKernels())
+	if (&detail::bestBandKernels() == &detail::scalarBandKernels())
 		GTEST_SKIP() << "built without Highway: only the scalar kernels exist";
 	test::onEveryTarget(expectVectorKernelsMatchScalar);
 }
