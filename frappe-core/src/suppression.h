@@ -3,6 +3,7 @@
 // again is compared with those already kept, in the order they were kept.
 #pragma once
 
+#include <algorithm>
 #include <span>
 
 namespace frappe::detail {
@@ -19,11 +20,8 @@ namespace frappe::detail {
 template<typename Kept, typename Item, typename Same>
 Kept *firstRepeated(std::span<Kept> kept, const Item &item, Same same)
 {
-	for (Kept &k : kept) {
-		if (same(k, item))
-			return &k;
-	}
-	return nullptr;
+	const auto it = std::ranges::find_if(kept, [&](const Kept &k) { return same(k, item); });
+	return it == kept.end() ? nullptr : &*it;
 }
 
 } // namespace frappe::detail
