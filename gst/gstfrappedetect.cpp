@@ -58,12 +58,15 @@
  * bit-exact and slow, for testing anywhere; `auto` (the default), the QPUs
  * when the probe succeeds, else the CPU with one warning on a Pi.
  *
- * With #GstFrappeDetect:pipelined, the front end of frame N+1 runs while the
- * back end of frame N runs on a worker thread. The element then holds one
- * buffer, answers the LATENCY query with one extra frame, asks upstream
- * pools for one more buffer, pushes the held buffer on EOS, caps, segment,
- * gap, stream-start and DRAIN queries, and drops it on flush.
- * Every buffer comes out once, in order, with its own metas.
+ * With #GstFrappeDetect:pipelined, two frames are detected at once, each
+ * whole frame on a detector of its own on one of two threads (a
+ * frappe::Pipeline): about twice the frame rate a core allows, for one frame
+ * of latency. The element then holds one buffer, answers the LATENCY query
+ * with one extra frame, asks upstream pools for one more buffer, pushes the
+ * held buffer on EOS, caps, segment, gap, stream-start and DRAIN queries,
+ * and drops it on flush. Every buffer comes out once, in order, with its own
+ * metas. In AScale mode each of the two detectors scales a frame from the
+ * last frame it ran.
  *
  * When detection fails on a frame the element posts an error and returns
  * a flow error, pipelined or not (pipelined, when the held frame is
@@ -90,7 +93,6 @@
 #include <cstdint>
 #include <exception>
 #include <memory>
-#include <optional>
 #include <string>
 #include <vector>
 
@@ -104,14 +106,14 @@
 #include "gstfrappeenums.h"
 #include "gstfrappeoutput.h"
 #include "gstfrappesettings.h"
-#include "gstfrappeworker.h"
+#include "gstfrappeframe.h"
 #include "pose.h"
 
 /* Not static: the settings log through it too. */
 GST_DEBUG_CATEGORY(gst_frappe_detect_debug);
 #define GST_CAT_DEFAULT gst_frappe_detect_debug
 
-using frappe::gst::InFlight;
+using frappe::gst::MappedFrame;
 using frappe::gst::Settings;
 
 /* -------------------------------------------------------------------------
@@ -125,10 +127,9 @@ struct FrappeDetectPrivate {
 
 	/* Streaming thread only. */
 	Settings active;
-	std::unique_ptr<frappe::Detector> detector;
-	std::optional<InFlight> held;
+	std::unique_ptr<frappe::Pipeline> pipeline;
+	std::vector<MappedFrame> held;   /* in the pipeline, oldest first */
 	std::vector<GstBuffer *> output; /* finished, waiting for generate_output */
-	frappe::gst::Worker worker;
 	bool loggedMemory = false;
 	bool warnedStride = false;
 	bool warnedFallback = false;
@@ -158,7 +159,7 @@ static GstStaticPadTemplate src_template =
  * Detection
  */
 
-/* Puts the front end the backend property names into the detector. */
+/* Puts the front end the backend property names into a detector. */
 static bool select_front_end(GstFrappeDetect *self, frappe::Detector &detector)
 {
 	FrappeDetectPrivate *priv = self->priv;
@@ -181,26 +182,31 @@ static bool select_front_end(GstFrappeDetect *self, frappe::Detector &detector)
 	return true;
 }
 
-static bool ensure_detector(GstFrappeDetect *self)
+/* The pipeline of the active settings: frames on one thread, or whole
+ * frames on two (pipelined, one buffer held). */
+static bool ensure_pipeline(GstFrappeDetect *self)
 {
 	FrappeDetectPrivate *priv = self->priv;
-	if (priv->detector)
+	if (priv->pipeline)
 		return true;
 	const frappe::Config config = priv->active.config();
 	try {
-		priv->detector = std::make_unique<frappe::Detector>(config);
+		priv->pipeline = std::make_unique<frappe::Pipeline>(config, frappe::Pipeline::Mode::Frames);
 	} catch (const std::exception &e) {
 		GST_ELEMENT_ERROR(self, LIBRARY, SETTINGS, ("Invalid detector settings"), ("%s", e.what()));
 		return false;
 	}
-	if (!select_front_end(self, *priv->detector)) {
-		priv->detector.reset();
-		return false;
+	for (int i = 0; i < priv->pipeline->detectorCount(); ++i) {
+		if (!select_front_end(self, priv->pipeline->detector(i))) {
+			priv->pipeline.reset();
+			return false;
+		}
 	}
-	GST_DEBUG_OBJECT(self, "detector for %s, mode %s, max-hamming %d, front end %s",
-			 config.dictionary.c_str(),
-			 config.mode == frappe::Mode::AScale ? "ascale" : "normal",
-			 priv->detector->maxHamming(), priv->detector->frontEnd().name());
+	priv->held.reserve(static_cast<std::size_t>(priv->pipeline->latency()) + 1);
+	GST_DEBUG_OBJECT(self, "pipeline for %s, mode %s, max-hamming %d, front end %s, %d thread(s)",
+			 config.dictionary.c_str(), config.mode == frappe::Mode::AScale ? "ascale" : "normal",
+			 priv->pipeline->detector().maxHamming(), priv->pipeline->detector().frontEnd().name(),
+			 priv->pipeline->threads());
 	return true;
 }
 
@@ -208,14 +214,14 @@ static void update_stats(GstFrappeDetect *self, const frappe::Result &result, do
 {
 	FrappeDetectPrivate *priv = self->priv;
 	GstStructure *s = frappe::gst::statsStructure(priv->frames, result, poseMs,
-						      priv->detector ? priv->detector->frontEnd().name() : "cpu",
+						      priv->pipeline->detector().frontEnd().name(),
 						      priv->active.pipelined);
 
 	GST_LOG_OBJECT(self, "stats %" GST_PTR_FORMAT, static_cast<void *>(s));
 
 	if (const auto line = priv->window.add(priv->frames, result, poseMs))
 		GST_INFO_OBJECT(self, "last 100 frames, ms per frame: %s%s", line->c_str(),
-				priv->active.pipelined ? " (front end overlapped with the back end)" : "");
+				priv->active.pipelined ? " (two frames at once)" : "");
 	GST_OBJECT_LOCK(self);
 	if (priv->stats)
 		gst_structure_free(priv->stats);
@@ -223,21 +229,22 @@ static void update_stats(GstFrappeDetect *self, const frappe::Result &result, do
 	GST_OBJECT_UNLOCK(self);
 }
 
+/* A frame whose detection failed: an element error, pipelined or not, and
+ * the buffer is dropped. */
+static GstFlowReturn fail(GstFrappeDetect *self, MappedFrame &f, const char *why)
+{
+	GST_ELEMENT_ERROR(self, STREAM, FAILED, ("Marker detection failed"), ("%s", why));
+	f.discard();
+	return GST_FLOW_ERROR;
+}
+
 /* Attaches metas, draws, posts the message and releases the frame; the
- * buffer goes to the output list. A back end that failed is an element
- * error, pipelined or not, and the buffer is dropped. */
-static GstFlowReturn finish(GstFrappeDetect *self, InFlight &f)
+ * buffer goes to the output list. */
+static void finish(GstFrappeDetect *self, MappedFrame &f, const frappe::Result &result)
 {
 	FrappeDetectPrivate *priv = self->priv;
 	const Settings &s = priv->active;
-
-	if (!f.error.empty() || !f.result) {
-		GST_ELEMENT_ERROR(self, STREAM, FAILED, ("Marker detection failed"), ("%s", f.error.c_str()));
-		f.discard();
-		return GST_FLOW_ERROR;
-	}
-	const frappe::Result &result = *f.result;
-	const std::string dictName(priv->detector->dictionary().name);
+	const std::string dictName(priv->pipeline->detector().dictionary().name);
 
 	const gint64 t0 = g_get_monotonic_time();
 	const frappe::gst::Poses poses = frappe::gst::estimatePoses(result.markers, s.markerSize, s.camera);
@@ -248,47 +255,71 @@ static GstFlowReturn finish(GstFrappeDetect *self, InFlight &f)
 	if (f.writable && s.annotate && !result.markers.empty())
 		frappe::gst::annotateMarkers(&f.frame, result, poses, s.markerSize, s.camera);
 
-	gst_video_frame_unmap(&f.frame);
+	GstBuffer *buffer = f.release();
 
 	if (s.postMessages) {
-		GstStructure *msg = frappe::gst::frameMessage(f.buffer, GST_BASE_TRANSFORM(self)->segment, result,
+		GstStructure *msg = frappe::gst::frameMessage(buffer, GST_BASE_TRANSFORM(self)->segment, result,
 							      poses, dictName.c_str());
 		gst_element_post_message(GST_ELEMENT(self), gst_message_new_element(GST_OBJECT(self), msg));
 	}
 
 	++priv->frames;
 	GST_LOG_OBJECT(self, "frame %" G_GUINT64_FORMAT " pts %" GST_TIME_FORMAT ": %zu markers in %.3f ms",
-		       priv->frames, GST_TIME_ARGS(GST_BUFFER_PTS(f.buffer)), result.markers.size(),
+		       priv->frames, GST_TIME_ARGS(GST_BUFFER_PTS(buffer)), result.markers.size(),
 		       result.times.total_ms + poseMs);
 	update_stats(self, result, poseMs);
 
-	priv->output.push_back(f.buffer);
-	f.buffer = nullptr;
+	priv->output.push_back(buffer);
+}
+
+/* Finishes the oldest held frame with what the pipeline returned for it
+ * (push() or flush()), or fails it when that threw. */
+static GstFlowReturn finish_oldest(GstFrappeDetect *self, const frappe::Result *result, const std::string &error)
+{
+	FrappeDetectPrivate *priv = self->priv;
+	MappedFrame f = priv->held.front();
+	priv->held.erase(priv->held.begin());
+	if (!error.empty())
+		return fail(self, f, error.c_str());
+	finish(self, f, *result);
 	return GST_FLOW_OK;
 }
 
-/* Waits for the held frame's back end and finishes it. */
+/* Finishes every held frame, in order; an error is returned once all are
+ * out of the pipeline. */
 static GstFlowReturn finish_held(GstFrappeDetect *self)
 {
 	FrappeDetectPrivate *priv = self->priv;
-	if (!priv->held)
-		return GST_FLOW_OK;
-	priv->worker.wait();
-	const GstFlowReturn ret = finish(self, *priv->held);
-	priv->held.reset();
+	GstFlowReturn ret = GST_FLOW_OK;
+	while (!priv->held.empty()) {
+		const frappe::Result *result = nullptr;
+		std::string error;
+		try {
+			result = priv->pipeline->flush();
+			if (!result)
+				error = "the pipeline lost a frame"; /* not reached */
+		} catch (const std::exception &e) {
+			error = e.what();
+		}
+		const GstFlowReturn r = finish_oldest(self, result, error);
+		if (ret == GST_FLOW_OK)
+			ret = r;
+	}
 	return ret;
 }
 
-/* Throws the held frame away (flush, stop). */
+/* Throws the held frames away (flush, stop). */
 static void drop_held(GstFrappeDetect *self)
 {
 	FrappeDetectPrivate *priv = self->priv;
-	if (!priv->held)
+	if (priv->held.empty())
 		return;
-	priv->worker.wait();
-	GST_DEBUG_OBJECT(self, "dropping held %" GST_PTR_FORMAT, static_cast<void *>(priv->held->buffer));
-	priv->held->discard();
-	priv->held.reset();
+	priv->pipeline->drop(); /* waits for the frames running */
+	for (MappedFrame &f : priv->held) {
+		GST_DEBUG_OBJECT(self, "dropping held %" GST_PTR_FORMAT, static_cast<void *>(f.buffer));
+		f.discard();
+	}
+	priv->held.clear();
 }
 
 static void clear_output(GstFrappeDetect *self)
@@ -298,7 +329,7 @@ static void clear_output(GstFrappeDetect *self)
 	self->priv->output.clear();
 }
 
-/* Pushes the held frame and anything waiting (serialized events). */
+/* Pushes the held frames and anything waiting (serialized events). */
 static GstFlowReturn drain(GstFrappeDetect *self)
 {
 	FrappeDetectPrivate *priv = self->priv;
@@ -317,7 +348,8 @@ static GstFlowReturn drain(GstFrappeDetect *self)
 	return ret != GST_FLOW_OK ? ret : held;
 }
 
-/* Picks up property changes; may finish the held frame first. */
+/* Picks up property changes; a new pipeline finishes the held frames of
+ * the old one first. */
 static GstFlowReturn apply_settings(GstFrappeDetect *self)
 {
 	FrappeDetectPrivate *priv = self->priv;
@@ -325,15 +357,15 @@ static GstFlowReturn apply_settings(GstFrappeDetect *self)
 	Settings next = priv->props;
 	GST_OBJECT_UNLOCK(self);
 
-	const bool rebuild = !next.sameDetector(priv->active);
 	const bool pipelineChange = next.pipelined != priv->active.pipelined;
+	const bool rebuild = !next.samePipeline(priv->active);
 	GstFlowReturn ret = GST_FLOW_OK;
-	if (rebuild || pipelineChange)
+	if (rebuild)
 		ret = finish_held(self);
 	priv->active = next;
-	if (rebuild && priv->detector) {
-		GST_DEBUG_OBJECT(self, "settings changed, rebuilding the detector");
-		priv->detector.reset();
+	if (rebuild && priv->pipeline) {
+		GST_DEBUG_OBJECT(self, "settings changed, rebuilding the pipeline");
+		priv->pipeline.reset();
 	}
 	if (pipelineChange) {
 		GST_DEBUG_OBJECT(self, "pipelined now %d", next.pipelined);
@@ -367,17 +399,18 @@ static void log_memory(GstFrappeDetect *self, GstBuffer *buffer)
 	}
 }
 
+/* Pushes the buffer into the pipeline and finishes the one it returns
+ * (itself when not pipelined, the held one when pipelined). */
 static GstFlowReturn process(GstFrappeDetect *self, GstBuffer *input)
 {
 	FrappeDetectPrivate *priv = self->priv;
-	GstVideoFilter *filter = GST_VIDEO_FILTER(self);
 
 	GstFlowReturn ret = apply_settings(self);
 	if (ret != GST_FLOW_OK) {
 		gst_buffer_unref(input);
 		return ret;
 	}
-	if (!ensure_detector(self)) {
+	if (!ensure_pipeline(self)) {
 		gst_buffer_unref(input);
 		return GST_FLOW_NOT_NEGOTIATED;
 	}
@@ -387,59 +420,30 @@ static GstFlowReturn process(GstFrappeDetect *self, GstBuffer *input)
 	GstBuffer *buffer = gst_buffer_make_writable(input);
 	log_memory(self, buffer);
 
-	InFlight f;
-	f.buffer = buffer;
-	f.writable = priv->active.annotate;
-	/* NO_REF: a mapped frame holding a second ref would make the buffer
-	 * read-only for the metas; we own the buffer until it is pushed. */
-	const auto flags = static_cast<GstMapFlags>(static_cast<int>(f.writable ? GST_MAP_READWRITE : GST_MAP_READ) |
-						    static_cast<int>(GST_VIDEO_FRAME_MAP_FLAG_NO_REF));
-	if (!gst_video_frame_map(&f.frame, &filter->in_info, buffer, flags)) {
-		gst_buffer_unref(buffer);
+	MappedFrame f;
+	if (!f.map(buffer, &GST_VIDEO_FILTER(self)->in_info, priv->active.annotate)) {
 		GST_ELEMENT_ERROR(self, STREAM, FAILED, ("Could not map the video frame"), (nullptr));
 		return GST_FLOW_ERROR;
 	}
-	f.image = frappe::ImageView(static_cast<const std::uint8_t *>(GST_VIDEO_FRAME_COMP_DATA(&f.frame, 0)),
-				    GST_VIDEO_FRAME_COMP_WIDTH(&f.frame, 0),
-				    GST_VIDEO_FRAME_COMP_HEIGHT(&f.frame, 0),
-				    GST_VIDEO_FRAME_COMP_STRIDE(&f.frame, 0));
-
-	frappe::Detector &detector = *priv->detector;
-	const bool pipelined = priv->active.pipelined;
 	try {
-		if (!pipelined) {
-			detector.runFrontEnd(f.image, 0);
-			f.result = &detector.runBackEnd(f.image, 0);
-		} else {
-			f.slot = priv->held ? 1 - priv->held->slot : 0;
-			/* Overlaps the held back end. In AScale mode the scale comes
-			 * from the last frame finished before this front end starts
-			 * (frappe-core locks that hand-over), as on live video. */
-			detector.runFrontEnd(f.image, f.slot);
-		}
+		priv->pipeline->detector().checkImage(f.image);
 	} catch (const std::exception &e) {
-		f.error = e.what();
+		return fail(self, f, e.what());
 	}
-	if (!pipelined || !f.error.empty())
-		return finish(self, f);
 
-	ret = finish_held(self);
-	if (ret != GST_FLOW_OK) {
-		f.discard();
-		return ret;
+	/* In the pipeline now: any exception of push() is the oldest frame's
+	 * (in AScale mode a frame scales from the last one its detector ran). */
+	priv->held.push_back(f);
+	const frappe::Result *result = nullptr;
+	std::string error;
+	try {
+		result = priv->pipeline->push(f.image);
+	} catch (const std::exception &e) {
+		error = e.what();
 	}
-	priv->held = std::move(f);
-	InFlight *h = &*priv->held;
-	frappe::Detector *d = &detector;
-	priv->worker.submit([h, d] {
-		try {
-			h->result = &d->runBackEnd(h->image, h->slot);
-		} catch (const std::exception &e) {
-			h->error = e.what();
-			h->result = nullptr;
-		}
-	});
-	return GST_FLOW_OK;
+	if (!result && error.empty())
+		return GST_FLOW_OK; /* held */
+	return finish_oldest(self, result, error);
 }
 
 /* -------------------------------------------------------------------------
@@ -477,7 +481,7 @@ static gboolean gst_frappe_detect_sink_event(GstBaseTransform *trans, GstEvent *
 	case GST_EVENT_STREAM_START:
 	case GST_EVENT_GAP:
 		/* The held buffer belongs before this event. */
-		if (self->priv->held || !self->priv->output.empty()) {
+		if (!self->priv->held.empty() || !self->priv->output.empty()) {
 			GST_DEBUG_OBJECT(self, "draining before %s", GST_EVENT_TYPE_NAME(event));
 			drain(self);
 		}
@@ -485,8 +489,8 @@ static gboolean gst_frappe_detect_sink_event(GstBaseTransform *trans, GstEvent *
 	case GST_EVENT_FLUSH_STOP:
 		drop_held(self);
 		clear_output(self);
-		if (self->priv->detector)
-			self->priv->detector->reset();
+		if (self->priv->pipeline)
+			self->priv->pipeline->reset();
 		break;
 	default:
 		break;
@@ -501,7 +505,7 @@ static gboolean gst_frappe_detect_query(GstBaseTransform *trans, GstPadDirection
 	/* Upstream wants its buffers back (e.g. to change its pool): push the
 	 * held one. DRAIN is serialized, so this is the streaming thread. */
 	if (direction == GST_PAD_SINK && GST_QUERY_TYPE(query) == GST_QUERY_DRAIN &&
-	    (self->priv->held || !self->priv->output.empty())) {
+	    (!self->priv->held.empty() || !self->priv->output.empty())) {
 		GST_DEBUG_OBJECT(self, "draining for a DRAIN query");
 		drain(self);
 	}
@@ -580,8 +584,7 @@ static gboolean gst_frappe_detect_stop(GstBaseTransform *trans)
 	GstFrappeDetect *self = GST_FRAPPE_DETECT(trans);
 	drop_held(self);
 	clear_output(self);
-	self->priv->worker.stop();
-	self->priv->detector.reset();
+	self->priv->pipeline.reset();
 	return TRUE;
 }
 

@@ -69,13 +69,13 @@ void getDoubleArray(GValue *value, const double *v, std::size_t n)
 
 } /* namespace */
 
-bool Settings::sameDetector(const Settings &o) const
+bool Settings::samePipeline(const Settings &o) const
 {
 	return dictionary == o.dictionary && mode == o.mode && edgeThreshold == o.edgeThreshold &&
 	       cornerThreshold == o.cornerThreshold && regionContrast == o.regionContrast &&
 	       maxHamming == o.maxHamming &&
 	       scaledSize == o.scaledSize && maxScaledFrames == o.maxScaledFrames &&
-	       backend == o.backend;
+	       backend == o.backend && pipelined == o.pipelined;
 }
 
 frappe::Config Settings::config() const
@@ -91,7 +91,7 @@ frappe::Config Settings::config() const
 	config.max_hamming = std::min(maxHamming, dict.bits * dict.bits / 2);
 	config.scaled_size = scaledSize;
 	config.max_scaled_frames = maxScaledFrames;
-	config.threads = 1;
+	config.threads = pipelined ? 2 : 1; /* whole frames on two threads */
 	return config;
 }
 
@@ -165,7 +165,7 @@ void installProperties(GObjectClass *gobject_class)
 	g_object_class_install_property(
 		gobject_class, PROP_PIPELINED,
 		g_param_spec_boolean("pipelined", "Pipelined",
-				     "Overlap the front end of the next frame with the back end of this one "
+				     "Detect two frames at once on two threads "
 				     "(holds one buffer: one frame of extra latency)",
 				     defaults.pipelined, live));
 	g_object_class_install_property(

@@ -56,11 +56,11 @@ struct Settings {
 	gdouble markerSize = 0.0; /* no pose */
 	Camera camera;
 
-	/* Whether a change between two settings needs a new Detector. */
-	bool sameDetector(const Settings &o) const;
+	/* Whether a change between two settings needs a new Pipeline. */
+	bool samePipeline(const Settings &o) const;
 
-	/* The detector's configuration: one thread, max-hamming clamped to
-	 * what the dictionary allows. */
+	/* The pipeline's configuration: one thread, or two when pipelined;
+	 * max-hamming clamped to what the dictionary allows. */
 	frappe::Config config() const;
 };
 

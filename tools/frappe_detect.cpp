@@ -35,7 +35,10 @@ const char kUsage[] =
 	"options:\n"
 	"  -d, --dictionary NAME   marker family (default aruco_mip_36h12); see --dictionaries\n"
 	"      --mode MODE         normal (default) or ascale (adaptive scaling over a sequence)\n"
-	"      --threads T         1 = single thread (default), 0 = one per core\n"
+	"      --threads T         images detected at once, each on a thread of its own:\n"
+	"                          1 (default), 0 = one per core; time_ms is then each\n"
+	"                          image's own detection time, and the images per second\n"
+	"                          of the whole list go to standard error\n"
 	"      --edge-threshold E  Sobel magnitude for an edge, intensities in [0,1] (default 0.27)\n"
 	"      --corner-threshold C  Shi-Tomasi threshold for a corner (default 0.19)\n"
 	"      --region-contrast R  contrast for the dark-region candidates that find blurred\n"
@@ -230,26 +233,108 @@ double median(std::vector<double> v)
 	return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
+/* The pipeline of the options, with the chosen front end on each of its
+ * detectors; throws std::runtime_error saying what went wrong. */
+std::unique_ptr<frappe::Pipeline> makePipeline(const Options &opt)
+{
+	auto pipeline = std::make_unique<frappe::Pipeline>(opt.config, frappe::Pipeline::Mode::Frames);
+	for (int i = 0; i < pipeline->detectorCount(); ++i) {
+		std::string fallback;
+		try {
+			fallback = frappe::selectBackend(pipeline->detector(i), opt.backend, 1);
+		} catch (const frappe::BackendNotBuilt &) {
+			throw std::runtime_error("backend " + opt.backend + " needs the vc4 part, which this build lacks");
+		} catch (const std::exception &e) {
+			throw std::runtime_error("backend " + opt.backend + " cannot be used: " + e.what());
+		}
+		if (!fallback.empty() && i == 0)
+			std::cerr << "frappe-detect: the QPUs cannot be used (" << fallback
+				  << "); using the CPU front end\n";
+	}
+	return pipeline;
+}
+
+/* Runs every readable frame `repeat` times through the pipeline, in order.
+ * With one thread each push runs its frame, and time_ms is the wall time
+ * of those pushes; with more, frames overlap and time_ms is each frame's
+ * own detection time (the sum of its stages). */
+void detectAll(frappe::Pipeline &pipeline, std::vector<Frame> &frames, int repeat)
+{
+	using Clock = std::chrono::steady_clock;
+	const bool serial = pipeline.latency() == 0;
+	std::vector<std::size_t> order; /* frame of each push still in flight */
+	std::vector<std::vector<double>> times(frames.size());
+	std::size_t detected = 0;
+	auto take = [&](const frappe::Result *res, double wallMs) {
+		Frame &f = frames[order.front()];
+		times[order.front()].push_back(serial ? wallMs : res->times.total_ms);
+		f.markers = res->markers;
+		f.times = res->times;
+		order.erase(order.begin());
+		++detected;
+	};
+	auto fail = [&](const std::exception &e) {
+		/* The oldest frame in flight failed: the next result is the
+		 * following push's. */
+		Frame &f = frames[order.front()];
+		f.error = e.what();
+		std::cerr << "frappe-detect: " << f.path << ": " << f.error << "\n";
+		order.erase(order.begin());
+	};
+
+	const auto t0 = Clock::now();
+	for (std::size_t i = 0; i < frames.size(); ++i) {
+		Frame &f = frames[i];
+		if (!f.error.empty())
+			continue;
+		const frappe::ImageView view(f.gray.data, f.gray.cols, f.gray.rows, static_cast<int>(f.gray.step[0]));
+		for (int r = 0; r < repeat; ++r) {
+			try {
+				pipeline.detector().checkImage(view);
+			} catch (const std::exception &e) {
+				f.error = e.what();
+				std::cerr << "frappe-detect: " << f.path << ": " << f.error << "\n";
+				break;
+			}
+			order.push_back(i);
+			try {
+				const auto p0 = Clock::now();
+				const frappe::Result *res = pipeline.push(view);
+				if (res)
+					take(res, std::chrono::duration<double, std::milli>(Clock::now() - p0).count());
+			} catch (const std::exception &e) {
+				fail(e);
+			}
+		}
+	}
+	for (;;) {
+		try {
+			const frappe::Result *res = pipeline.flush();
+			if (!res)
+				break;
+			take(res, 0.0);
+		} catch (const std::exception &e) {
+			fail(e);
+		}
+	}
+	const double wall = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+	for (std::size_t i = 0; i < frames.size(); ++i)
+		if (frames[i].error.empty() && !times[i].empty())
+			frames[i].ms = median(times[i]);
+	if (!serial && detected > 0)
+		std::fprintf(stderr, "frappe-detect: %zu detections on %d threads in %.1f ms: %.1f per second\n",
+			     detected, pipeline.threads(), wall, 1000.0 * static_cast<double>(detected) / wall);
+}
+
 } // namespace
 
 int main(int argc, char **argv)
 {
 	Options opt = parse(argc, argv);
 
-	std::unique_ptr<Detector> detector;
+	std::unique_ptr<frappe::Pipeline> pipeline;
 	try {
-		detector = std::make_unique<Detector>(opt.config);
-		std::string fallback;
-		try {
-			fallback = frappe::selectBackend(*detector, opt.backend, opt.config.threads);
-		} catch (const frappe::BackendNotBuilt &) {
-			throw std::runtime_error("backend " + opt.backend + " needs the vc4 part, which this build lacks");
-		} catch (const std::exception &e) {
-			throw std::runtime_error("backend " + opt.backend + " cannot be used: " + e.what());
-		}
-		if (!fallback.empty())
-			std::cerr << "frappe-detect: the QPUs cannot be used (" << fallback
-				  << "); using the CPU front end\n";
+		pipeline = makePipeline(opt);
 	} catch (const std::exception &e) {
 		std::cerr << "frappe-detect: " << e.what() << "\n";
 		return 2;
@@ -280,35 +365,26 @@ int main(int argc, char **argv)
 			std::cerr << "frappe-detect: " << f.error << "\n";
 	}
 
-	using Clock = std::chrono::steady_clock;
-	bool warmed = false;
-	for (Frame &f : frames) {
-		if (!f.error.empty())
-			continue;
-		const frappe::ImageView view(f.gray.data, f.gray.cols, f.gray.rows, static_cast<int>(f.gray.step[0]));
-		try {
-			if (!warmed && opt.repeat > 1) {
-				detector->detect(view);
-				detector->reset();
-			}
-			warmed = true;
-			std::vector<double> times;
-			times.reserve(opt.repeat);
-			for (int r = 0; r < opt.repeat; ++r) {
-				const auto t0 = Clock::now();
-				const frappe::Result &res = detector->detect(view);
-				times.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
-				if (r == opt.repeat - 1) {
-					f.markers = res.markers;
-					f.times = res.times;
+	/* Buffers and threads warm before timing, on the first good image. */
+	if (opt.repeat > 1) {
+		for (const Frame &f : frames) {
+			if (!f.error.empty())
+				continue;
+			const frappe::ImageView view(f.gray.data, f.gray.cols, f.gray.rows,
+						     static_cast<int>(f.gray.step[0]));
+			try {
+				for (int i = 0; i < pipeline->threads(); ++i)
+					pipeline->push(view);
+				while (pipeline->flush()) {
 				}
+			} catch (const std::exception &) {
+				/* the timed run reports it */
 			}
-			f.ms = median(times);
-		} catch (const std::exception &e) {
-			f.error = e.what();
-			std::cerr << "frappe-detect: " << f.path << ": " << f.error << "\n";
+			pipeline->reset();
+			break;
 		}
 	}
+	detectAll(*pipeline, frames, opt.repeat);
 
 	bool anyError = false;
 	std::ofstream out;
@@ -329,7 +405,7 @@ int main(int argc, char **argv)
 			std::cout << jsonLine(f.path, f.markers, f.ms, f.error) << "\n";
 		} else if (f.error.empty()) {
 			std::printf("%s: %zu marker%s (%s) in %.2f ms\n", f.path.c_str(), f.markers.size(),
-				    f.markers.size() == 1 ? "" : "s", std::string(detector->dictionary().name).c_str(), f.ms);
+				    f.markers.size() == 1 ? "" : "s", std::string(pipeline->detector().dictionary().name).c_str(), f.ms);
 			for (const Marker &m : f.markers) {
 				std::printf("  id %4d  hamming %d  margin %.2f  corners", m.id, m.hamming, m.margin);
 				for (const auto &p : m.corners)

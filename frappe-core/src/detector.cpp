@@ -14,6 +14,7 @@
 #include "contour_trace.h"
 #include "corner_refine.h"
 #include "decode.h"
+#include "detector_stages.h"
 #include "front_end_rows.h"
 #include "marker_set.h"
 #include "quad_geometry.h"
@@ -174,10 +175,10 @@ struct FRAPPE_HIDDEN Detector::Impl {
 		std::vector<detail::Quad> quads;
 		Result result;
 	};
-	Slot slots[kSlots];
+	Slot slots[detail::DetectorStages::kSlots];
 
 	/* Used by one stage each, so that stages of different slots can run
-	 * at once: the tracer by runTrace(), the warp buffer by runFinish(). */
+	 * at once: the tracer by trace(), the warp buffer by finish(). */
 	detail::ContourTracer tracer;
 	detail::ContourTracer regionTracer;
 	std::vector<detail::Quad> regionQuads;
@@ -199,7 +200,7 @@ struct FRAPPE_HIDDEN Detector::Impl {
 	int blockSizedW = 0, blockSizedH = 0;
 	std::uint64_t finishedFrames = 0;
 	BlockView blockView(const ImageView &image, int f, const std::array<Point2f, 4> &outline, float margin);
-	/* With a batch warper (runFinish() only): per candidate its traced
+	/* With a batch warper (finish() only): per candidate its traced
 	 * outline, whether it refined, and its place in the warped batch (-1
 	 * when not warped); per warped candidate its corners and samples. */
 	struct Batch {
@@ -247,8 +248,9 @@ struct FRAPPE_HIDDEN Detector::Impl {
 	}
 	const Slot &slotAt(int slot) const
 	{
-		if (slot < 0 || slot >= kSlots)
-			throw std::invalid_argument("frappe::Detector: slot must be 0.." + std::to_string(kSlots - 1));
+		constexpr int n = detail::DetectorStages::kSlots;
+		if (slot < 0 || slot >= n)
+			throw std::invalid_argument("frappe::Detector: slot must be 0.." + std::to_string(n - 1));
 		return slots[slot];
 	}
 };
@@ -672,15 +674,17 @@ Detector &Detector::operator=(Detector &&) noexcept = default;
 
 const Result &Detector::detect(const ImageView &image)
 {
-	runFrontEnd(image, 0);
-	return runBackEnd(image, 0);
+	detail::DetectorStages::frontEnd(*this, image, 0);
+	return detail::DetectorStages::backEnd(*this, image, 0);
 }
 
-void Detector::runFrontEnd(const ImageView &image, int slot)
+namespace detail {
+
+void DetectorStages::frontEnd(Detector &detector, const ImageView &image, int slot)
 {
-	Impl &d = *impl_;
+	Detector::Impl &d = *detector.impl_;
 	d.checkImage(image);
-	Impl::Slot &s = d.slotAt(slot);
+	Detector::Impl::Slot &s = d.slotAt(slot);
 	s.result.times = {};
 	StageTimer timer(s.result.times, Stage::AdaptiveScale);
 	float scale;
@@ -704,22 +708,16 @@ void Detector::runFrontEnd(const ImageView &image, int slot)
 	s.result.scale = s.edges.scale;
 }
 
-const Result &Detector::runBackEnd(const ImageView &image, int slot)
+void DetectorStages::trace(Detector &detector, int slot)
 {
-	runTrace(slot);
-	return runFinish(image, slot);
-}
-
-void Detector::runTrace(int slot)
-{
-	Impl &d = *impl_;
+	Detector::Impl &d = *detector.impl_;
 	d.trace(d.slotAt(slot));
 }
 
-const Result &Detector::runFinish(const ImageView &image, int slot)
+const Result &DetectorStages::finish(Detector &detector, const ImageView &image, int slot)
 {
-	Impl &d = *impl_;
-	Impl::Slot &s = d.slotAt(slot);
+	Detector::Impl &d = *detector.impl_;
+	Detector::Impl::Slot &s = d.slotAt(slot);
 	d.finish(image, s);
 	{
 		std::lock_guard<std::mutex> lock(d.adaptiveLock);
@@ -731,6 +729,8 @@ const Result &Detector::runFinish(const ImageView &image, int slot)
 	s.result.times.total_ms = total;
 	return s.result;
 }
+
+} // namespace detail
 
 void Detector::checkImage(const ImageView &image) const
 {
@@ -747,7 +747,7 @@ void Detector::setFrontEnd(std::unique_ptr<FrontEnd> frontEnd)
 const FrontEnd &Detector::frontEnd() const { return *impl_->frontEnd; }
 void Detector::setWarper(std::unique_ptr<CandidateWarper> warper) { impl_->warper = std::move(warper); }
 const CandidateWarper *Detector::warper() const { return impl_->warper.get(); }
-const EdgeMap &Detector::edgeMap(int slot) const { return impl_->slotAt(slot).edges; }
+const EdgeMap &Detector::edgeMap() const { return impl_->slots[0].edges; }
 void Detector::reset()
 {
 	std::lock_guard<std::mutex> lock(impl_->adaptiveLock);

@@ -1,65 +1,90 @@
 // SPDX-License-Identifier: MIT
-// Two threads over a stream. Stages: each call runs the front end of the new
-// frame and the finish (refine, warp, decode) of the oldest on the worker,
-// while the caller traces the frame in between. Frames: whole frames from a
-// queue, taken by a worker with its own detector as soon as it is free, and
-// by the caller only when it must return a frame that nobody has started.
+// Frames over several threads, results in order. Frames: whole frames from
+// a ring, each taken by an idle worker with its own detector as soon as it
+// is pushed, and by the caller only when it must return a frame nobody has
+// started. Stages: each call runs the front end of the new frame and the
+// finish (refine, warp, decode) of the oldest on the worker, while the
+// caller traces the frame in between.
 #include "frappe/pipeline.h"
 
+#include <algorithm>
 #include <condition_variable>
 #include <exception>
 #include <mutex>
+#include <stdexcept>
+#include <string>
+#include <thread>
 #include <utility>
+#include <vector>
 
+#include "detector_stages.h"
 #include "worker.h"
 
 namespace frappe {
 
 namespace detail {
 
-/// Mode::Frames. Frames wait in a ring; the worker drains it with its own
-/// detector and runs on after push() returns; the caller runs a frame only
-/// when the result it must return belongs to a frame nobody has started.
-/// Results come out kLatency frames late, in order; each frame's Result is
-/// copied into the ring (its vectors keep their capacity, so nothing is
-/// allocated once warm) and swapped out to `returned_`.
+namespace {
+
+/* config.threads as a thread count: 0 is one per core. The detectors are
+ * made with one thread each, so the range is checked here. */
+int threadCount(const Config &config)
+{
+	if (config.threads < 0 || config.threads > 256)
+		throw std::invalid_argument("frappe::Config: threads must be in [0, 256], got " +
+					    std::to_string(config.threads));
+	if (config.threads > 0)
+		return config.threads;
+	return static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+}
+
+} // namespace
+
+/// Mode::Frames. Frames wait in a ring of latency + 1 entries; each idle
+/// worker drains it with its own detector and runs on after push() returns;
+/// the caller runs a frame only when the result it must return belongs to
+/// a frame nobody has started. Each frame's Result is copied into the ring
+/// (its vectors keep their capacity, so nothing is allocated once warm) and
+/// swapped out to `returned_`.
 class FrameQueue
 {
 public:
-	static constexpr int kLatency = 2;
-
-	FrameQueue(const Config &config, Detector &mine, Worker &worker)
-		: mine_(mine), theirs_(config), worker_(worker)
+	FrameQueue(const Config &config, int threads) : latency_(threads - 1), ring_(static_cast<std::size_t>(threads))
 	{
+		Config single = config;
+		single.threads = 1; /* the threads are here, not in the bands */
+		for (int i = 0; i < threads; ++i)
+			detectors_.push_back(std::make_unique<Detector>(single));
+		for (int i = 1; i < threads; ++i)
+			helpers_.push_back(std::make_unique<Helper>(this, *detectors_[static_cast<std::size_t>(i)]));
 	}
 	~FrameQueue()
 	{
-		{
-			std::lock_guard<std::mutex> guard(lock_);
-			stopping_ = true; /* the worker takes no new frame */
-		}
-		worker_.wait(); /* returns at once when nothing was posted */
+		stopHelpers(); /* before the detectors they use go */
 	}
 
 	const Result *push(const ImageView &image)
 	{
-		bool start = false;
+		Helper *start = nullptr;
 		{
 			std::lock_guard<std::mutex> guard(lock_);
-			Entry &e = ring_[(head_ + count_) % kRing];
+			Entry &e = at(count_);
 			e.image = image;
 			e.state = State::Waiting;
 			++count_;
-			if (!draining_) {
-				draining_ = true;
-				start = true;
+			for (auto &h : helpers_) {
+				if (!h->draining) {
+					h->draining = true;
+					start = h.get();
+					break;
+				}
 			}
 		}
 		if (start) {
-			worker_.wait(); /* its last drain has returned or is returning */
-			worker_.post(drain_);
+			start->worker.wait(); /* its last drain has returned or is returning */
+			start->worker.post(*start);
 		}
-		return count_ > kLatency ? pop(kLatency) : nullptr;
+		return pop(latency_);
 	}
 
 	/* The oldest frame's result once more than `keep` frames are in
@@ -69,7 +94,7 @@ public:
 		std::unique_lock<std::mutex> guard(lock_);
 		if (count_ <= keep)
 			return nullptr;
-		Entry &oldest = ring_[head_];
+		Entry &oldest = at(0);
 		while (oldest.state != State::Done) {
 			Entry *next = nextWaiting();
 			if (!next) {
@@ -78,15 +103,27 @@ public:
 			}
 			next->state = State::Running;
 			guard.unlock();
-			run(mine_, *next);
+			run(*detectors_[0], *next);
 			guard.lock();
 		}
 		std::swap(returned_, oldest.result);
-		head_ = (head_ + 1) % kRing;
+		const std::exception_ptr failed = std::exchange(oldest.failure, nullptr);
+		head_ = (head_ + 1) % ring_.size();
 		--count_;
-		if (failure_)
-			std::rethrow_exception(std::exchange(failure_, nullptr));
+		if (failed)
+			std::rethrow_exception(failed);
 		return &returned_;
+	}
+
+	void drop()
+	{
+		stopHelpers();
+		std::lock_guard<std::mutex> guard(lock_);
+		for (Entry &e : ring_)
+			e.failure = nullptr;
+		head_ = 0;
+		count_ = 0;
+		stopping_ = false;
 	}
 
 	bool pending() const
@@ -95,28 +132,57 @@ public:
 		return count_ > 0;
 	}
 
+	int latency() const { return latency_; }
+	int detectorCount() const { return static_cast<int>(detectors_.size()); }
+	Detector &detector(int index) { return *detectors_.at(static_cast<std::size_t>(index)); }
+
 private:
 	enum class State { Waiting, Running, Done };
 	struct Entry {
 		ImageView image;
 		Result result;
 		State state = State::Done;
+		std::exception_ptr failure; /* thrown when the entry is popped */
 	};
-	static constexpr int kRing = kLatency + 1;
+
+	/* A worker thread with its detector; the task it runs drains the ring
+	 * until no frame waits. */
+	struct Helper {
+		Helper(FrameQueue *queue, Detector &det) : q(queue), detector(det) {}
+		void operator()()
+		{
+			std::unique_lock<std::mutex> guard(q->lock_);
+			for (;;) {
+				Entry *e = q->stopping_ ? nullptr : q->nextWaiting();
+				if (!e) {
+					draining = false;
+					return;
+				}
+				e->state = State::Running;
+				guard.unlock();
+				q->run(detector, *e);
+				guard.lock();
+			}
+		}
+		FrameQueue *q;
+		Detector &detector;
+		bool draining = false; /* under the queue's lock */
+		Worker worker;
+	};
+
+	Entry &at(int i) { return ring_[(head_ + static_cast<std::size_t>(i)) % ring_.size()]; }
 
 	/* The oldest frame nobody has started; lock held. */
 	Entry *nextWaiting()
 	{
-		for (int i = 0; i < count_; ++i) {
-			Entry &e = ring_[(head_ + i) % kRing];
-			if (e.state == State::Waiting)
-				return &e;
-		}
+		for (int i = 0; i < count_; ++i)
+			if (at(i).state == State::Waiting)
+				return &at(i);
 		return nullptr;
 	}
 
 	/* Runs one frame, lock not held; a frame that fails (out of memory)
-	 * comes out with no markers and the error is thrown by the pop. */
+	 * keeps its exception for its pop. */
 	void run(Detector &detector, Entry &e)
 	{
 		std::exception_ptr failed;
@@ -128,175 +194,213 @@ private:
 		std::lock_guard<std::mutex> guard(lock_);
 		if (failed) {
 			e.result.markers.clear();
-			failure_ = failed;
+			e.failure = failed;
 		}
 		e.state = State::Done;
 		done_.notify_all();
 	}
 
-	/* The worker's task: frames until none waits. */
-	struct Drain {
-		FrameQueue *q;
-		void operator()() const
+	/* Lets the helpers finish the frames they run and take no new one. */
+	void stopHelpers()
+	{
 		{
-			std::unique_lock<std::mutex> guard(q->lock_);
-			for (;;) {
-				Entry *e = q->stopping_ ? nullptr : q->nextWaiting();
-				if (!e) {
-					q->draining_ = false;
-					return;
-				}
-				e->state = State::Running;
-				guard.unlock();
-				q->run(q->theirs_, *e);
-				guard.lock();
-			}
+			std::lock_guard<std::mutex> guard(lock_);
+			stopping_ = true;
 		}
-	} drain_{ this };
+		for (auto &h : helpers_)
+			h->worker.wait(); /* at once when nothing was posted */
+	}
 
-	Detector &mine_;
-	Detector theirs_;
-	Worker &worker_;
+	const int latency_;
+	std::vector<std::unique_ptr<Detector>> detectors_; /* [0]: the caller's */
 	mutable std::mutex lock_;
 	std::condition_variable done_;
-	Entry ring_[kRing];
-	int head_ = 0, count_ = 0;
-	bool draining_ = false, stopping_ = false;
-	std::exception_ptr failure_;
+	std::vector<Entry> ring_;
+	std::size_t head_ = 0;
+	int count_ = 0;
+	bool stopping_ = false;
 	Result returned_;
+	std::vector<std::unique_ptr<Helper>> helpers_; /* last: they go first */
 };
 
-} // namespace detail
+/// Mode::Stages. At most three frames in flight, oldest first, each in a
+/// slot of the one detector: one traced and waiting for its finish, one
+/// whose front end has run, and the new one.
+class StageQueue
+{
+public:
+	static constexpr int kLatency = 2;
 
-struct FRAPPE_HIDDEN Pipeline::Impl {
-	Impl(const Config &config, Mode mode) : detector(config)
+	explicit StageQueue(const Config &config) : detector_(config) {}
+	~StageQueue() { worker_.wait(); }
+
+	const Result *push(const ImageView &image)
 	{
-		if (mode == Mode::Frames)
-			frameQueue = std::make_unique<detail::FrameQueue>(config, detector, worker);
-	}
-	~Impl()
-	{
-		/* Before the worker and the detectors it uses go. */
-		frameQueue.reset();
+		frames_[count_] = { image, freeSlot(), false };
+		Frame &fresh = frames_[count_];
+		Frame *oldest = count_ > 0 ? &frames_[0] : nullptr;
+		Frame *toTrace = nullptr;
+		for (int i = 0; i < count_; ++i)
+			if (!frames_[i].traced)
+				toTrace = &frames_[i];
+		++count_;
+
+		round_.start = &fresh;
+		round_.finish = oldest && oldest->traced ? oldest : nullptr;
+		round_.finished = nullptr;
+		worker_.post(round_);
+		if (toTrace) {
+			DetectorStages::trace(detector_, toTrace->slot);
+			toTrace->traced = true;
+		}
+		worker_.wait();
+		if (failure_) {
+			count_ = 0; /* out of memory mid-round: drop the frames in flight */
+			std::rethrow_exception(std::exchange(failure_, nullptr));
+		}
+		if (!round_.finish)
+			return nullptr;
+		popOldest();
+		return round_.finished;
 	}
 
+	const Result *flush()
+	{
+		if (count_ == 0)
+			return nullptr;
+		const Frame oldest = frames_[0];
+		popOldest();
+		if (!oldest.traced)
+			DetectorStages::trace(detector_, oldest.slot);
+		return &DetectorStages::finish(detector_, oldest.image, oldest.slot);
+	}
+
+	/* push() returns only once its round has, so nothing runs here. */
+	void drop() { count_ = 0; }
+	bool pending() const { return count_ > 0; }
+	Detector &detector() { return detector_; }
+
+private:
 	struct Frame {
 		ImageView image;
 		int slot = 0;
 		bool traced = false;
 	};
 
-	Detector detector;
-	detail::Worker worker;
-
-	/* Mode::Frames */
-	std::unique_ptr<detail::FrameQueue> frameQueue;
-
-	/* Mode::Stages: frames in flight, oldest first; at most one traced and
-	 * one not. */
-	Frame frames[Detector::kSlots];
-	int count = 0;
-
 	/* The worker's round: the new frame's front end, then the oldest
 	 * frame's finish when there is one. A member, so posting it allocates
 	 * nothing. */
 	struct Round {
-		Impl *self;
+		StageQueue *self;
 		const Frame *start = nullptr;
 		const Frame *finish = nullptr;
 		const Result *finished = nullptr;
 		void operator()()
 		{
 			try {
-				self->detector.runFrontEnd(start->image, start->slot);
+				DetectorStages::frontEnd(self->detector_, start->image, start->slot);
 				if (finish)
-					finished = &self->detector.runFinish(finish->image, finish->slot);
+					finished = &DetectorStages::finish(self->detector_, finish->image, finish->slot);
 			} catch (...) {
-				self->failure = std::current_exception();
+				self->failure_ = std::current_exception();
 			}
 		}
-	} round{ this };
-	std::exception_ptr failure;
+	};
 
 	int freeSlot() const
 	{
-		for (int s = 0; s < Detector::kSlots; ++s) {
+		for (int s = 0; s < DetectorStages::kSlots; ++s) {
 			bool used = false;
-			for (int i = 0; i < count; ++i)
-				used |= frames[i].slot == s;
+			for (int i = 0; i < count_; ++i)
+				used |= frames_[i].slot == s;
 			if (!used)
 				return s;
 		}
 		return 0; /* not reached: at most kSlots - 1 frames wait */
 	}
 
-	void pop()
+	void popOldest()
 	{
-		for (int i = 1; i < count; ++i)
-			frames[i - 1] = frames[i];
-		--count;
+		for (int i = 1; i < count_; ++i)
+			frames_[i - 1] = frames_[i];
+		--count_;
 	}
+
+	Detector detector_;
+	Frame frames_[DetectorStages::kSlots];
+	int count_ = 0;
+	Round round_{ this };
+	std::exception_ptr failure_;
+	Worker worker_; /* last: it goes first */
 };
 
-Pipeline::Pipeline(const Config &config, Mode mode) : impl_(std::make_unique<Impl>(config, mode)) {}
+} // namespace detail
+
+struct FRAPPE_HIDDEN Pipeline::Impl {
+	std::unique_ptr<detail::FrameQueue> frames; /* Mode::Frames */
+	std::unique_ptr<detail::StageQueue> stages; /* Mode::Stages */
+};
+
+Pipeline::Pipeline(const Config &config, Mode mode) : impl_(std::make_unique<Impl>())
+{
+	if (mode == Mode::Stages)
+		impl_->stages = std::make_unique<detail::StageQueue>(config);
+	else
+		impl_->frames = std::make_unique<detail::FrameQueue>(config, detail::threadCount(config));
+}
 
 Pipeline::~Pipeline() = default;
 
 const Result *Pipeline::push(const ImageView &image)
 {
 	Impl &d = *impl_;
-	d.detector.checkImage(image);
-	if (d.frameQueue)
-		return d.frameQueue->push(image);
-
-	d.frames[d.count] = { image, d.freeSlot(), false };
-	Impl::Frame &fresh = d.frames[d.count];
-	Impl::Frame *oldest = d.count > 0 ? &d.frames[0] : nullptr;
-	Impl::Frame *toTrace = nullptr;
-	for (int i = 0; i < d.count; ++i)
-		if (!d.frames[i].traced)
-			toTrace = &d.frames[i];
-	++d.count;
-
-	d.round.start = &fresh;
-	d.round.finish = oldest && oldest->traced ? oldest : nullptr;
-	d.round.finished = nullptr;
-	d.worker.post(d.round);
-	if (toTrace) {
-		d.detector.runTrace(toTrace->slot);
-		toTrace->traced = true;
-	}
-	d.worker.wait();
-	if (d.failure) {
-		d.count = 0; /* out of memory mid-round: drop the frames in flight */
-		std::rethrow_exception(std::exchange(d.failure, nullptr));
-	}
-	if (!d.round.finish)
-		return nullptr;
-	d.pop();
-	return d.round.finished;
+	detector().checkImage(image);
+	return d.frames ? d.frames->push(image) : d.stages->push(image);
 }
 
 const Result *Pipeline::flush()
 {
 	Impl &d = *impl_;
-	if (d.frameQueue)
-		return d.frameQueue->pop(0);
-	if (d.count == 0)
-		return nullptr;
-	const Impl::Frame oldest = d.frames[0];
-	d.pop();
-	if (!oldest.traced)
-		d.detector.runTrace(oldest.slot);
-	return &d.detector.runFinish(oldest.image, oldest.slot);
+	return d.frames ? d.frames->pop(0) : d.stages->flush();
+}
+
+void Pipeline::drop()
+{
+	Impl &d = *impl_;
+	if (d.frames)
+		d.frames->drop();
+	else
+		d.stages->drop();
+}
+
+void Pipeline::reset()
+{
+	for (int i = 0; i < detectorCount(); ++i)
+		detector(i).reset();
 }
 
 bool Pipeline::pending() const
 {
-	return impl_->frameQueue ? impl_->frameQueue->pending() : impl_->count > 0;
+	return impl_->frames ? impl_->frames->pending() : impl_->stages->pending();
 }
 
-int Pipeline::latency() const { return impl_->frameQueue ? detail::FrameQueue::kLatency : 2; }
-Detector &Pipeline::detector() { return impl_->detector; }
+int Pipeline::latency() const
+{
+	return impl_->frames ? impl_->frames->latency() : detail::StageQueue::kLatency;
+}
+
+int Pipeline::threads() const { return impl_->frames ? impl_->frames->detectorCount() : 2; }
+
+int Pipeline::detectorCount() const { return impl_->frames ? impl_->frames->detectorCount() : 1; }
+
+Detector &Pipeline::detector(int index)
+{
+	Impl &d = *impl_;
+	if (d.frames)
+		return d.frames->detector(index);
+	if (index != 0)
+		throw std::out_of_range("frappe::Pipeline: one detector in Mode::Stages");
+	return d.stages->detector();
+}
 
 } // namespace frappe

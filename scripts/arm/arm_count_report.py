@@ -6,7 +6,7 @@ Inputs: the plugin log (M/C/B/N lines, see scripts/arm/frappecount.c), the
 linker map and `nm -n -S -C` of the driver (to map each counted function to
 its object file, hence its stage, and to demangle it), and the driver's
 stdout (image sizes). Per frame: frappe = the intervals frappe_begin ->
-frappe_front (runFrontEnd) -> frappe_back (runBackEnd); OpenCV = opencv_begin
+frappe_front (front end) -> frappe_back (back end); OpenCV = opencv_begin
 -> opencv_end (cv::aruco::detectMarkers). --arch names the target in the
 headings (armv6, aarch64 or aarch64-scalar); the instruction classes are
 named by the log itself (A line; older logs: the A32 names).
@@ -325,8 +325,8 @@ def main():
       f"**{percentile(whole_px, .5):.2f}** | **{percentile(whole_px, .9):.2f}** | 100% |")
     P(f"| whole frame, frappe's own code | | | {percentile(own_px, .5):.2f} | {percentile(own_px, .9):.2f} | |")
     P(f"| whole frame, library code it calls (libm, libc, libgcc) | | | {percentile(lib_px, .5):.2f} | {percentile(lib_px, .9):.2f} | |")
-    P(f"| (check: runFrontEnd interval) | | | {percentile(fe_l, .5):.2f} | {percentile(fe_l, .9):.2f} | |")
-    P(f"| (check: runBackEnd interval) | | | {percentile(be_l, .5):.2f} | {percentile(be_l, .9):.2f} | |")
+    P(f"| (check: front-end interval) | | | {percentile(fe_l, .5):.2f} | {percentile(fe_l, .9):.2f} | |")
+    P(f"| (check: back-end interval) | | | {percentile(be_l, .5):.2f} | {percentile(be_l, .9):.2f} | |")
     P("")
     if a.arch == "armv6":
         P("Library code is Debian armel's (ARMv5TE, soft-float libm: an atan2f call costs ~1500 instructions "
@@ -383,7 +383,7 @@ def main():
     if a.csv:
         with open(a.csv, "w") as f:
             f.write(",".join(["image", "width", "height", "frappe_markers", "opencv_markers", "frappe_insns",
-                              "runFrontEnd", "runBackEnd"] + STAGES + ["opencv_insns"]) + "\n")
+                              "front_end_call", "back_end_call"] + STAGES + ["opencv_insns"]) + "\n")
             for r in csv_rows:
                 f.write(",".join(str(x) for x in r) + "\n")
 

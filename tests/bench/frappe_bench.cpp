@@ -164,7 +164,7 @@ void reportThroughput(const frappe::Config &base, const std::vector<cv::Mat> &im
 	one.threads = 1;
 	two.threads = 2;
 	frappe::Detector d1(one), d2(two);
-	frappe::Pipeline pipe(one), frames(one, frappe::Pipeline::Mode::Frames);
+	frappe::Pipeline pipe(one, frappe::Pipeline::Mode::Stages), frames(two, frappe::Pipeline::Mode::Frames);
 	std::size_t sink = 0;
 	auto single = [&](const cv::Mat &g) { sink += d1.detect(viewOf(g)).markers.size(); };
 	auto bands = [&](const cv::Mat &g) { sink += d2.detect(viewOf(g)).markers.size(); };

@@ -15,8 +15,9 @@
 //
 // --region-contrast sets Config::region_contrast (0 turns the region map and
 // its candidates off), to measure what that path costs.
-// frappe runs as Detector::detect() does, split into its two public halves
-// (runFrontEnd, then runBackEnd) with a marker between them. OpenCV gets the
+// frappe runs as Detector::detect() does, split into its two halves (the
+// library's internal detail::DetectorStages: the front end, then the back
+// end) with a marker between them; it links the static library. OpenCV gets the
 // same setup as tests/bench/frappe_bench.cpp: the dictionary as a custom
 // Dictionary, at most 5 corrected bits (capped by the dictionary's safe
 // maximum), no corner refinement. Images: 8-bit PNG (libpng) or JPEG
@@ -38,6 +39,7 @@
 #include <png.h>
 
 #include "frappe/frappe.h"
+#include "detector_stages.h" /* frappe-core/src: internal */
 
 #ifdef FRAPPE_COUNT_OPENCV
 #include <opencv2/core/utility.hpp>
@@ -273,9 +275,9 @@ int main(int argc, char **argv)
 		const Gray &g = images[k];
 		const frappe::ImageView view(g.pixels.data(), g.width, g.height);
 		armcount_mark_frappe_begin();
-		det.runFrontEnd(view, 0);
+		frappe::detail::DetectorStages::frontEnd(det, view, 0);
 		armcount_mark_frappe_front();
-		const frappe::Result &res = det.runBackEnd(view, 0);
+		const frappe::Result &res = frappe::detail::DetectorStages::backEnd(det, view, 0);
 		armcount_mark_frappe_back();
 		const int nf = static_cast<int>(res.markers.size());
 		if (fo.is_open()) {

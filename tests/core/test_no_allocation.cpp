@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
-// After the first frame of a given size, detect() allocates nothing: this
-// binary counts every operator new.
+// After the first frame of a given size, detect() allocates nothing, and
+// neither does a Pipeline's push(): this binary counts every operator new.
 #include <atomic>
 #include <cstdlib>
 #include <new>
@@ -35,7 +35,11 @@ class NoAllocation : public ::testing::TestWithParam<int>
 {
 };
 
-TEST_P(NoAllocation, SecondFrameOfTheSameSizeAllocatesNothing)
+namespace {
+
+/* Six small markers, six others, two large ones (read on frames of block
+ * means, 2 x 2 and 4 x 4). */
+std::vector<Image> scenes()
 {
 	const Dictionary &dict = *findDictionary("aruco_mip_36h12");
 	Image a(640, 480, 80), b(640, 480, 120);
@@ -44,13 +48,25 @@ TEST_P(NoAllocation, SecondFrameOfTheSameSizeAllocatesNothing)
 		renderMarker(a.mut(), dict, k, squarePose(80.0f + 100.0f * k, 150.0f, 60.0f, 20.0f * k, 30.0f));
 		renderMarker(b.mut(), dict, 10 + k, squarePose(80.0f + 100.0f * k, 330.0f, 70.0f, -15.0f * k, 20.0f));
 	}
-	/* Large markers: read on frames of block means (2 x 2 and 4 x 4). */
 	Image c(640, 480, 100);
 	renderMarker(c.mut(), dict, 20, squarePose(170.0f, 240.0f, 200.0f, 10.0f, 20.0f));
 	renderMarker(c.mut(), dict, 21, squarePose(470.0f, 240.0f, 130.0f, -10.0f, 25.0f));
 	addNoise(a, 3.0f, rng);
 	addNoise(b, 3.0f, rng);
 	addNoise(c, 3.0f, rng);
+	std::vector<Image> out;
+	out.push_back(std::move(a));
+	out.push_back(std::move(b));
+	out.push_back(std::move(c));
+	return out;
+}
+
+} // namespace
+
+TEST_P(NoAllocation, SecondFrameOfTheSameSizeAllocatesNothing)
+{
+	const std::vector<Image> s = scenes();
+	const Image &a = s[0], &b = s[1], &c = s[2];
 	Config config;
 	config.threads = GetParam(); /* bands on persistent workers */
 	Detector det(config);
@@ -71,3 +87,30 @@ TEST_P(NoAllocation, SecondFrameOfTheSameSizeAllocatesNothing)
 }
 
 INSTANTIATE_TEST_SUITE_P(Threads, NoAllocation, ::testing::Values(1, 2, 4));
+
+/* Whole frames on several threads: which detector runs a frame depends on
+ * timing, so each detector is warmed directly; the results' vectors then
+ * circulate between the ring and the caller, each grown by the warm-up. */
+TEST_P(NoAllocation, PipelinePushAllocatesNothingOnceWarm)
+{
+	const std::vector<Image> s = scenes();
+	Config config;
+	config.threads = GetParam();
+	Pipeline pipeline(config, Pipeline::Mode::Frames);
+	for (int i = 0; i < pipeline.detectorCount(); ++i)
+		for (const Image &img : s)
+			pipeline.detector(i).detect(img.view());
+	for (int k = 0; k < 12; ++k)
+		pipeline.push(s[static_cast<std::size_t>(k) % 3].view());
+
+	std::size_t markers = 0;
+	const long before = gAllocations.load();
+	for (int k = 12; k < 24; ++k)
+		if (const Result *r = pipeline.push(s[static_cast<std::size_t>(k) % 3].view()))
+			markers += r->markers.size();
+	const long after = gAllocations.load();
+	while (pipeline.flush()) {
+	}
+	EXPECT_EQ(markers, 4u * (6 + 6 + 2));
+	EXPECT_EQ(after - before, 0) << "push() allocated on frames of a size it had seen";
+}

@@ -1,7 +1,11 @@
 // SPDX-License-Identifier: MIT
-// Both two-thread modes give, latency() frames late and in order, exactly
-// what detect() gives frame by frame; bad frames are refused without losing
-// the ones in flight.
+// Every mode gives, latency() frames late and in order, exactly what
+// detect() gives frame by frame; bad frames are refused without losing the
+// ones in flight; dropped frames leave nothing behind.
+#include <algorithm>
+#include <stdexcept>
+#include <thread>
+
 #include <gtest/gtest.h>
 
 #include "frappe/frappe.h"
@@ -41,9 +45,49 @@ void expectSame(const Result &a, const Result &b, int frame)
 	}
 }
 
+/* Pushes frames[from..] and flushes: the results are those of frames[next..]
+ * in order, exactly as detect() gives them, each push returning one as soon
+ * as more than latency() frames are in flight. */
+void pushTheRest(Pipeline &pipeline, const std::vector<Image> &frames, std::size_t from, std::size_t next)
+{
+	Detector reference(Config{});
+	for (std::size_t i = from; i < frames.size(); ++i) {
+		const std::size_t inFlight = i + 1 - next;
+		const Result *r = pipeline.push(frames[i].view());
+		ASSERT_EQ(r != nullptr, inFlight > static_cast<std::size_t>(pipeline.latency())) << "push " << i;
+		if (r) {
+			expectSame(*r, reference.detect(frames[next].view()), static_cast<int>(next));
+			++next;
+		}
+	}
+	while (const Result *r = pipeline.flush()) {
+		expectSame(*r, reference.detect(frames[next].view()), static_cast<int>(next));
+		++next;
+	}
+	EXPECT_EQ(next, frames.size());
+	EXPECT_FALSE(pipeline.pending());
+}
+
 } // namespace
 
-class PipelineModes : public ::testing::TestWithParam<Pipeline::Mode>
+/* A mode and its thread count (Config::threads), with the latency and the
+ * detectors that go with them. */
+struct Setup {
+	Pipeline::Mode mode;
+	int threads;
+	int latency;
+	int detectors;
+	const char *name;
+};
+
+Config configOf(const Setup &s)
+{
+	Config c;
+	c.threads = s.threads;
+	return c;
+}
+
+class PipelineModes : public ::testing::TestWithParam<Setup>
 {
 };
 
@@ -55,8 +99,9 @@ TEST_P(PipelineModes, SameMarkersAsDetectLatencyFramesLateInOrder)
 	for (const Image &f : frames)
 		expected.push_back(reference.detect(f.view()));
 
-	Pipeline pipeline(Config{}, GetParam());
-	EXPECT_EQ(pipeline.latency(), 2);
+	Pipeline pipeline(configOf(GetParam()), GetParam().mode);
+	EXPECT_EQ(pipeline.latency(), GetParam().latency);
+	EXPECT_EQ(pipeline.detectorCount(), GetParam().detectors);
 	std::vector<Result> got;
 	int pushes = 0;
 	for (const Image &f : frames) {
@@ -66,7 +111,7 @@ TEST_P(PipelineModes, SameMarkersAsDetectLatencyFramesLateInOrder)
 			got.push_back(*r);
 		++pushes;
 	}
-	EXPECT_TRUE(pipeline.pending());
+	EXPECT_EQ(pipeline.pending(), pipeline.latency() > 0);
 	while (const Result *r = pipeline.flush())
 		got.push_back(*r);
 	EXPECT_FALSE(pipeline.pending());
@@ -79,11 +124,61 @@ TEST_P(PipelineModes, SameMarkersAsDetectLatencyFramesLateInOrder)
 	}
 }
 
+/* A seek: the frames in flight go without results, and the stream goes on
+ * from the next push as if the pipeline were new. */
+TEST_P(PipelineModes, DropForgetsTheFramesInFlight)
+{
+	const std::vector<Image> frames = sequence(6);
+	Pipeline pipeline(configOf(GetParam()), GetParam().mode);
+	for (int i = 0; i < 3; ++i)
+		pipeline.push(frames[static_cast<std::size_t>(i)].view());
+	pipeline.drop();
+	EXPECT_FALSE(pipeline.pending());
+	EXPECT_EQ(pipeline.flush(), nullptr);
+	pushTheRest(pipeline, frames, 3, 3);
+}
+
+TEST_P(PipelineModes, FlushWithNothingInFlight)
+{
+	Pipeline pipeline(configOf(GetParam()), GetParam().mode);
+	EXPECT_FALSE(pipeline.pending());
+	EXPECT_EQ(pipeline.flush(), nullptr);
+	/* A pipeline may be destroyed with frames in flight, in Frames mode
+	 * with a worker still on one. */
+	const std::vector<Image> frames = sequence(2);
+	Pipeline other(configOf(GetParam()), GetParam().mode);
+	other.push(frames[0].view());
+	other.push(frames[1].view());
+}
+
+INSTANTIATE_TEST_SUITE_P(All, PipelineModes,
+			 ::testing::Values(Setup{ Pipeline::Mode::Stages, 1, 2, 1, "Stages" },
+					   Setup{ Pipeline::Mode::Frames, 1, 0, 1, "FramesOneThread" },
+					   Setup{ Pipeline::Mode::Frames, 2, 1, 2, "FramesTwoThreads" },
+					   Setup{ Pipeline::Mode::Frames, 3, 2, 3, "FramesThreeThreads" }),
+			 [](const auto &info) { return std::string(info.param.name); });
+
+TEST(Pipeline, ThreadsAreCheckedAndZeroIsOnePerCore)
+{
+	Config c;
+	c.threads = -1;
+	EXPECT_THROW(Pipeline(c, Pipeline::Mode::Frames), std::invalid_argument);
+	c.threads = 257;
+	EXPECT_THROW(Pipeline(c, Pipeline::Mode::Frames), std::invalid_argument);
+	c.threads = 0;
+	Pipeline perCore(c, Pipeline::Mode::Frames);
+	EXPECT_EQ(perCore.threads(), static_cast<int>(std::max(1u, std::thread::hardware_concurrency())));
+	EXPECT_EQ(perCore.latency(), perCore.threads() - 1);
+	/* Each detector of Mode::Frames runs on its own thread only. */
+	EXPECT_EQ(perCore.detector(0).config().threads, 1);
+	EXPECT_THROW(Pipeline(Config{}, Pipeline::Mode::Stages).detector(1), std::out_of_range);
+}
+
 TEST(Pipeline, BadFrameIsRefusedAndTheFrameInFlightSurvives)
 {
 	const std::vector<Image> frames = sequence(3);
 	Detector reference(Config{});
-	Pipeline pipeline(Config{});
+	Pipeline pipeline(Config{}, Pipeline::Mode::Stages);
 	EXPECT_EQ(pipeline.push(frames[0].view()), nullptr);
 	EXPECT_THROW(pipeline.push(ImageView(nullptr, 10, 10, 10)), std::invalid_argument);
 	EXPECT_EQ(pipeline.push(frames[1].view()), nullptr);
@@ -100,47 +195,17 @@ TEST(Pipeline, BadFrameIsRefusedAndTheFrameInFlightSurvives)
 	EXPECT_EQ(pipeline.flush(), nullptr);
 }
 
-TEST_P(PipelineModes, FlushWithNothingInFlight)
-{
-	Pipeline pipeline(Config{}, GetParam());
-	EXPECT_FALSE(pipeline.pending());
-	EXPECT_EQ(pipeline.flush(), nullptr);
-	/* A pipeline may be destroyed with frames in flight, in Frames mode
-	 * with the worker still on one. */
-	const std::vector<Image> frames = sequence(2);
-	Pipeline other(Config{}, GetParam());
-	EXPECT_EQ(other.push(frames[0].view()), nullptr);
-	other.push(frames[1].view());
-}
-
 /* Frames mode: a refused frame changes nothing in flight; frames come out
  * in order whichever thread ran them (which one does depends on timing, so
- * a long stream of frames of different cost exercises both). */
+ * a long stream of frames of different cost exercises all three). */
 TEST(Pipeline, FramesModeRefusesABadFrameAndKeepsTheOrder)
 {
 	const std::vector<Image> frames = sequence(24);
-	Detector reference(Config{});
-	Pipeline pipeline(Config{}, Pipeline::Mode::Frames);
+	Config three;
+	three.threads = 3;
+	Pipeline pipeline(three, Pipeline::Mode::Frames);
 	EXPECT_EQ(pipeline.push(frames[0].view()), nullptr);
 	EXPECT_EQ(pipeline.push(frames[1].view()), nullptr);
 	EXPECT_THROW(pipeline.push(ImageView(nullptr, 10, 10, 10)), std::invalid_argument);
-	std::size_t next = 0;
-	for (std::size_t i = 2; i < frames.size(); ++i) {
-		const Result *r = pipeline.push(frames[i].view());
-		ASSERT_NE(r, nullptr);
-		expectSame(*r, reference.detect(frames[next].view()), static_cast<int>(next));
-		++next;
-	}
-	while (const Result *r = pipeline.flush()) {
-		expectSame(*r, reference.detect(frames[next].view()), static_cast<int>(next));
-		++next;
-	}
-	EXPECT_EQ(next, frames.size());
-	EXPECT_FALSE(pipeline.pending());
+	pushTheRest(pipeline, frames, 2, 0);
 }
-
-INSTANTIATE_TEST_SUITE_P(Both, PipelineModes,
-			 ::testing::Values(Pipeline::Mode::Stages, Pipeline::Mode::Frames),
-			 [](const auto &info) {
-				 return std::string(info.param == Pipeline::Mode::Stages ? "Stages" : "Frames");
-			 });

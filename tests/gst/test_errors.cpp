@@ -1,13 +1,13 @@
 // SPDX-License-Identifier: MIT
-// frappedetect: a back end that fails is an element error and a flow error,
-// pipelined or not; no buffer leaves without its markers.
+// frappedetect: a detection that fails is an element error and a flow
+// error, pipelined or not; no buffer leaves without its markers.
 //
 // The failure is injected without a hook in the element: this program
-// defines frappe::Detector::runBackEnd itself and exports it, so the
-// plugin's calls reach this definition first (ELF interposition), which
-// throws from the call numbered failFrom on and otherwise calls the
-// library's. Where
-// interposition does not happen (a static libfrappe-core) the tests skip.
+// defines frappe::Detector::detect itself and exports it, so the calls of
+// libfrappe-core's Pipeline reach this definition first (ELF
+// interposition), which throws from the call numbered failFrom on and
+// otherwise calls the library's. Where interposition does not happen (a
+// static libfrappe-core) the tests skip.
 #include <atomic>
 #include <climits>
 #include <stdexcept>
@@ -29,27 +29,27 @@ static auto *const gstEnv = ::testing::AddGlobalTestEnvironment(new GstEnvironme
 
 namespace {
 
-/* Calls are numbered from 0; the pipelined back end runs on a worker
- * thread, so the tests name the call that fails, not the moment. */
-std::atomic<int> backEndCalls{ 0 };
+/* Calls are numbered from 0; pipelined, frames run on two threads, so the
+ * tests name the call that fails, not the moment. */
+std::atomic<int> detectCalls{ 0 };
 std::atomic<int> failFrom{ INT_MAX };
 
-using RunBackEnd = const frappe::Result &(*)(frappe::Detector *, const frappe::ImageView &, int);
+using Detect = const frappe::Result &(*)(frappe::Detector *, const frappe::ImageView &);
 
-RunBackEnd libraryRunBackEnd()
+Detect libraryDetect()
 {
-	static const auto fn = reinterpret_cast<RunBackEnd>(
-		dlsym(RTLD_NEXT, "_ZN6frappe8Detector10runBackEndERKNS_9ImageViewEi"));
+	static const auto fn =
+		reinterpret_cast<Detect>(dlsym(RTLD_NEXT, "_ZN6frappe8Detector6detectERKNS_9ImageViewE"));
 	return fn;
 }
 
 } // namespace
 
-const frappe::Result &frappe::Detector::runBackEnd(const ImageView &image, int slot)
+const frappe::Result &frappe::Detector::detect(const ImageView &image)
 {
-	if (backEndCalls++ >= failFrom)
-		throw std::runtime_error("injected back-end failure");
-	return libraryRunBackEnd()(this, image, slot);
+	if (detectCalls++ >= failFrom)
+		throw std::runtime_error("injected detection failure");
+	return libraryDetect()(this, image);
 }
 
 namespace {
@@ -72,7 +72,7 @@ void expectDetectionError(GstBus *bus)
 	gst_message_parse_error(msg, &err, &debug);
 	EXPECT_TRUE(g_error_matches(err, GST_STREAM_ERROR, GST_STREAM_ERROR_FAILED)) << err->message;
 	EXPECT_EQ(std::string(err->message), "Marker detection failed");
-	EXPECT_NE(std::string(debug ? debug : "").find("injected back-end failure"), std::string::npos);
+	EXPECT_NE(std::string(debug ? debug : "").find("injected detection failure"), std::string::npos);
 	g_error_free(err);
 	g_free(debug);
 	gst_message_unref(msg);
@@ -96,27 +96,27 @@ struct Harness {
 	GstBus *bus;
 };
 
-/* Whether the plugin's back end calls come here. */
+/* Whether the plugin's detections come here. */
 bool interposed()
 {
-	if (!libraryRunBackEnd())
+	if (!libraryDetect())
 		return false;
 	Harness t("frappedetect");
-	const int before = backEndCalls;
+	const int before = detectCalls;
 	if (gst_harness_push(t.h, frame(0)) != GST_FLOW_OK)
 		return false;
 	gst_buffer_unref(gst_harness_pull(t.h));
-	return backEndCalls > before;
+	return detectCalls > before;
 }
 
 } // namespace
 
-TEST(Errors, BackEndFailureIsAnErrorUnpipelined)
+TEST(Errors, DetectionFailureIsAnErrorUnpipelined)
 {
 	if (!interposed())
-		GTEST_SKIP() << "frappe::Detector::runBackEnd cannot be interposed in this build";
+		GTEST_SKIP() << "frappe::Detector::detect cannot be interposed in this build";
 	Harness t("frappedetect");
-	failFrom = backEndCalls + 1;
+	failFrom = detectCalls + 1;
 	ASSERT_EQ(gst_harness_push(t.h, frame(0)), GST_FLOW_OK);
 	EXPECT_EQ(gst_harness_push(t.h, frame(1)), GST_FLOW_ERROR);
 	expectDetectionError(t.bus);
@@ -128,15 +128,15 @@ TEST(Errors, BackEndFailureIsAnErrorUnpipelined)
 	EXPECT_EQ(gst_harness_try_pull(t.h), nullptr);
 }
 
-TEST(Errors, BackEndFailureIsAnErrorPipelined)
+TEST(Errors, DetectionFailureIsAnErrorPipelined)
 {
 	if (!interposed())
-		GTEST_SKIP() << "frappe::Detector::runBackEnd cannot be interposed in this build";
+		GTEST_SKIP() << "frappe::Detector::detect cannot be interposed in this build";
 	Harness t("frappedetect pipelined=true");
-	failFrom = backEndCalls + 1;
+	failFrom = detectCalls + 1;
 	ASSERT_EQ(gst_harness_push(t.h, frame(0)), GST_FLOW_OK);
-	/* Frame 0 comes out now; frame 1's back end runs on the worker and
-	 * fails; frame 2 finishes frame 1 and gets the error. */
+	/* Frame 0 comes out now; frame 1's detection fails on one of the
+	 * two threads; frame 2 finishes frame 1 and gets the error. */
 	ASSERT_EQ(gst_harness_push(t.h, frame(1)), GST_FLOW_OK);
 	EXPECT_EQ(gst_harness_push(t.h, frame(2)), GST_FLOW_ERROR);
 	expectDetectionError(t.bus);
@@ -148,12 +148,12 @@ TEST(Errors, BackEndFailureIsAnErrorPipelined)
 	EXPECT_EQ(gst_harness_try_pull(t.h), nullptr) << "a buffer left without its markers";
 }
 
-TEST(Errors, BackEndFailureOfTheHeldBufferAtEosIsAnError)
+TEST(Errors, DetectionFailureOfTheHeldBufferAtEosIsAnError)
 {
 	if (!interposed())
-		GTEST_SKIP() << "frappe::Detector::runBackEnd cannot be interposed in this build";
+		GTEST_SKIP() << "frappe::Detector::detect cannot be interposed in this build";
 	Harness t("frappedetect pipelined=true");
-	failFrom = backEndCalls.load();
+	failFrom = detectCalls.load();
 	ASSERT_EQ(gst_harness_push(t.h, frame(0)), GST_FLOW_OK);
 	gst_harness_push_event(t.h, gst_event_new_eos());
 	expectDetectionError(t.bus);

@@ -18,6 +18,10 @@
 
 namespace frappe {
 
+namespace detail {
+class DetectorStages;
+}
+
 /// The stages of the paper's Algorithm 1, in order.
 enum class Stage {
 	AdaptiveScale,
@@ -41,8 +45,8 @@ struct StageTimes {
 	double operator[](Stage s) const { return ms[static_cast<int>(s)]; }
 };
 
-/// Everything one detect() call produced. Owned by the Detector and
-/// overwritten by the next call on the same slot.
+/// Everything one detect() call produced. Owned by the Detector (or the
+/// Pipeline) and overwritten by its next frame.
 struct Result {
 	std::vector<Marker> markers;
 	StageTimes times;
@@ -54,7 +58,8 @@ struct Result {
 ///
 /// One instance is used by one thread at a time; separate instances share
 /// nothing. After the first frame of a given size, detect() allocates no
-/// memory (result vectors keep their capacity).
+/// memory (result vectors keep their capacity). To overlap the frames of a
+/// stream on several threads, use a Pipeline.
 class FRAPPE_EXPORT Detector {
 public:
 	/// Throws std::invalid_argument when the dictionary is unknown or a
@@ -74,24 +79,6 @@ public:
 	/// Throws std::invalid_argument for an image detect() would refuse.
 	void checkImage(const ImageView &image) const;
 
-	/// Frames in flight at once in staged use.
-	static constexpr int kSlots = 3;
-
-	/// Staged use for pipelining: each frame goes through a slot (0 ..
-	/// kSlots-1). runFrontEnd() fills the slot's edge map; runBackEnd() then
-	/// traces it and refines, warps and decodes. Stages of different slots
-	/// may run on different threads at once; the image must stay valid
-	/// until the slot's back end (or runFinish()) returns. In AScale mode
-	/// the scale of a frame comes from the last frame finished before its
-	/// front end started. Throws std::invalid_argument for a bad slot.
-	void runFrontEnd(const ImageView &image, int slot);
-	const Result &runBackEnd(const ImageView &image, int slot);
-
-	/// runBackEnd() in two halves, for a three-stage pipeline: the contour
-	/// trace, then refinement, warp and decoding.
-	void runTrace(int slot);
-	const Result &runFinish(const ImageView &image, int slot);
-
 	/// Replaces the front end (for example with the VC4 one). The default
 	/// is the CPU front end.
 	void setFrontEnd(std::unique_ptr<FrontEnd> frontEnd);
@@ -104,8 +91,9 @@ public:
 	/// The batch warper, or nullptr.
 	const CandidateWarper *warper() const;
 
-	/// The edge map of a slot's last frame, for visualisation and tests.
-	const EdgeMap &edgeMap(int slot = 0) const;
+	/// The edge map of the last frame detect() ran, for visualisation and
+	/// tests.
+	const EdgeMap &edgeMap() const;
 
 	/// Forgets what AScale learned from earlier frames.
 	void reset();
@@ -116,6 +104,8 @@ public:
 	FrontEndParams frontEndParams() const;
 
 private:
+	/* Pipeline runs the stages of different frames on different threads. */
+	friend class detail::DetectorStages;
 	struct Impl;
 	std::unique_ptr<Impl> impl_;
 };

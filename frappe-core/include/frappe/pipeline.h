@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// frappe/pipeline.h: the paper's pipelined mode for a stream of frames.
+// frappe/pipeline.h: a stream of frames on several threads, results in order.
 #pragma once
 
 #include "frappe/export.h"
@@ -12,55 +12,76 @@
 
 namespace frappe {
 
-/// Runs detection over a stream with two threads, results in order.
+/// Runs detection over a stream of frames, overlapping frames on several
+/// threads; results come out in order, latency() frames after their push.
+/// The only place in Frappe where frames overlap: the CLI and the GStreamer
+/// element drive one.
 ///
-/// Mode::Stages (the paper's pipelined mode), three stages: while the
-/// calling thread traces the contours of frame N, a worker thread runs the
-/// front end of frame N+1 and then refines, warps and decodes frame N-1.
-/// Results come out two frames late. Throughput is bounded by the slower of
-/// the trace and the rest, instead of their sum; one detector's memory. In
-/// AScale mode a frame's scale comes from the last frame finished before its
-/// front end started (three frames earlier).
+/// Mode::Frames (the default): whole frames, each on a detector of its own.
+/// `config.threads` threads (0: one per core; 1: each frame on the calling
+/// thread as it is pushed, latency 0), latency threads - 1. A frame starts
+/// on an idle worker as soon as it is pushed and runs on after push()
+/// returns; the calling thread runs a frame only when the result it must
+/// return belongs to a frame nobody has started. Throughput approaches
+/// `threads` times a detector's whatever the balance of the stages (1.8-2.1x
+/// with two threads on the synth images); a detector's memory per thread.
+/// Each detector runs single-threaded, and in AScale mode scales from the
+/// last frame it ran.
 ///
-/// Mode::Frames: whole frames on two detectors. Frames wait in a queue; a
-/// worker thread with its own detector takes each as soon as it is free (it
-/// runs on after push() returns), and the calling thread runs one only when
-/// the result it must return belongs to a frame nobody has started. Results
-/// come out two frames late. Throughput approaches twice a detector's
-/// whatever the balance of the stages and the spread of frame costs (1.76x
-/// on the synth images, where the staged mode gives 1.3x); twice the memory.
-/// In AScale mode each detector scales from the last frame it ran.
+/// Mode::Stages (the paper's pipelined mode): one detector, two threads,
+/// three stages. While the calling thread traces the contours of frame N, a
+/// worker thread runs the front end of frame N+1 and then refines, warps and
+/// decodes frame N-1. Latency 2. Throughput is bounded by the slower of the
+/// trace and the rest (1.3x on the synth images). `config.threads` splits
+/// the front end into row bands. In AScale mode a frame's scale comes from
+/// the last frame finished before its front end started.
 class FRAPPE_EXPORT Pipeline {
 public:
-	enum class Mode { Stages, Frames };
+	enum class Mode { Frames, Stages };
 
 	/// Throws std::invalid_argument like Detector's constructor.
-	explicit Pipeline(const Config &config, Mode mode = Mode::Stages);
+	explicit Pipeline(const Config &config, Mode mode = Mode::Frames);
 	~Pipeline();
 	Pipeline(const Pipeline &) = delete;
 	Pipeline &operator=(const Pipeline &) = delete;
 
 	/// Starts `image`, which must stay valid until its result has been
-	/// returned, and returns the result of the frame pushed latency() calls
-	/// before, or nullptr for the first latency() frames. A returned Result stays
-	/// valid until the next push() or flush(). Throws std::invalid_argument
-	/// for a bad image, before starting it; the frames already in flight are
-	/// unaffected.
+	/// returned (or drop() has returned), and returns the result of the
+	/// frame pushed latency() calls before, or nullptr while fewer frames
+	/// are in flight. A returned Result stays valid until the next push() or
+	/// flush(). Throws std::invalid_argument for a bad image, before
+	/// starting it: the frames in flight are unaffected. When the detection
+	/// of the frame to return failed (out of memory), throws its exception
+	/// instead; that frame is gone, `image` is in flight (Mode::Frames; in
+	/// Mode::Stages every frame in flight is dropped).
 	const Result *push(const ImageView &image);
 
 	/// At the end of the stream: finishes the oldest frame in flight and
 	/// returns its result, or nullptr when none is left. Call until nullptr.
+	/// Throws like push() when that frame failed.
 	const Result *flush();
+
+	/// Forgets the frames in flight without their results (a seek, a
+	/// stop), after waiting for the ones running.
+	void drop();
+
+	/// Forgets what AScale learned from earlier frames, on every detector.
+	void reset();
 
 	/// Whether frames are in flight (pushed, results not yet returned).
 	bool pending() const;
 
-	/// Frames between a push and its result (2).
+	/// Frames between a push and its result.
 	int latency() const;
 
-	/// The detector of the calling thread (Mode::Frames has a second one,
-	/// configured alike, for the worker).
-	Detector &detector();
+	/// Threads that detect, the calling one included.
+	int threads() const;
+
+	/// The detectors, configured alike (Mode::Frames has one per thread,
+	/// detector 0 the calling thread's): to set a front end or a warper on
+	/// each before the first push.
+	int detectorCount() const;
+	Detector &detector(int index = 0);
 
 private:
 	struct Impl;
