@@ -23,7 +23,7 @@ public:
 
 /*
  * Puts the front end named `name` into `detector`: "cpu" keeps the CPU front
- * end the detector has; "vc4", "vc4-emu" and "auto" go to vc4/, which decides
+ * end the detector has; "vc4", "vc4-emu" and "auto" go to vc4/backend, which decides
  * what runs ("auto" without vc4/ in the build keeps the CPU). `threads` are
  * the bands of a CPU front end that "auto" falls back to.
  *

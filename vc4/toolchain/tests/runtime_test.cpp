@@ -310,7 +310,7 @@ TEST(RuntimeDevice, AllocationGoesThroughHeapMapAndImport)
 	const std::vector<std::string> expected = {
 		"ioctl /dev/dma_heap/vidbuf_cached " + test::hex32(uapi::kIoctlDmaHeapAlloc) + " len=8192 -> dmabuf3",
 		"mmap dmabuf3 8192 @0x00000000",
-		"ioctl /dev/vcsm-cma " + test::hex32(uapi::kIoctlVcsmImportDmabuf) + " dmabuf3 cached=0 name=frappe",
+		"ioctl /dev/vcsm-cma " + test::hex32(uapi::kIoctlVcsmImportDmabuf) + " dmabuf3 cached=0 name=vc4-qpu",
 		"sync dmabuf3 0x00000003"};
 	EXPECT_EQ(os.log, expected);
 }

@@ -49,7 +49,7 @@ TEST(Listing, HexListingRoundTrip)
 
 TEST(Pgm, RoundTrip)
 {
-	const auto path = std::filesystem::temp_directory_path() / "frappe-vc4-pgm-test.pgm";
+	const auto path = std::filesystem::temp_directory_path() / "vc4-pgm-test.pgm";
 	tools::GreyImage img{3, 2, {1, 2, 3, 250, 251, 252}};
 	tools::writePgm(path.string(), img);
 	const auto back = tools::readPgm(path.string());

@@ -119,7 +119,7 @@ bool tryDmaHeap(Os &os, const DeviceOptions &o, ProbeReport &r)
 		uapi::VcsmImportDmabuf import;
 		import.dmabuf_fd = buf.fd;
 		import.cached = uapi::kVcsmCacheNone;
-		std::memcpy(import.name, "frappe-probe", 12);
+		std::memcpy(import.name, "vc4-qpu-probe", 13);
 		e = os.ioctl(vcsm.fd, uapi::kIoctlVcsmImportDmabuf, &import);
 		if (e < 0 || import.handle < 0 || import.dma_addr == 0) {
 			notes += (notes.empty() ? "" : "; ") + o.vcsm + " import of a " + path + " buffer failed: " +
@@ -316,7 +316,7 @@ GpuDevice::Allocation GpuDevice::allocateDmaHeap(uint32_t bytes, uint32_t align)
 	uapi::VcsmImportDmabuf import;
 	import.dmabuf_fd = a.dmabuf;
 	import.cached = uapi::kVcsmCacheNone;
-	std::memcpy(import.name, "frappe", 6);
+	std::memcpy(import.name, "vc4-qpu", 7);
 	e = os_.ioctl(vcsm_, uapi::kIoctlVcsmImportDmabuf, &import);
 	if (e < 0 || import.handle < 0 || import.dma_addr == 0) {
 		free(a);
