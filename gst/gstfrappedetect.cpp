@@ -60,8 +60,8 @@
  *
  * With #GstFrappeDetect:pipelined, two frames are detected at once, each
  * whole frame on a detector of its own on one of two threads (a
- * frappe::Pipeline): about twice the frame rate a core allows, for one frame
- * of latency. The element then holds one buffer, answers the LATENCY query
+ * frappe::Pipeline): about 1.5 times the frame rate a core allows, for one
+ * frame of latency. The element then holds one buffer, answers the LATENCY query
  * with one extra frame, asks upstream pools for one more buffer, pushes the
  * held buffer on EOS, caps, segment, gap, stream-start and DRAIN queries,
  * and drops it on flush. Every buffer comes out once, in order, with its own
@@ -183,7 +183,7 @@ static bool select_front_end(GstFrappeDetect *self, frappe::Detector &detector)
 }
 
 /* The pipeline of the active settings: frames on one thread, or whole
- * frames on two (pipelined, one buffer held). */
+ * frames on two with one frame of latency (pipelined: one buffer held). */
 static bool ensure_pipeline(GstFrappeDetect *self)
 {
 	FrappeDetectPrivate *priv = self->priv;
@@ -191,7 +191,8 @@ static bool ensure_pipeline(GstFrappeDetect *self)
 		return true;
 	const frappe::Config config = priv->active.config();
 	try {
-		priv->pipeline = std::make_unique<frappe::Pipeline>(config, frappe::Pipeline::Mode::Frames);
+		priv->pipeline = std::make_unique<frappe::Pipeline>(config, frappe::Pipeline::Mode::Frames,
+								     priv->active.pipelined ? 1 : 0);
 	} catch (const std::exception &e) {
 		GST_ELEMENT_ERROR(self, LIBRARY, SETTINGS, ("Invalid detector settings"), ("%s", e.what()));
 		return false;

@@ -40,7 +40,9 @@ int threadCount(const Config &config)
 
 } // namespace
 
-/// Mode::Frames. Frames wait in a ring of latency + 1 entries; each idle
+/// Mode::Frames. Frames wait in a ring of latency + 1 entries (a frame
+/// in flight beyond those `threads` run gives a thread slack to start the
+/// next while the caller waits for a slow one); each idle
 /// worker drains it with its own detector and runs on after push() returns;
 /// the caller runs a frame only when the result it must return belongs to
 /// a frame nobody has started. Each frame's Result is copied into the ring
@@ -49,7 +51,8 @@ int threadCount(const Config &config)
 class FrameQueue
 {
 public:
-	FrameQueue(const Config &config, int threads) : latency_(threads - 1), ring_(static_cast<std::size_t>(threads))
+	FrameQueue(const Config &config, int threads, int latency)
+		: latency_(latency), ring_(static_cast<std::size_t>(latency) + 1)
 	{
 		Config single = config;
 		single.threads = 1; /* the threads are here, not in the bands */
@@ -341,12 +344,21 @@ struct FRAPPE_HIDDEN Pipeline::Impl {
 	std::unique_ptr<detail::StageQueue> stages; /* Mode::Stages */
 };
 
-Pipeline::Pipeline(const Config &config, Mode mode) : impl_(std::make_unique<Impl>())
+Pipeline::Pipeline(const Config &config, Mode mode, int latency) : impl_(std::make_unique<Impl>())
 {
-	if (mode == Mode::Stages)
+	auto fail = [](const std::string &what) { throw std::invalid_argument("frappe::Pipeline: " + what); };
+	if (mode == Mode::Stages) {
+		if (latency != kDefaultLatency && latency != detail::StageQueue::kLatency)
+			fail("Mode::Stages has a latency of 2, not " + std::to_string(latency));
 		impl_->stages = std::make_unique<detail::StageQueue>(config);
-	else
-		impl_->frames = std::make_unique<detail::FrameQueue>(config, detail::threadCount(config));
+		return;
+	}
+	const int threads = detail::threadCount(config);
+	if (latency == kDefaultLatency)
+		latency = threads > 1 ? threads : 0;
+	if (latency < 0 || latency > 256)
+		fail("latency must be in [0, 256], got " + std::to_string(latency));
+	impl_->frames = std::make_unique<detail::FrameQueue>(config, threads, latency);
 }
 
 Pipeline::~Pipeline() = default;

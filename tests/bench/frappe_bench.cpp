@@ -14,7 +14,8 @@
 // (Debian's libapriltag) runs too, single-threaded, at decimate 1 and 2.
 //
 // Then, unless --no-extras: throughput with two threads (front-end bands,
-// the pipelined mode, whole frames on two detectors) against one; the cost
+// the staged pipeline, whole frames on two detectors at latency 2 and at the
+// element's latency 1) against one; the cost
 // of the same frames at 1280x960 against 640x480; and of a frame with 24
 // markers against one.
 // Not a test: speed is never asserted.
@@ -164,7 +165,8 @@ void reportThroughput(const frappe::Config &base, const std::vector<cv::Mat> &im
 	one.threads = 1;
 	two.threads = 2;
 	frappe::Detector d1(one), d2(two);
-	frappe::Pipeline pipe(one, frappe::Pipeline::Mode::Stages), frames(two, frappe::Pipeline::Mode::Frames);
+	frappe::Pipeline pipe(one, frappe::Pipeline::Mode::Stages), frames(two, frappe::Pipeline::Mode::Frames),
+		held(two, frappe::Pipeline::Mode::Frames, 1);
 	std::size_t sink = 0;
 	auto single = [&](const cv::Mat &g) { sink += d1.detect(viewOf(g)).markers.size(); };
 	auto bands = [&](const cv::Mat &g) { sink += d2.detect(viewOf(g)).markers.size(); };
@@ -176,6 +178,10 @@ void reportThroughput(const frappe::Config &base, const std::vector<cv::Mat> &im
 		if (const frappe::Result *r = frames.push(viewOf(g)))
 			sink += r->markers.size();
 	};
+	auto wholeHeld = [&](const cv::Mat &g) { /* the element's pipelined mode */
+		if (const frappe::Result *r = held.push(viewOf(g)))
+			sink += r->markers.size();
+	};
 	/* Warm-up: buffers and worker threads. */
 	throughputMs(images, 1, single);
 	throughputMs(images, 1, bands);
@@ -183,7 +189,9 @@ void reportThroughput(const frappe::Config &base, const std::vector<cv::Mat> &im
 	while (pipe.flush()) {}
 	throughputMs(images, 1, whole);
 	while (frames.flush()) {}
-	double t1 = 0, t2 = 0, tp = 0, tf = 0;
+	throughputMs(images, 1, wholeHeld);
+	while (held.flush()) {}
+	double t1 = 0, t2 = 0, tp = 0, tf = 0, th = 0;
 	for (int r = 0; r < repeat; ++r) { /* interleaved runs */
 		t1 += throughputMs(images, 1, single);
 		t2 += throughputMs(images, 1, bands);
@@ -191,12 +199,15 @@ void reportThroughput(const frappe::Config &base, const std::vector<cv::Mat> &im
 		while (pipe.flush()) {}
 		tf += throughputMs(images, 1, whole);
 		while (frames.flush()) {}
+		th += throughputMs(images, 1, wholeHeld);
+		while (held.flush()) {}
 	}
 	std::printf("\nthroughput, frames per second over %zu frames x %d:\n", images.size(), repeat);
 	std::printf("  1 thread                     %8.1f fps\n", 1000.0 * repeat / t1);
 	std::printf("  2 threads, front-end bands   %8.1f fps  (%.2fx)\n", 1000.0 * repeat / t2, t1 / t2);
 	std::printf("  2 threads, pipelined (3 stg) %8.1f fps  (%.2fx)\n", 1000.0 * repeat / tp, t1 / tp);
 	std::printf("  2 threads, whole frames      %8.1f fps  (%.2fx)\n", 1000.0 * repeat / tf, t1 / tf);
+	std::printf("  2 threads, whole, latency 1  %8.1f fps  (%.2fx)\n", 1000.0 * repeat / th, t1 / th);
 	if (sink == 0)
 		std::printf("  (no markers found)\n");
 }

@@ -75,6 +75,7 @@ void pushTheRest(Pipeline &pipeline, const std::vector<Image> &frames, std::size
 struct Setup {
 	Pipeline::Mode mode;
 	int threads;
+	int latencyAsked;
 	int latency;
 	int detectors;
 	const char *name;
@@ -99,7 +100,7 @@ TEST_P(PipelineModes, SameMarkersAsDetectLatencyFramesLateInOrder)
 	for (const Image &f : frames)
 		expected.push_back(reference.detect(f.view()));
 
-	Pipeline pipeline(configOf(GetParam()), GetParam().mode);
+	Pipeline pipeline(configOf(GetParam()), GetParam().mode, GetParam().latencyAsked);
 	EXPECT_EQ(pipeline.latency(), GetParam().latency);
 	EXPECT_EQ(pipeline.detectorCount(), GetParam().detectors);
 	std::vector<Result> got;
@@ -129,7 +130,7 @@ TEST_P(PipelineModes, SameMarkersAsDetectLatencyFramesLateInOrder)
 TEST_P(PipelineModes, DropForgetsTheFramesInFlight)
 {
 	const std::vector<Image> frames = sequence(6);
-	Pipeline pipeline(configOf(GetParam()), GetParam().mode);
+	Pipeline pipeline(configOf(GetParam()), GetParam().mode, GetParam().latencyAsked);
 	for (int i = 0; i < 3; ++i)
 		pipeline.push(frames[static_cast<std::size_t>(i)].view());
 	pipeline.drop();
@@ -140,25 +141,26 @@ TEST_P(PipelineModes, DropForgetsTheFramesInFlight)
 
 TEST_P(PipelineModes, FlushWithNothingInFlight)
 {
-	Pipeline pipeline(configOf(GetParam()), GetParam().mode);
+	Pipeline pipeline(configOf(GetParam()), GetParam().mode, GetParam().latencyAsked);
 	EXPECT_FALSE(pipeline.pending());
 	EXPECT_EQ(pipeline.flush(), nullptr);
 	/* A pipeline may be destroyed with frames in flight, in Frames mode
 	 * with a worker still on one. */
 	const std::vector<Image> frames = sequence(2);
-	Pipeline other(configOf(GetParam()), GetParam().mode);
+	Pipeline other(configOf(GetParam()), GetParam().mode, GetParam().latencyAsked);
 	other.push(frames[0].view());
 	other.push(frames[1].view());
 }
 
 INSTANTIATE_TEST_SUITE_P(All, PipelineModes,
-			 ::testing::Values(Setup{ Pipeline::Mode::Stages, 1, 2, 1, "Stages" },
-					   Setup{ Pipeline::Mode::Frames, 1, 0, 1, "FramesOneThread" },
-					   Setup{ Pipeline::Mode::Frames, 2, 1, 2, "FramesTwoThreads" },
-					   Setup{ Pipeline::Mode::Frames, 3, 2, 3, "FramesThreeThreads" }),
+			 ::testing::Values(Setup{ Pipeline::Mode::Stages, 1, -1, 2, 1, "Stages" },
+					   Setup{ Pipeline::Mode::Frames, 1, -1, 0, 1, "FramesOneThread" },
+					   Setup{ Pipeline::Mode::Frames, 2, -1, 2, 2, "FramesTwoThreads" },
+					   Setup{ Pipeline::Mode::Frames, 2, 1, 1, 2, "FramesTwoThreadsLatencyOne" },
+					   Setup{ Pipeline::Mode::Frames, 3, -1, 3, 3, "FramesThreeThreads" }),
 			 [](const auto &info) { return std::string(info.param.name); });
 
-TEST(Pipeline, ThreadsAreCheckedAndZeroIsOnePerCore)
+TEST(Pipeline, ThreadsAndLatencyAreCheckedAndZeroThreadsIsOnePerCore)
 {
 	Config c;
 	c.threads = -1;
@@ -168,10 +170,13 @@ TEST(Pipeline, ThreadsAreCheckedAndZeroIsOnePerCore)
 	c.threads = 0;
 	Pipeline perCore(c, Pipeline::Mode::Frames);
 	EXPECT_EQ(perCore.threads(), static_cast<int>(std::max(1u, std::thread::hardware_concurrency())));
-	EXPECT_EQ(perCore.latency(), perCore.threads() - 1);
+	EXPECT_EQ(perCore.latency(), perCore.threads() > 1 ? perCore.threads() : 0);
 	/* Each detector of Mode::Frames runs on its own thread only. */
 	EXPECT_EQ(perCore.detector(0).config().threads, 1);
 	EXPECT_THROW(Pipeline(Config{}, Pipeline::Mode::Stages).detector(1), std::out_of_range);
+	EXPECT_THROW(Pipeline(Config{}, Pipeline::Mode::Stages, 1), std::invalid_argument);
+	EXPECT_THROW(Pipeline(Config{}, Pipeline::Mode::Frames, -2), std::invalid_argument);
+	EXPECT_THROW(Pipeline(Config{}, Pipeline::Mode::Frames, 257), std::invalid_argument);
 }
 
 TEST(Pipeline, BadFrameIsRefusedAndTheFrameInFlightSurvives)

@@ -87,8 +87,8 @@ struct Config {
 
 	/// Threads; 1 = strictly single-threaded, 0 = one per hardware core. A
 	/// Pipeline (Mode::Frames) runs this many whole frames at once, one per
-	/// thread: what pays on a stream (1.8-2.1x with two threads, for
-	/// threads - 1 frames of latency and a detector's memory per thread). A
+	/// thread: what pays on a stream (1.8x with two threads, for a frame of
+	/// latency per thread and a detector's memory per thread). A
 	/// lone Detector, which has one frame at a time, splits its front end
 	/// into row bands instead: 0.6-1.0x on 640x480, only worth it on large
 	/// frames.
