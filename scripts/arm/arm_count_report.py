@@ -133,7 +133,7 @@ def stage_of(obj, name):
         return "warp"
     if base in ("dictionary", "dictionaries"):
         return "decode"
-    if base in ("detector", "pipeline"):
+    if base in ("detector", "candidate_reader", "pipeline"):
         return "detector"
     return "other"
 
@@ -332,7 +332,7 @@ def main():
         P("Library code is Debian armel's (ARMv5TE, soft-float libm: an atan2f call costs ~1500 instructions "
           "there, a sin/cos/atan2 in double ~2700): on a hard-float Pi OS build it costs a fraction of this.\n")
     P("Stages by the object file / function each instruction's function belongs to (library and libgcc "
-      "code counted to its caller); `detector` = detector.cpp's own code (checks, the back end's loop). "
+      "code counted to its caller); `detector` = detector.cpp's and candidate_reader.cpp's own code (checks, the back end's loop). "
       "Medians of each row are taken separately, so they do not add up to the whole frame's median.\n")
     if cv_l:
         P("### OpenCV 4.6 aruco (Debian armel: ARMv5TE, soft-float; reference only)\n" if a.arch == "armv6"

@@ -1,0 +1,386 @@
+// SPDX-License-Identifier: MIT
+// The back end after the trace: each candidate, smallest first, placed on
+// the frame (or the frame halved into blocks for large cells), its corners
+// refined, warped to the sample grid, binarised, decoded and verified; the
+// markers kept once. Detector::Impl::finish() is the entry.
+#include <algorithm>
+#include <cmath>
+#include <span>
+
+#include "corner_refine.h"
+#include "detector_impl.h"
+#include "marker_set.h"
+#include "quad_geometry.h"
+
+namespace frappe {
+
+namespace {
+
+using detail::bigEnough;
+using detail::cellSide;
+using detail::kMaxReadBlock;
+using detail::kReadCell;
+using detail::quadArea;
+using detail::sidesAtLeast;
+using detail::StageTimer;
+using detail::toFullResolution;
+
+/* Cells under 4 px along some side of the quad: there warpMarker's
+ * samples, a quarter cell from the cell's edges, lie within a pixel of the
+ * neighbouring cells, and blur of a pixel mixes them in. */
+bool smallCells(const std::array<Point2f, 4> &q, int bits)
+{
+	return !sidesAtLeast(q, 4.0f * static_cast<float>(bits + 2));
+}
+
+/* The block (1: the frame itself) a candidate with cells of `cell` pixels
+ * is read at. */
+int readBlock(float cell)
+{
+	int f = 1;
+	while (2 * f <= kMaxReadBlock && cell >= static_cast<float>(2 * f) * kReadCell)
+		f *= 2;
+	return f;
+}
+
+/* The corner refinement window for cells large enough (refineQuad). */
+constexpr detail::RefineWindow kBlurWindow{ 6, 64, true, 2 };
+
+/* The traced outline lies within 2.5 traced pixels of the marker's. */
+constexpr float kSearch = 2.5f;
+
+} // namespace
+
+/* Refines a candidate's corners in place. A region outline lies up to a
+ * region pixel inside the marker's: a wider search. On cells of 6 px or
+ * more, a wide window (RefineWindow{6, 64}: 3.5 px either side) stays on
+ * the border's outer edge, away from the code's, and unlike the default one
+ * it stays unbiased on strongly blurred edges (blur set: corner error 0.40
+ * -> 0.35 px). It can fail to measure a side where the default one does
+ * not (large blurred markers upsampled 3x): then the default one. `image`
+ * is the frame or the frame halved to blocks of `block` pixels (finish()). */
+bool Detector::Impl::refineQuad(const ImageView &image, const Slot &slot, detail::Quad &q, float search,
+				 int block) const
+{
+	if (q.fromRegion)
+		search = std::max(search, 2.0f / slot.edges.regions.scale / static_cast<float>(block));
+	const float wideCell = 6.0f * static_cast<float>(dict->bits + 2);
+	if (sidesAtLeast(q.corners, wideCell) && detail::refineCorners(image, q.corners, search, kBlurWindow))
+		return true;
+	return detail::refineCorners(image, q.corners, search);
+}
+
+/* `image` halved f (2, 4, 8) times, whole or the blocks of a patch
+ * reaching `margin` pixels beyond the outline's box. */
+Detector::Impl::BlockView Detector::Impl::blockView(const ImageView &image, int f,
+						   const std::array<Point2f, 4> &outline, float margin)
+{
+	const std::size_t frameArea = static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height);
+	if (image.width != blockSizedW || image.height != blockSizedH) {
+		blockSizedW = image.width;
+		blockSizedH = image.height;
+		blockFrameOf.fill(0);
+		std::size_t all = 0;
+		for (int g = 2; g <= kMaxReadBlock; g *= 2) {
+			blockFrameAt[static_cast<std::size_t>(g)] = all;
+			all += static_cast<std::size_t>(image.width / g) * static_cast<std::size_t>(image.height / g);
+		}
+		blockFrames.resize(all);
+		blockPatch.reserve(frameArea / 4);
+		blockHalf.resize(frameArea / 4 + frameArea / 16);
+	}
+	/* The frame (or patch) halved log2(f) times: the first halvings into
+	 * blockHalf (a quarter of the frame, then a sixteenth), the last into
+	 * `out`. */
+	auto halve = [&](const ImageView &src, std::uint8_t *out) {
+		ImageView level = src;
+		for (int g = 2; g < f; g *= 2) {
+			const int w = level.width / 2, h = level.height / 2;
+			std::uint8_t *dst = blockHalf.data() + (g == 2 ? 0 : frameArea / 4);
+			detail::halveImage(level, dst);
+			level = ImageView(dst, w, h, w);
+		}
+		detail::halveImage(level, out);
+	};
+	const int W = image.width / f, H = image.height / f;
+	float x0 = outline[0].x, x1 = x0, y0 = outline[0].y, y1 = y0;
+	for (const Point2f &p : outline) {
+		x0 = std::min(x0, p.x);
+		x1 = std::max(x1, p.x);
+		y0 = std::min(y0, p.y);
+		y1 = std::max(y1, p.y);
+	}
+	const float ff = static_cast<float>(f);
+	const int bx0 = std::clamp(static_cast<int>(std::floor((x0 - margin) / ff)), 0, W);
+	const int by0 = std::clamp(static_cast<int>(std::floor((y0 - margin) / ff)), 0, H);
+	const int bx1 = std::clamp(static_cast<int>(std::ceil((x1 + margin) / ff)) + 1, bx0, W);
+	const int by1 = std::clamp(static_cast<int>(std::ceil((y1 + margin) / ff)) + 1, by0, H);
+	const int w = bx1 - bx0, h = by1 - by0;
+	const std::size_t read = static_cast<std::size_t>(w) * static_cast<std::size_t>(h) * static_cast<std::size_t>(f * f);
+	const auto fi = static_cast<std::size_t>(f);
+	BlockView b;
+	if (blockFrameOf[fi] != finishedFrames && blockPatchRead + read <= frameArea) {
+		blockPatchRead += read;
+		blockPatch.resize(static_cast<std::size_t>(w) * static_cast<std::size_t>(h));
+		if (w > 0 && h > 0)
+			halve(ImageView(image.row(by0 * f) + bx0 * f, w * f, h * f, image.stride), blockPatch.data());
+		b.view = ImageView(blockPatch.data(), w, h, w);
+		b.ox = bx0 * f;
+		b.oy = by0 * f;
+		return b;
+	}
+	std::uint8_t *frame = blockFrames.data() + blockFrameAt[fi];
+	if (blockFrameOf[fi] != finishedFrames) {
+		if (W > 0 && H > 0)
+			halve(image, frame);
+		blockFrameOf[fi] = finishedFrames;
+	}
+	b.view = ImageView(frame, W, H, W);
+	return b;
+}
+
+/* Batch mode: every candidate refined, then all warped in one call. */
+void Detector::Impl::refineAndWarpAll(const ImageView &image, Slot &slot, float search)
+{
+	const std::size_t n = slot.quads.size();
+	batch.outlines.resize(n);
+	batch.refined.resize(n);
+	batch.place.resize(n);
+	batch.quads.clear();
+	StageTimer timer(slot.result.times, Stage::Refine);
+	for (std::size_t k = 0; k < n; ++k) {
+		std::array<Point2f, 4> &corners = slot.quads[k].corners;
+		batch.outlines[k] = corners;
+		batch.place[k] = -1;
+		batch.refined[k] = 0;
+		if (readBlock(cellSide(corners, dict->bits)) > 1)
+			continue; /* read on a halved frame by finish() */
+		batch.refined[k] = refineQuad(image, slot, slot.quads[k], search, 1);
+		if (batch.refined[k] && bigEnough(corners, config.min_marker_side)) {
+			batch.place[k] = static_cast<int>(batch.quads.size());
+			batch.quads.push_back(corners);
+		}
+	}
+	timer.lap(Stage::Warp);
+	const std::size_t m = batch.quads.size();
+	batch.warpedOk.assign(m, 0);
+	batch.samples.resize(std::max(batch.samples.size(), m));
+	warper->warp(image, batch.quads, (dict->bits + 2) * detail::kSamplesPerCell,
+		     std::span(batch.samples).first(m), batch.warpedOk);
+}
+
+/* Candidates not worth refining: the outline of a decoded marker's quiet
+ * zone, and clutter as the probe's read at the traced outline shows it. */
+bool Detector::Impl::skipCandidate(const detail::Quad &q, const std::array<Point2f, 4> &tracedOutline,
+				   const std::vector<Marker> &found) const
+{
+	const int bits = dict->bits;
+	const int traced = q.probeRead;
+	if (detail::surroundsMarker(tracedOutline, quadArea(tracedOutline), traced, bits, found))
+		return true;
+	/* The probe's read at the traced outline decides two things before
+	 * refinement. A frame with more white cells than twice what decode
+	 * forgives, on a quad of at least 4 px a cell (where the traced outline
+	 * lies well within a cell of the refined one), is clutter: nothing to
+	 * refine. A white frame goes straight to the inset read (readInset()),
+	 * which starts from the traced outline anyway.
+	 * A region outline lies inside the marker's, so its frame samples fall
+	 * on the border cells at any size: a mixed frame is clutter there
+	 * whatever the size. So is a region whose samples spread less than the
+	 * contrast that made it a dark region: a patch of dark texture, not a
+	 * code. (Together they drop two thirds of the region quads that used
+	 * to be refined for nothing, at the cost of no marker.) */
+	if (traced < 0)
+		return false;
+	const int mixedFrame = 2 * detail::allowedBorderErrors(bits);
+	const bool mixed = traced > mixedFrame && traced < whiteFrame();
+	if (q.fromRegion)
+		return mixed || q.probeContrast < static_cast<float>(params.region_contrast);
+	return mixed && sidesAtLeast(tracedOutline, 4.0f * static_cast<float>(bits + 2));
+}
+
+/* Large cells are read on the frame halved f times, in its pixels
+ * (readBlock()). The patch reaches what refinement reads across a side (its
+ * search and profile: 13 pixels of the halved frame at most) and the reads'
+ * ring a cell outside the border; a white frame is only read inside
+ * (insetQuad()). Leaves q's corners in the block's pixels. */
+Detector::Impl::Reading Detector::Impl::placeCandidate(const ImageView &image, detail::Quad &q,
+							const std::array<Point2f, 4> &tracedOutline)
+{
+	Reading r;
+	const float cellPx = cellSide(tracedOutline, dict->bits);
+	r.f = readBlock(cellPx);
+	r.inBatch = warper != nullptr && r.f == 1;
+	const float ff = static_cast<float>(r.f);
+	r.block = r.f == 1 ? BlockView{ image }
+			   : blockView(image, r.f, tracedOutline,
+				       q.probeRead >= whiteFrame() ? ff : std::max(14.0f * ff, cellPx + 2.0f * ff));
+	r.minSide = config.min_marker_side / ff;
+	r.outline = tracedOutline;
+	if (r.f > 1) {
+		const Point2f origin{ static_cast<float>(r.block.ox), static_cast<float>(r.block.oy) };
+		for (int i = 0; i < 4; ++i) {
+			r.outline[i] = toFullResolution({ r.outline[i].x - origin.x, r.outline[i].y - origin.y }, ff);
+			q.corners[i] = r.outline[i];
+		}
+	}
+	return r;
+}
+
+/* Warps and binarises a refined candidate large enough to read. */
+void Detector::Impl::sampleRefined(Reading &r, const detail::Quad &q, std::size_t k, Result &res,
+				   StageTimer &timer)
+{
+	r.samples = &warped;
+	if (!r.refined || !bigEnough(q.corners, r.minSide))
+		return;
+	++res.candidates;
+	timer.lap(Stage::Warp);
+	if (r.inBatch) {
+		const int j = batch.place[k];
+		r.refined = batch.warpedOk[static_cast<std::size_t>(j)] != 0;
+		r.samples = &batch.samples[static_cast<std::size_t>(j)];
+	} else {
+		r.refined = detail::warpMarker(r.block.view, q.corners, dict->bits, warped);
+	}
+	timer.lap(Stage::Decode);
+	if (r.refined)
+		r.b = detail::binarise(*r.samples, dict->bits);
+}
+
+/* No dark frame inside the outline, or a white one: this may be the outline
+ * of the quiet zone (the marker's own outline merged with its code's edges,
+ * as on small or blurred markers). The marker would lie one cell inside. */
+void Detector::Impl::readInset(Reading &r, detail::Quad &q, Result &res, StageTimer &timer)
+{
+	timer.lap(Stage::Refine);
+	q.corners = r.outline;
+	const bool inset = detail::insetQuad(r.block.view, q.corners, dict->bits, warped);
+	r.readable = inset && bigEnough(q.corners, r.minSide);
+	if (!r.readable)
+		return;
+	++res.candidates;
+	timer.lap(Stage::Decode);
+	r.samples = &warped;
+	r.b = detail::binarise(warped, dict->bits);
+}
+
+/* Decodes a sampled candidate, trying what else may read when its samples
+ * do not; on a read at the traced outline, q takes that outline. */
+detail::MarkerRead Detector::Impl::decodeCandidate(const Reading &r, detail::Quad &q)
+{
+	const ImageView &img = r.block.view;
+	const int bits = dict->bits;
+	detail::MarkerRead read;
+	if (!r.readable)
+		return read;
+	if (smallCells(q.corners, bits)) {
+		/* Quarter-cell samples of small cells lie within a pixel of
+		 * their neighbours: read the cells at their centres, at the
+		 * refined corners, else at the traced ones. */
+		if (bigEnough(q.corners, r.minSide))
+			read = detail::readCellCentres(img, q.corners, *codes, policy, warped);
+		if (!read.ok() && r.refined && bigEnough(r.outline, r.minSide)) {
+			read = detail::readCellCentres(img, r.outline, *codes, policy, warped);
+			if (read.ok())
+				q.corners = r.outline;
+		}
+		return read;
+	}
+	if (detail::readable(r.b, bits))
+		read = detail::readMarker(img, q.corners, *codes, policy, *r.samples, r.b);
+	if (!read.ok() && r.refined && r.b.border_errors < whiteFrame()) {
+		/* Refinement can pull a blurred marker's sides onto its code's
+		 * edges; the traced outline may still read. */
+		if (detail::warpMarker(img, r.outline, bits, warped)) {
+			const detail::Binarised bt = detail::binarise(warped, bits);
+			if (detail::readable(bt, bits)) {
+				read = detail::readMarker(img, r.outline, *codes, policy, warped, bt);
+				if (read.ok())
+					q.corners = r.outline;
+			}
+		}
+	}
+	if (!read.ok()) {
+		/* Blur of about a cell (a blurred marker, or a small one
+		 * upsampled) reaches the quarter-cell samples of cells of any
+		 * size. */
+		read = detail::readCellCentres(img, q.corners, *codes, policy, warped);
+	}
+	return read;
+}
+
+/* Reads candidate k: refine, warp, binarise; the inset read when that finds
+ * no dark frame; then decoding and its fallbacks. A marker read is left in
+ * `m`, its corners in frame pixels from the code's first. */
+bool Detector::Impl::readCandidate(const ImageView &image, Slot &slot, std::size_t k, float search,
+				   StageTimer &timer, Marker &m)
+{
+	detail::Quad &q = slot.quads[k];
+	const std::array<Point2f, 4> tracedOutline = warper ? batch.outlines[k] : q.corners;
+	if (skipCandidate(q, tracedOutline, slot.result.markers))
+		return false;
+	Reading r = placeCandidate(image, q, tracedOutline);
+	/* With at least the frame's search on a halved frame: blur spreads a
+	 * large marker's edges over as many of its pixels as a small one's
+	 * over the frame's. */
+	const float ff = static_cast<float>(r.f);
+	r.refined = r.inBatch ? batch.refined[k] != 0
+			      : q.probeRead < whiteFrame() &&
+					refineQuad(r.block.view, slot, q, std::max(search / ff, kSearch), r.f);
+	sampleRefined(r, q, k, slot.result, timer);
+	if (!r.refined || r.b.border_errors >= whiteFrame())
+		readInset(r, q, slot.result, timer);
+	timer.lap(Stage::Decode);
+	const detail::MarkerRead read = decodeCandidate(r, q);
+	if (!read.ok())
+		return false;
+	if (r.f > 1) {
+		const Point2f origin{ static_cast<float>(r.block.ox), static_cast<float>(r.block.oy) };
+		for (Point2f &p : q.corners) {
+			p = toFullResolution(p, 1.0f / ff);
+			p = { p.x + origin.x, p.y + origin.y };
+		}
+	}
+	const detail::Decoded &d = read.decoded;
+	m.id = d.id;
+	m.hamming = d.hamming;
+	m.margin = read.margin;
+	for (int i = 0; i < 4; ++i)
+		m.corners[i] = q.corners[(i + d.rotation) & 3];
+	return true;
+}
+
+/* The candidates in order, smallest first: each read, each marker kept
+ * once. */
+void Detector::Impl::finish(const ImageView &image, Slot &slot)
+{
+	Result &res = slot.result;
+	res.markers.clear();
+	res.candidates = 0;
+	res.times[Stage::Refine] = res.times[Stage::Warp] = res.times[Stage::Decode] = 0.0;
+	++finishedFrames; /* halved frames made before are stale */
+	blockPatchRead = 0;
+	const float scale = slot.edges.scale;
+	const float search = kSearch / scale;
+	{
+		StageTimer timer(res.times, Stage::Refine);
+		for (detail::Quad &q : slot.quads)
+			for (Point2f &p : q.corners)
+				p = toFullResolution(p, scale);
+	}
+	if (warper)
+		refineAndWarpAll(image, slot, search);
+	for (std::size_t k = 0; k < slot.quads.size(); ++k) {
+		StageTimer timer(res.times, Stage::Refine);
+		Marker m;
+		if (readCandidate(image, slot, k, search, timer, m))
+			detail::keepMarker(res.markers, m);
+	}
+	/* Smallest first, a block of a marker's code cells decoded before the
+	 * marker around it did: now that both are known, drop it. */
+	StageTimer timer(res.times, Stage::Decode);
+	detail::dropNestedMarkers(res.markers, dict->bits);
+}
+
+} // namespace frappe
