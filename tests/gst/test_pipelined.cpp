@@ -222,7 +222,7 @@ TEST(Pipelined, StateCyclesWithAFrameInFlight)
 	gst_harness_set_src_caps_str(h, capsString(spec).c_str());
 	for (int cycle = 0; cycle < 5; ++cycle) {
 		ASSERT_EQ(gst_harness_push(h, frameOf(2 * cycle, spec)), GST_FLOW_OK);
-		/* The frame is held (its back end may still be running). */
+		/* The frame is held (its detection may still be running). */
 		ASSERT_EQ(gst_element_set_state(h->element, GST_STATE_NULL), GST_STATE_CHANGE_SUCCESS);
 		ASSERT_EQ(gst_element_set_state(h->element, GST_STATE_PLAYING), GST_STATE_CHANGE_SUCCESS);
 		/* The sink pad lost its sticky events: send them again. */
