@@ -46,6 +46,8 @@ void validate(const Config &c, const Dictionary &d)
 		fail("region_contrast must be in [0, 1], got " + std::to_string(c.region_contrast));
 	if (c.threads < 0 || c.threads > 256)
 		fail("threads must be in [0, 256], got " + std::to_string(c.threads));
+	if (c.max_pixels < 1 || c.max_pixels > (1LL << 30))
+		fail("max_pixels must be in [1, 2^30], got " + std::to_string(c.max_pixels));
 }
 
 /* Reads a traced quad as a marker, so that the tracer can skip the
@@ -116,6 +118,9 @@ void Detector::Impl::checkImage(const ImageView &image) const
 		     std::to_string(image.height));
 	if (image.width > kMaxSide || image.height > kMaxSide)
 		fail("image side must be at most " + std::to_string(kMaxSide) + " pixels");
+	if (static_cast<long long>(image.width) * image.height > config.max_pixels)
+		fail("image of " + std::to_string(image.width) + "x" + std::to_string(image.height) +
+		     " has more than max_pixels (" + std::to_string(config.max_pixels) + ") pixels");
 	if (image.stride < image.width)
 		fail("stride (" + std::to_string(image.stride) + ") is smaller than the width (" +
 		     std::to_string(image.width) + ")");

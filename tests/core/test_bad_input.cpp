@@ -44,6 +44,28 @@ TEST(BadInput, OutOfRangeParameters)
 	c = Config{};
 	c.threads = -2;
 	EXPECT_NE(errorOf([&] { Detector d(c); }).find("threads"), std::string::npos);
+	c = Config{};
+	c.max_pixels = 0;
+	EXPECT_NE(errorOf([&] { Detector d(c); }).find("max_pixels"), std::string::npos);
+}
+
+/* A frame beyond max_pixels is refused before any buffer grows to it (no
+ * pixel is read: the view's data may be a lie); a frame at the limit runs. */
+TEST(BadInput, FramesBeyondMaxPixelsAreRefused)
+{
+	std::vector<std::uint8_t> px(64 * 64, 100);
+	Config c;
+	c.max_pixels = 64 * 63;
+	Detector det(c);
+	const std::string e = errorOf([&] { det.detect(ImageView(px.data(), 64, 64, 64)); });
+	EXPECT_NE(e.find("64x64 has more than max_pixels (4032)"), std::string::npos) << e;
+	EXPECT_TRUE(det.detect(ImageView(px.data(), 64, 63, 64)).markers.empty());
+	/* The default refuses 30000 x 30000 (a 900 MP image a small PNG can
+	 * claim) without touching it. */
+	Detector defaults(Config{});
+	const std::uint8_t one = 0;
+	EXPECT_NE(errorOf([&] { defaults.detect(ImageView(&one, 30000, 30000, 30000)); }).find("max_pixels"),
+		  std::string::npos);
 }
 
 TEST(BadInput, ZeroSizesNullDataAndShortStride)

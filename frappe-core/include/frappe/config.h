@@ -85,6 +85,14 @@ struct Config {
 	/// markers at more cost.
 	float min_marker_side = 10.0f;
 
+	/// The largest frame, in pixels, detect() accepts (it throws
+	/// std::invalid_argument beyond): a bound on the memory and time a frame
+	/// may take, whatever a file or a buffer claims. The default, 2^26
+	/// (8192 x 8192), is comfortably above 8K video (7680 x 4320); buffers
+	/// grow with the largest frame seen, about 4 bytes a pixel. Range [1,
+	/// 2^30].
+	long long max_pixels = 1LL << 26;
+
 	/// Threads; 1 = strictly single-threaded, 0 = one per hardware core. A
 	/// Pipeline (Mode::Frames) runs this many whole frames at once, one per
 	/// thread: what pays on a stream (1.8x with two threads, for a frame of
