@@ -10,6 +10,9 @@ packages=(
 	libopencv-dev libeigen3-dev libhwy-dev
 	# tests
 	libgtest-dev libgmock-dev libbenchmark-dev libapriltag-dev
+	# the fuzzers (tests/fuzz: libFuzzer is clang's, its runtime in
+	# libclang-rt) and the ThreadSanitizer build of CI
+	clang libclang-rt-14-dev
 	# the data tests' scorer (../shared/tools/eval.py) and scripts/quality.py
 	python3-numpy
 	# the CMake package (its version file comes from cmake's templates) and

@@ -190,8 +190,10 @@ namespace {
  * -mpopcnt GCC calls a library routine for each, so on x86 a second copy
  * with the POPCNT instruction is chosen at load time. (In an anonymous
  * namespace: GCC exports the ifunc of target_clones whatever its
- * visibility, and the library exports no internals.) */
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+ * visibility, and the library exports no internals.) Not under
+ * ThreadSanitizer, which instruments the ifunc's resolver: it runs while
+ * the program is loaded, before the sanitizer's runtime, and crashes. */
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_THREAD__)
 __attribute__((target_clones("popcnt", "default")))
 #endif
 Decoded nearestCode(const Dictionary &dict, std::uint64_t code, int maxHamming)

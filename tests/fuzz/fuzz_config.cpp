@@ -1,0 +1,117 @@
+// SPDX-License-Identifier: MIT
+// libFuzzer target: the settings a user types. A dictionary name (any bytes)
+// and every Config field from the input, then a Detector and a Pipeline on
+// them and a frame of a fuzzed size. The library's promise: a bad setting or
+// frame is a std::invalid_argument, nothing else; a good one detects.
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "frappe/frappe.h"
+
+namespace {
+
+/* Reads values off the input, zeros once it runs out. */
+class Reader
+{
+public:
+	Reader(const std::uint8_t *data, std::size_t size) : data_(data), size_(size) {}
+	template<typename T>
+	T get()
+	{
+		T v{};
+		const std::size_t n = std::min(sizeof(T), size_ - at_);
+		std::memcpy(&v, data_ + at_, n);
+		at_ += n;
+		return v;
+	}
+	std::string_view text(std::size_t most)
+	{
+		const std::size_t n = std::min<std::size_t>(get<std::uint8_t>() % (most + 1), size_ - at_);
+		std::string_view s(reinterpret_cast<const char *>(data_ + at_), n);
+		at_ += n;
+		return s;
+	}
+
+private:
+	const std::uint8_t *data_;
+	std::size_t size_;
+	std::size_t at_ = 0;
+};
+
+/* A float that is often in a sensible range and sometimes anything. */
+float number(Reader &in, float typical)
+{
+	const std::uint8_t how = in.get<std::uint8_t>();
+	const float raw = in.get<float>();
+	switch (how % 4) {
+	case 0: return typical;
+	case 1: return typical * static_cast<float>(how) / 64.0f;
+	default: return raw; /* NaN, infinities, negatives, huge */
+	}
+}
+
+} // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t *data, std::size_t size)
+{
+	Reader in(data, size);
+	frappe::Config c;
+	const std::string_view name = in.text(40);
+	const auto dicts = frappe::dictionaries();
+	/* Half the time a real name, so the other fields get fuzzed past it. */
+	if ((in.get<std::uint8_t>() & 1) != 0)
+		c.dictionary = std::string(dicts[in.get<std::uint8_t>() % dicts.size()].name);
+	else
+		c.dictionary = std::string(name);
+	const frappe::Dictionary *found = frappe::findDictionary(name);
+	if (found && frappe::findDictionary(found->name) != found)
+		std::abort(); /* a dictionary's own name finds it */
+
+	c.mode = (in.get<std::uint8_t>() & 1) != 0 ? frappe::Mode::AScale : frappe::Mode::Normal;
+	c.edge_threshold = number(in, 0.27f);
+	c.corner_threshold = number(in, 0.19f);
+	c.max_hamming = in.get<std::int8_t>() % 24;
+	c.weak_margin = number(in, 0.3f);
+	c.scaled_size = number(in, 28.0f);
+	c.max_scaled_frames = in.get<std::int16_t>();
+	c.region_contrast = number(in, 0.16f);
+	c.corner_cluster_radius = number(in, 4.0f);
+	c.min_marker_side = number(in, 10.0f);
+	c.threads = in.get<std::int8_t>() % 4;
+	c.max_pixels = (in.get<std::uint8_t>() & 1) != 0 ? in.get<std::int64_t>() : c.max_pixels;
+
+	/* Geometry: sizes, strides and the pixel count around the limits. */
+	const int w = in.get<std::int16_t>() % 300;
+	const int h = in.get<std::int16_t>() % 300;
+	const int stride = w + in.get<std::int8_t>() % 8;
+	std::vector<std::uint8_t> pixels(static_cast<std::size_t>(std::max(0, stride)) *
+					 static_cast<std::size_t>(std::max(0, h)) + 1, 128);
+	const frappe::ImageView view(pixels.data(), w, h, stride);
+
+	try {
+		frappe::Detector det(c);
+		try {
+			det.detect(view);
+		} catch (const std::invalid_argument &) {
+		}
+		frappe::Pipeline pipeline(c, (in.get<std::uint8_t>() & 1) != 0 ? frappe::Pipeline::Mode::Stages
+										 : frappe::Pipeline::Mode::Frames);
+		try {
+			pipeline.push(view);
+		} catch (const std::invalid_argument &) {
+		}
+		while (pipeline.flush()) {
+		}
+	} catch (const std::invalid_argument &) {
+		/* a refused setting: the documented answer */
+	}
+	return 0;
+}

@@ -1,0 +1,89 @@
+#!/usr/bin/env python3
+# SPDX-License-Identifier: MIT
+"""Writes the fuzzers' seed corpus (tests/fuzz/corpus/): a few inputs that
+reach deep into each target, so that a minute of fuzzing starts from markers
+rather than from noise. Run it again after changing a target's input layout.
+"""
+import os
+import random
+import struct
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+DICTS = os.path.join(HERE, '..', '..', 'frappe-core', 'dictionaries')
+
+
+def dictionary_names():
+    # frappe::dictionaries() lists them in the order of the generated table:
+    # the file names sorted (frappe-core/gen_dictionaries.py).
+    return sorted(f[:-4] for f in os.listdir(DICTS) if f.endswith('.txt'))
+
+
+def code(name, idx):
+    lines = [l.split()[0] for l in open(os.path.join(DICTS, name + '.txt')) if l.strip() and not l.startswith('#')]
+    return int(lines[idx], 16)
+
+
+def marker(size, bits, value, cell, at, white=230, black=20):
+    img = [[white] * size for _ in range(size)]
+    n = bits + 2
+    for cy in range(n):
+        for cx in range(n):
+            if cx in (0, n - 1) or cy in (0, n - 1):
+                v = black
+            else:
+                bit = (bits * bits - 1) - ((cy - 1) * bits + (cx - 1))
+                v = white if (value >> bit) & 1 else black
+            for y in range(cell):
+                for x in range(cell):
+                    img[at + cy * cell + y][at + cx * cell + x] = v
+    return img
+
+
+def blur(img):
+    h, w = len(img), len(img[0])
+    out = [row[:] for row in img]
+    for y in range(1, h - 1):
+        for x in range(1, w - 1):
+            out[y][x] = sum(img[y + dy][x + dx] for dy in (-1, 0, 1) for dx in (-1, 0, 1)) // 9
+    return out
+
+
+def detect_seed(path, img, dict_index, flags, pad=0, frames=1):
+    h, w = len(img), len(img[0])
+    head = bytes([(w - 1) % 192, (h - 1) % 192, pad, flags, dict_index, frames - 1])
+    with open(path, 'wb') as f:
+        f.write(head + bytes(v for row in img for v in row))
+
+
+def main():
+    names = dictionary_names()
+    out = os.path.join(HERE, 'corpus', 'detect')
+    os.makedirs(out, exist_ok=True)
+    small = names.index('4x4_50')
+    mip = names.index('aruco_mip_36h12')
+    detect_seed(os.path.join(out, 'marker-4x4'), marker(96, 4, code('4x4_50', 0), 8, 16), small, 0)
+    detect_seed(os.path.join(out, 'marker-4x4-blur-regions'), blur(marker(96, 4, code('4x4_50', 7), 8, 16)),
+                small, 2)
+    detect_seed(os.path.join(out, 'marker-mip-ascale'), marker(128, 6, code('aruco_mip_36h12', 3), 10, 24),
+                mip, 1, pad=3, frames=2)
+    rng = random.Random(1)
+    detect_seed(os.path.join(out, 'noise'), [[rng.randrange(256) for _ in range(64)] for _ in range(48)], mip, 2)
+
+    out = os.path.join(HERE, 'corpus', 'config')
+    os.makedirs(out, exist_ok=True)
+    for i, name in enumerate([b'aruco_mip_36h12', b'DICT_4X4_50', b'tag36h11', b'nope']):
+        # In LLVMFuzzerTestOneInput's order: the name, "use a real name
+        # instead" (no), the mode, the fields at their typical values
+        # (selector 0; max_hamming 2, max_scaled_frames 5, threads 1, the
+        # default max_pixels), a 64 x 48 frame of stride 64, the pipeline mode.
+        typical = bytes([0]) + struct.pack('<f', 0.0)
+        body = bytes([len(name)]) + name + bytes([0, i & 1])
+        body += typical * 2 + struct.pack('<b', 2) + typical * 2 + struct.pack('<h', 5)
+        body += typical * 3 + struct.pack('<b', 1) + bytes([0])
+        body += struct.pack('<hhb', 64, 48, 0) + bytes([i & 1])
+        with open(os.path.join(out, 'config-%d' % i), 'wb') as f:
+            f.write(body)
+
+
+if __name__ == '__main__':
+    main()
