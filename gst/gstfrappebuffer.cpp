@@ -95,7 +95,9 @@ Lie checkBuffer(GstBuffer *buffer, const GstVideoInfo *info, bool allPlanes, std
 void BufferLog::lie(GstElement *element, Lie lie, const char *why, GstBuffer *buffer)
 {
 	bool &warned = warnedLie_[static_cast<std::size_t>(lie)];
-	if (!warned) {
+	/* An empty GAP buffer says it has nothing to show: not a lie. */
+	const bool gap = lie == Lie::NoMemory && GST_BUFFER_FLAG_IS_SET(buffer, GST_BUFFER_FLAG_GAP);
+	if (!warned && !gap) {
 		warned = true;
 		GST_ELEMENT_WARNING(element, STREAM, FORMAT,
 				    ("Video buffer does not hold the frame it describes; passed through without detection"),

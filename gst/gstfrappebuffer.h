@@ -43,7 +43,8 @@ public:
 
 	/* A GST_ELEMENT_WARNING the first time a kind of lie is seen, a debug
 	 * line after: a producer that lies usually lies on every frame, and a
-	 * warning per frame would flood the bus. */
+	 * warning per frame would flood the bus. An empty GAP buffer gets
+	 * the debug line only. */
 	void lie(GstElement *element, Lie lie, const char *why, GstBuffer *buffer);
 
 	/* Which memory the first buffer is (dmabuf: not copied), and a

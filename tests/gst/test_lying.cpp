@@ -189,6 +189,25 @@ TEST(Lying, BufferWithoutMemory)
 	expectPassedThrough("frappedetect", kGray64, empty, "no memory");
 }
 
+/* An empty buffer flagged GAP has nothing to show: it passes through
+ * without a warning, and does not use up the one for an empty buffer. */
+TEST(Lying, EmptyGapBufferIsNoLie)
+{
+	Harness t("frappedetect", kGray64);
+	GstBuffer *gap = gst_buffer_new();
+	GST_BUFFER_FLAG_SET(gap, GST_BUFFER_FLAG_GAP);
+	GST_BUFFER_PTS(gap) = 0;
+	ASSERT_EQ(gst_harness_push(t.h, gap), GST_FLOW_OK);
+	GstBuffer *empty = gst_buffer_new();
+	GST_BUFFER_PTS(empty) = kFrame;
+	ASSERT_EQ(gst_harness_push(t.h, empty), GST_FLOW_OK);
+	EXPECT_EQ(gst_harness_buffers_received(t.h), 2u);
+	const BusMessages msgs(t.bus);
+	const auto warnings = msgs.of(GST_MESSAGE_WARNING);
+	ASSERT_EQ(warnings.size(), 1u) << "for the empty buffer without GAP";
+	expectLieWarning(warnings[0], "no memory (buffer pts 0:00:00.033333333)");
+}
+
 TEST(Lying, BufferSmallerThanCapsWithoutMeta)
 {
 	GstBuffer *small = gst_buffer_new_allocate(nullptr, 4000, nullptr);
