@@ -28,7 +28,8 @@
  * the top-left pixel.
  *
  * When #GstFrappeDetect:post-messages is TRUE (the default) the element posts
- * one element message per frame, named `frappedetect`, with the fields:
+ * one element message per frame it detects on, named `frappedetect`, with the
+ * fields:
  *
  * * `timestamp` (guint64): the buffer's presentation timestamp
  * * `stream-time` (guint64), `running-time` (guint64): from the segment
@@ -64,9 +65,25 @@
  * frame of latency. The element then holds one buffer, answers the LATENCY query
  * with one extra frame, asks upstream pools for one more buffer, pushes the
  * held buffer on EOS, caps, segment, gap, stream-start and DRAIN queries,
- * and drops it on flush. Every buffer comes out once, in order, with its own
- * metas. In AScale mode each of the two detectors scales a frame from the
- * last frame it ran.
+ * and drops it on flush. Every buffer the element receives comes out once,
+ * in order, with its own metas (QoS may drop buffers before that: below).
+ * In AScale mode each of the two detectors scales a frame from the last
+ * frame it ran.
+ *
+ * A buffer that does not hold the frame it describes is neither mapped nor
+ * read: no memory at all; a #GstVideoMeta whose format, size or planes
+ * differ from the caps; a stride negative or shorter than a row; the luma
+ * plane (and, with #GstFrappeDetect:annotate, any plane) ending past the
+ * buffer or, with a meta, past the memory its offset is in. It comes out
+ * untouched, in its place (pipelined, after the held buffer), with no
+ * metas, no drawing and no message. The first buffer of each kind of fault
+ * posts a warning (GST_STREAM_ERROR_FORMAT), later ones only a debug line.
+ * Caps of more than frappe::Config's max_pixels (2^26) are refused.
+ *
+ * QoS (#GstBaseTransform:qos) is on by default, as for every GstVideoFilter:
+ * with a synchronising sink downstream, a buffer that is already late when
+ * it arrives is dropped before detection and neither comes out nor gets a
+ * message. With qos=false every buffer comes out.
  *
  * When detection fails on a frame the element posts an error and returns
  * a flow error, pipelined or not (pipelined, when the held frame is
@@ -90,19 +107,20 @@
 
 #include "gstfrappedetect.h"
 
+#include <array>
 #include <cstdint>
 #include <exception>
 #include <memory>
 #include <string>
 #include <vector>
 
-#include <gst/allocators/gstdmabuf.h>
 #include <gst/video/video.h>
 
 #include <frappe/frappe.h>
 
 #include "annotate.h"
 #include "frappe_backend.h"
+#include "gstfrappebuffer.h"
 #include "gstfrappeenums.h"
 #include "gstfrappeoutput.h"
 #include "gstfrappesettings.h"
@@ -113,6 +131,7 @@
 GST_DEBUG_CATEGORY(gst_frappe_detect_debug);
 #define GST_CAT_DEFAULT gst_frappe_detect_debug
 
+using frappe::gst::Lie;
 using frappe::gst::MappedFrame;
 using frappe::gst::Settings;
 
@@ -130,8 +149,7 @@ struct FrappeDetectPrivate {
 	std::unique_ptr<frappe::Pipeline> pipeline;
 	std::vector<MappedFrame> held;   /* in the pipeline, oldest first */
 	std::vector<GstBuffer *> output; /* finished, waiting for generate_output */
-	bool loggedMemory = false;
-	bool warnedStride = false;
+	frappe::gst::BufferLog bufferLog;
 	bool warnedFallback = false;
 	guint64 frames = 0;
 	frappe::gst::StatsWindow window;
@@ -375,29 +393,18 @@ static GstFlowReturn apply_settings(GstFrappeDetect *self)
 	return ret;
 }
 
-static void log_memory(GstFrappeDetect *self, GstBuffer *buffer)
+/* A buffer that does not hold its frame comes out untouched (no metas,
+ * no drawing, no message), after the held frames: it must not overtake
+ * them, so pipelined it costs one frame of overlap. */
+static GstFlowReturn pass_through(GstFrappeDetect *self, GstBuffer *buffer)
 {
-	FrappeDetectPrivate *priv = self->priv;
-	GstMemory *mem = gst_buffer_peek_memory(buffer, 0);
-	const bool dmabuf = mem && gst_is_dmabuf_memory(mem);
-	if (!priv->loggedMemory) {
-		priv->loggedMemory = true;
-		if (dmabuf)
-			GST_DEBUG_OBJECT(self, "input is dmabuf memory (fd %d): mapped %s, not copied",
-					 gst_dmabuf_memory_get_fd(mem),
-					 priv->active.annotate ? "read-write to annotate" : "read-only");
-		else
-			GST_DEBUG_OBJECT(self, "input is %s memory",
-					 mem && mem->allocator ? mem->allocator->mem_type : "unknown");
+	const GstFlowReturn ret = finish_held(self);
+	if (ret != GST_FLOW_OK) {
+		gst_buffer_unref(buffer);
+		return ret;
 	}
-	GstVideoFilter *filter = GST_VIDEO_FILTER(self);
-	if (dmabuf && !priv->warnedStride && !gst_buffer_get_video_meta(buffer) &&
-	    GST_VIDEO_INFO_WIDTH(&filter->in_info) % 64 != 0) {
-		priv->warnedStride = true;
-		GST_WARNING_OBJECT(self, "dmabuf input %d pixels wide without GstVideoMeta: the "
-				   "producer's stride may differ from the default one",
-				   GST_VIDEO_INFO_WIDTH(&filter->in_info));
-	}
+	self->priv->output.push_back(buffer);
+	return GST_FLOW_OK;
 }
 
 /* Pushes the buffer into the pipeline and finishes the one it returns
@@ -416,13 +423,23 @@ static GstFlowReturn process(GstFrappeDetect *self, GstBuffer *input)
 		return GST_FLOW_NOT_NEGOTIATED;
 	}
 
+	/* Before anything maps or reads it: the luma plane the detector
+	 * reads and, to annotate, the chroma planes it writes. */
+	const GstVideoInfo *info = &GST_VIDEO_FILTER(self)->in_info;
+	std::array<char, frappe::gst::kLieText> why;
+	const Lie lie = frappe::gst::checkBuffer(input, info, priv->active.annotate, why);
+	if (lie != Lie::None) {
+		priv->bufferLog.lie(GST_ELEMENT(self), lie, why.data(), input);
+		return pass_through(self, input);
+	}
+
 	/* Metas need a writable buffer: a shallow copy when shared, which
 	 * keeps the memory (and zero-copy) as long as we map read-only. */
 	GstBuffer *buffer = gst_buffer_make_writable(input);
-	log_memory(self, buffer);
+	priv->bufferLog.memory(GST_ELEMENT(self), buffer, info, priv->active.annotate);
 
 	MappedFrame f;
-	if (!f.map(buffer, &GST_VIDEO_FILTER(self)->in_info, priv->active.annotate)) {
+	if (!f.map(buffer, info, priv->active.annotate)) {
 		GST_ELEMENT_ERROR(self, STREAM, FAILED, ("Could not map the video frame"), (nullptr));
 		return GST_FLOW_ERROR;
 	}
@@ -551,19 +568,8 @@ static gboolean gst_frappe_detect_propose_allocation(GstBaseTransform *trans, Gs
 	GST_OBJECT_LOCK(self);
 	const gboolean pipelined = self->priv->props.pipelined;
 	GST_OBJECT_UNLOCK(self);
-	if (!pipelined)
-		return TRUE;
-	for (guint i = 0; i < gst_query_get_n_allocation_pools(query); ++i) {
-		GstBufferPool *pool = nullptr;
-		guint size, min, max;
-		gst_query_parse_nth_allocation_pool(query, i, &pool, &size, &min, &max);
-		if (max != 0 && max < min + 1)
-			max = min + 1;
-		gst_query_set_nth_allocation_pool(query, i, pool, size, min + 1, max);
-		GST_DEBUG_OBJECT(self, "asking for %u buffers in pool %u (one held)", min + 1, i);
-		if (pool)
-			gst_object_unref(pool);
-	}
+	if (pipelined)
+		frappe::gst::askOneMoreBuffer(GST_ELEMENT(self), query);
 	return TRUE;
 }
 
@@ -575,8 +581,7 @@ static gboolean gst_frappe_detect_start(GstBaseTransform *trans)
 	GST_OBJECT_UNLOCK(self);
 	self->priv->frames = 0;
 	self->priv->window.reset();
-	self->priv->loggedMemory = false;
-	self->priv->warnedStride = false;
+	self->priv->bufferLog.reset();
 	return TRUE;
 }
 
@@ -589,11 +594,21 @@ static gboolean gst_frappe_detect_stop(GstBaseTransform *trans)
 	return TRUE;
 }
 
+/* Frames beyond max_pixels (the element leaves it at Config's default)
+ * are refused here, once, rather than failing at every buffer; a buffer's
+ * meta must then match these caps (checkBuffer). */
 static gboolean gst_frappe_detect_set_info(GstVideoFilter *filter, GstCaps *, GstVideoInfo *in_info,
 					   GstCaps *, GstVideoInfo *)
 {
-	GST_DEBUG_OBJECT(filter, "%s %dx%d", GST_VIDEO_INFO_NAME(in_info), GST_VIDEO_INFO_WIDTH(in_info),
-			 GST_VIDEO_INFO_HEIGHT(in_info));
+	const gint w = GST_VIDEO_INFO_WIDTH(in_info), h = GST_VIDEO_INFO_HEIGHT(in_info);
+	GST_DEBUG_OBJECT(filter, "%s %dx%d", GST_VIDEO_INFO_NAME(in_info), w, h);
+	const long long maxPixels = frappe::Config{}.max_pixels;
+	if (static_cast<long long>(w) * h > maxPixels) {
+		GST_ELEMENT_ERROR(filter, CORE, NEGOTIATION,
+				  ("Frames of %dx%d are larger than the detector accepts (%lld pixels)", w, h, maxPixels),
+				  (nullptr));
+		return FALSE;
+	}
 	return TRUE;
 }
 

@@ -1,7 +1,8 @@
 /* SPDX-License-Identifier: MIT
  *
  * gstfrappemeta.h: the per-marker metadata that frappedetect attaches to
- * every buffer, for applications (link with pkg-config gstfrappemeta).
+ * the buffers it detects on, for applications (link with pkg-config
+ * gstfrappemeta).
  */
 #pragma once
 
