@@ -4,12 +4,17 @@
 //   frappe-detect photo.jpg [--annotate out.png]      people
 //   frappe-detect --list L --out D.jsonl --repeat N   benchmarks (DETECTOR-CONTRACT.md)
 #include <algorithm>
+#include <cerrno>
+#include <cstring>
+#include <deque>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <limits>
+#include <new>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -17,6 +22,8 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "annotate.h"
+#include "cli_text.h"
+#include "image_check.h"
 #include "frappe/frappe.h"
 #include "frappe_backend.h"
 
@@ -52,11 +59,16 @@ const char kUsage[] =
 	"  -a, --annotate PATH     write the image with the markers drawn (a folder for several images)\n"
 	"      --json              print one JSON line per image instead of text\n"
 	"      --stats             print per-stage timings\n"
-	"      --list FILE         images to process, one path per line\n"
-	"      --out FILE          JSON lines output, one per listed image, in order\n"
+	"      --list FILE         images to process, one path per line (a regular file of\n"
+	"                          at most 64 MiB and 1000000 images)\n"
+	"      --out FILE          JSON lines output, one per listed image, in order; a\n"
+	"                          name's bytes that are not UTF-8 are written \\u00XX\n"
 	"      --repeat N          time each image over N runs, report the median (default 1)\n"
 	"      --dictionaries      list the built-in dictionaries\n"
 	"      --version           print the version\n"
+	"\n"
+	"Images are read one at a time and refused, with an error line, when larger\n"
+	"than 2^26 pixels (read from the header, before decoding) or cut short.\n"
 	"  -h, --help              this text\n";
 
 struct Options {
@@ -76,12 +88,38 @@ struct Options {
 template<typename T>
 T parseNumber(const std::string &opt, const std::string &text)
 {
-	std::istringstream in(text);
 	T v{};
-	in >> v;
-	if (in.fail() || !in.eof())
+	if (!frappe::cli::parseNumber(text, v))
 		usageError(opt + " needs a number, got '" + text + "'");
 	return v;
+}
+
+/* The list is read whole (paths only, no pixels): bounded so that a wrong
+ * argument (/dev/zero, a huge file) fails at once instead of eating memory. */
+constexpr std::size_t kMaxListBytes = 64u << 20;
+constexpr std::size_t kMaxListImages = 1000000;
+
+void readList(const std::string &list, std::vector<std::string> &images)
+{
+	std::vector<std::uint8_t> bytes;
+	std::string error;
+	if (!frappe::cli::readFileBounded(list, kMaxListBytes, bytes, error))
+		usageError("--list: " + error + " (a list is a regular file of at most 64 MiB)");
+	std::size_t begin = 0;
+	while (begin < bytes.size()) {
+		std::size_t end = begin;
+		while (end < bytes.size() && bytes[end] != '\n')
+			++end;
+		std::string line(bytes.begin() + static_cast<std::ptrdiff_t>(begin), bytes.begin() + static_cast<std::ptrdiff_t>(end));
+		begin = end + 1;
+		while (!line.empty() && (line.back() == '\r' || line.back() == ' ' || line.back() == '\t'))
+			line.pop_back();
+		if (line.empty() || line[0] == '#')
+			continue;
+		if (images.size() >= kMaxListImages)
+			usageError("--list: " + list + " names more than " + std::to_string(kMaxListImages) + " images");
+		images.push_back(std::move(line));
+	}
 }
 
 Options parse(int argc, char **argv)
@@ -152,44 +190,14 @@ Options parse(int argc, char **argv)
 			o.images.push_back(a);
 		}
 	}
-	if (!o.list.empty()) {
-		std::ifstream in(o.list);
-		if (!in)
-			usageError("cannot read the list " + o.list);
-		for (std::string line; std::getline(in, line);) {
-			while (!line.empty() && (line.back() == '\r' || line.back() == ' ' || line.back() == '\t'))
-				line.pop_back();
-			if (line.empty() || line[0] == '#')
-				continue;
-			o.images.push_back(line);
-		}
-	}
+	if (!o.list.empty())
+		readList(o.list, o.images);
 	if (o.images.empty())
 		usageError("no images given");
 	return o;
 }
 
-std::string jsonEscape(const std::string &s)
-{
-	std::string out;
-	for (char c : s) {
-		switch (c) {
-		case '"': out += "\\\""; break;
-		case '\\': out += "\\\\"; break;
-		case '\n': out += "\\n"; break;
-		case '\t': out += "\\t"; break;
-		default:
-			if (static_cast<unsigned char>(c) < 0x20) {
-				char buf[8];
-				std::snprintf(buf, sizeof(buf), "\\u%04x", c);
-				out += buf;
-			} else {
-				out += c;
-			}
-		}
-	}
-	return out;
-}
+using frappe::cli::jsonEscape;
 
 std::string jsonLine(const std::string &image, const std::vector<Marker> &markers, double ms,
 		     const std::string &error)
@@ -223,8 +231,63 @@ struct Frame {
 	std::string error;
 	std::vector<Marker> markers;
 	frappe::StageTimes times;
-	double ms = 0;
+	std::vector<double> times_ms; /* one per repeat */
+	int in_flight = 0;            /* pushes whose result has not come back */
+	bool all_pushed = false;
 };
+
+/* Reads, checks and decodes one image into f.gray, or sets f.error. The
+ * size comes from the header and is refused before any decoding; a file
+ * that ends before its format's end marker is refused too, where OpenCV
+ * would return a partial image with a warning. */
+void loadImage(Frame &f, long long maxPixels)
+{
+	/* Enough for any frame of maxPixels at 8 bytes a pixel (16-bit RGBA
+	 * stored raw) plus 16 MiB of metadata, 528 MiB by default; the bound on
+	 * formats we cannot read the size of. Under 2 GiB: cv::Mat's int size. */
+	const std::size_t fileLimit = static_cast<std::size_t>(
+		std::min<long long>(8 * maxPixels + (16 << 20), std::numeric_limits<std::int32_t>::max()));
+	std::vector<std::uint8_t> bytes;
+	try {
+		if (!frappe::cli::readFileBounded(f.path, fileLimit, bytes, f.error))
+			return;
+	} catch (const std::bad_alloc &) { /* a 32-bit Pi may not find the room */
+		f.error = "out of memory reading " + f.path;
+		return;
+	}
+	const frappe::cli::ImageHeader h = frappe::cli::inspectImage(bytes.data(), bytes.size());
+	if (!h.error.empty()) {
+		f.error = f.path + ": " + h.error;
+		return;
+	}
+	if (h.format != frappe::cli::ImageFormat::Unknown && h.width > maxPixels / h.height) {
+		f.error = f.path + ": " + std::to_string(h.width) + " x " + std::to_string(h.height) + " " +
+			  frappe::cli::formatName(h.format) + ", more than the limit of " + std::to_string(maxPixels) +
+			  " pixels (Config::max_pixels); not decoded";
+		return;
+	}
+	try {
+		f.gray = cv::imdecode(cv::Mat(1, static_cast<int>(bytes.size()), CV_8UC1, bytes.data()), cv::IMREAD_GRAYSCALE);
+	} catch (const cv::Exception &e) {
+		f.gray.release();
+		f.error = "cannot decode " + f.path + " as an image (OpenCV: " + e.err + ")";
+		return;
+	} catch (const std::bad_alloc &) {
+		f.error = "out of memory decoding " + f.path;
+		return;
+	}
+	if (f.gray.empty()) {
+		f.error = "cannot decode " + f.path + " as an image";
+		return;
+	}
+	/* EXIF orientation may swap the sides, never the count. */
+	if (h.format != frappe::cli::ImageFormat::Unknown &&
+	    static_cast<long long>(f.gray.cols) * f.gray.rows != h.width * h.height) {
+		f.error = f.path + ": decoded " + std::to_string(f.gray.cols) + " x " + std::to_string(f.gray.rows) +
+			  ", the header says " + std::to_string(h.width) + " x " + std::to_string(h.height);
+		f.gray.release();
+	}
+}
 
 double median(std::vector<double> v)
 {
@@ -254,83 +317,228 @@ std::unique_ptr<frappe::Pipeline> makePipeline(const Options &opt)
 	return pipeline;
 }
 
-/* Runs every readable frame `repeat` times through the pipeline, in order.
- * With one thread each push runs its frame, and time_ms is the wall time
- * of those pushes; with more, frames overlap and time_ms is each frame's
- * own detection time (the sum of its stages). */
-void detectAll(frappe::Pipeline &pipeline, std::vector<Frame> &frames, int repeat)
-{
-	using Clock = std::chrono::steady_clock;
-	const bool serial = pipeline.latency() == 0;
-	std::vector<std::size_t> order; /* frame of each push still in flight */
-	std::vector<std::vector<double>> times(frames.size());
-	std::size_t detected = 0;
-	auto take = [&](const frappe::Result *res, double wallMs) {
-		Frame &f = frames[order.front()];
-		times[order.front()].push_back(serial ? wallMs : res->times.total_ms);
-		f.markers = res->markers;
-		f.times = res->times;
-		order.erase(order.begin());
-		++detected;
-	};
-	auto fail = [&](const std::exception &e) {
-		/* The oldest frame in flight failed: the next result is the
-		 * following push's. */
-		Frame &f = frames[order.front()];
-		f.error = e.what();
-		std::cerr << "frappe-detect: " << f.path << ": " << f.error << "\n";
-		order.erase(order.begin());
-	};
+/* Streams the images: each is read, decoded, detected `repeat` times and
+ * written out in list order before the pipeline moves far past it, so at
+ * most latency() + 1 decoded frames are held whatever the list's length.
+ * With one thread each push runs its frame, and time_ms is the wall time of
+ * that push; with more, frames overlap and time_ms is each frame's own
+ * detection time (the sum of its stages). */
+class Runner {
+public:
+	Runner(const Options &opt, frappe::Pipeline &pipeline, std::FILE *out)
+		: opt_(opt), pipeline_(pipeline), out_(out), serial_(pipeline.latency() == 0),
+		  many_(opt.images.size() > 1)
+	{
+	}
 
-	const auto t0 = Clock::now();
-	for (std::size_t i = 0; i < frames.size(); ++i) {
-		Frame &f = frames[i];
-		if (!f.error.empty())
-			continue;
-		const frappe::ImageView view(f.gray.data, f.gray.cols, f.gray.rows, static_cast<int>(f.gray.step[0]));
-		for (int r = 0; r < repeat; ++r) {
-			try {
-				pipeline.detector().checkImage(view);
-			} catch (const std::exception &e) {
-				f.error = e.what();
-				std::cerr << "frappe-detect: " << f.path << ": " << f.error << "\n";
-				break;
+	void run()
+	{
+		using Clock = std::chrono::steady_clock;
+		const auto t0 = Clock::now();
+		bool warmed = opt_.repeat == 1; /* a warm-up only for timed repeats */
+		for (const std::string &path : opt_.images) {
+			Frame &f = window_.emplace_back();
+			f.path = path;
+			loadImage(f, opt_.config.max_pixels);
+			if (!f.error.empty())
+				std::cerr << "frappe-detect: " << f.error << "\n";
+			if (f.error.empty() && !warmed) {
+				warmUp(f);
+				warmed = true;
 			}
-			order.push_back(i);
+			for (int r = 0; r < opt_.repeat && f.error.empty(); ++r)
+				push(f);
+			f.all_pushed = true;
+			writeFinished();
+		}
+		for (;;) {
 			try {
-				const auto p0 = Clock::now();
-				const frappe::Result *res = pipeline.push(view);
-				if (res)
-					take(res, std::chrono::duration<double, std::milli>(Clock::now() - p0).count());
+				const frappe::Result *res = pipeline_.flush();
+				if (!res)
+					break;
+				take(*res, 0.0);
 			} catch (const std::exception &e) {
 				fail(e);
 			}
+			writeFinished();
 		}
+		writeFinished();
+		const double wall = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+		if (!serial_ && detected_ > 0)
+			std::fprintf(stderr,
+				     "frappe-detect: %zu detections on %d threads in %.1f ms (reading and decoding included): "
+				     "%.1f per second\n",
+				     detected_, pipeline_.threads(), wall, 1000.0 * static_cast<double>(detected_) / wall);
 	}
-	for (;;) {
+
+	std::size_t failed() const { return failed_; }
+	std::size_t total() const { return total_; }
+	bool writeFailed() const { return writeFailed_; }
+	bool annotateFailed() const { return annotateFailed_; }
+
+private:
+	static frappe::ImageView view(const Frame &f)
+	{
+		return { f.gray.data, f.gray.cols, f.gray.rows, static_cast<int>(f.gray.step[0]) };
+	}
+
+	/* Buffers and threads warm before timing, on the first good image;
+	 * nothing is in flight yet. */
+	void warmUp(const Frame &f)
+	{
 		try {
-			const frappe::Result *res = pipeline.flush();
-			if (!res)
-				break;
-			take(res, 0.0);
+			for (int i = 0; i < pipeline_.threads(); ++i)
+				pipeline_.push(view(f));
+			while (pipeline_.flush()) {
+			}
+		} catch (const std::exception &) {
+			/* the timed run reports it */
+		}
+		pipeline_.reset();
+	}
+
+	void push(Frame &f)
+	{
+		using Clock = std::chrono::steady_clock;
+		try {
+			pipeline_.detector().checkImage(view(f));
+		} catch (const std::exception &e) {
+			f.error = f.path + ": " + e.what();
+			std::cerr << "frappe-detect: " << f.error << "\n";
+			return;
+		}
+		inFlight_.push_back(&f);
+		++f.in_flight;
+		try {
+			const auto p0 = Clock::now();
+			const frappe::Result *res = pipeline_.push(view(f));
+			if (res)
+				take(*res, std::chrono::duration<double, std::milli>(Clock::now() - p0).count());
 		} catch (const std::exception &e) {
 			fail(e);
 		}
 	}
-	const double wall = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-	for (std::size_t i = 0; i < frames.size(); ++i)
-		if (frames[i].error.empty() && !times[i].empty())
-			frames[i].ms = median(times[i]);
-	if (!serial && detected > 0)
-		std::fprintf(stderr, "frappe-detect: %zu detections on %d threads in %.1f ms: %.1f per second\n",
-			     detected, pipeline.threads(), wall, 1000.0 * static_cast<double>(detected) / wall);
-}
+
+	void take(const frappe::Result &res, double wallMs)
+	{
+		Frame &f = *inFlight_.front();
+		inFlight_.pop_front();
+		--f.in_flight;
+		f.times_ms.push_back(serial_ ? wallMs : res.times.total_ms);
+		f.markers = res.markers; /* the last repetition's */
+		f.times = res.times;
+		++detected_;
+	}
+
+	/* The oldest push in flight failed: the next result is the following
+	 * push's. */
+	void fail(const std::exception &e)
+	{
+		Frame &f = *inFlight_.front();
+		inFlight_.pop_front();
+		--f.in_flight;
+		if (f.error.empty()) {
+			f.error = f.path + ": " + e.what();
+			std::cerr << "frappe-detect: " << f.error << "\n";
+		}
+	}
+
+	/* Writes and forgets the finished frames at the head of the window. */
+	void writeFinished()
+	{
+		while (!window_.empty() && window_.front().all_pushed && window_.front().in_flight == 0) {
+			write(window_.front());
+			window_.pop_front();
+		}
+	}
+
+	void write(const Frame &f)
+	{
+		++total_;
+		if (!f.error.empty())
+			++failed_;
+		const double ms = f.error.empty() && !f.times_ms.empty() ? median(f.times_ms) : 0.0;
+		if (out_) {
+			const std::string line = jsonLine(f.path, f.markers, ms, f.error) + "\n";
+			/* a line at a time: a run cut short keeps what it found */
+			if (std::fputs(line.c_str(), out_) < 0 || std::fflush(out_) != 0)
+				writeFailed_ = true;
+		}
+		if (opt_.json) {
+			std::cout << jsonLine(f.path, f.markers, ms, f.error) << "\n";
+		} else if (f.error.empty() && opt_.out.empty()) {
+			std::printf("%s: %zu marker%s (%s) in %.2f ms\n", f.path.c_str(), f.markers.size(),
+				    f.markers.size() == 1 ? "" : "s",
+				    std::string(pipeline_.detector().dictionary().name).c_str(), ms);
+			for (const Marker &m : f.markers) {
+				std::printf("  id %4d  hamming %d  margin %.2f  corners", m.id, m.hamming, m.margin);
+				for (const auto &p : m.corners)
+					std::printf(" (%.2f, %.2f)", p.x, p.y);
+				std::printf("\n");
+			}
+		}
+		if (opt_.stats && f.error.empty() && (opt_.json || opt_.out.empty())) {
+			std::printf("  stages:");
+			for (int s = 0; s < frappe::kStageCount; ++s)
+				std::printf(" %s %.3f ms",
+					    std::string(frappe::stageName(static_cast<frappe::Stage>(s))).c_str(),
+					    f.times.ms[s]);
+			std::printf("\n");
+		}
+		std::fflush(stdout);
+		if (!opt_.annotate.empty() && f.error.empty())
+			annotate(f);
+	}
+
+	void annotate(const Frame &f)
+	{
+		namespace fs = std::filesystem;
+		if (many_ && !annotateDirMade_) {
+			std::error_code ec;
+			fs::create_directories(opt_.annotate, ec);
+			annotateDirMade_ = true;
+		}
+		const std::string path =
+			many_ ? (fs::path(opt_.annotate) / fs::path(f.path).filename()).replace_extension(".png").string()
+			      : opt_.annotate;
+		bool ok = false;
+		try {
+			ok = cv::imwrite(path, frappe::cli::annotate(f.gray, f.markers));
+		} catch (const cv::Exception &) {
+			ok = false;
+		}
+		if (!ok) {
+			std::cerr << "frappe-detect: cannot write " << path << "\n";
+			annotateFailed_ = true;
+		}
+	}
+
+	const Options &opt_;
+	frappe::Pipeline &pipeline_;
+	std::FILE *out_;
+	const bool serial_, many_;
+	std::deque<Frame> window_;      /* read, not yet written, in list order */
+	std::deque<Frame *> inFlight_;  /* the frame of each push in flight; deque ends keep references */
+	std::size_t detected_ = 0, failed_ = 0, total_ = 0;
+	bool writeFailed_ = false, annotateDirMade_ = false, annotateFailed_ = false;
+};
 
 } // namespace
 
 int main(int argc, char **argv)
 {
 	Options opt = parse(argc, argv);
+
+	/* Opened before the run: a path that cannot be written fails now, not
+	 * after an hour of detection. */
+	std::FILE *out = nullptr;
+	if (!opt.out.empty()) {
+		out = std::fopen(opt.out.c_str(), "w");
+		if (!out) {
+			std::cerr << "frappe-detect: cannot write --out " << opt.out << ": " << std::strerror(errno) << "\n";
+			return 2;
+		}
+	}
 
 	std::unique_ptr<frappe::Pipeline> pipeline;
 	try {
@@ -344,111 +552,17 @@ int main(int argc, char **argv)
 		opt.repeat = 1;
 	}
 
-	/* Decode everything first: the timed loop does no I/O. */
-	std::vector<Frame> frames(opt.images.size());
-	for (std::size_t i = 0; i < frames.size(); ++i) {
-		Frame &f = frames[i];
-		f.path = opt.images[i];
-		std::error_code ec;
-		if (!std::filesystem::is_regular_file(f.path, ec)) {
-			f.error = "cannot open " + f.path;
-		} else {
-			try {
-				f.gray = cv::imread(f.path, cv::IMREAD_GRAYSCALE);
-			} catch (const cv::Exception &e) {
-				f.gray.release();
-			}
-			if (f.gray.empty())
-				f.error = "cannot decode " + f.path + " as an image";
-		}
-		if (!f.error.empty())
-			std::cerr << "frappe-detect: " << f.error << "\n";
+	Runner runner(opt, *pipeline, out);
+	runner.run();
+	if (out && (runner.writeFailed() || std::fclose(out) != 0)) {
+		std::cerr << "frappe-detect: cannot write --out " << opt.out << ": " << std::strerror(errno) << "\n";
+		return 2;
 	}
-
-	/* Buffers and threads warm before timing, on the first good image. */
-	if (opt.repeat > 1) {
-		for (const Frame &f : frames) {
-			if (!f.error.empty())
-				continue;
-			const frappe::ImageView view(f.gray.data, f.gray.cols, f.gray.rows,
-						     static_cast<int>(f.gray.step[0]));
-			try {
-				for (int i = 0; i < pipeline->threads(); ++i)
-					pipeline->push(view);
-				while (pipeline->flush()) {
-				}
-			} catch (const std::exception &) {
-				/* the timed run reports it */
-			}
-			pipeline->reset();
-			break;
-		}
-	}
-	detectAll(*pipeline, frames, opt.repeat);
-
-	bool anyError = false;
-	std::ofstream out;
-	if (!opt.out.empty()) {
-		out.open(opt.out);
-		if (!out) {
-			std::cerr << "frappe-detect: cannot write " << opt.out << "\n";
-			return 2;
-		}
-	}
-	for (const Frame &f : frames) {
-		anyError = anyError || !f.error.empty();
-		if (out.is_open())
-			out << jsonLine(f.path, f.markers, f.ms, f.error) << "\n";
-		if (!opt.out.empty() && !opt.json)
-			continue;
-		if (opt.json) {
-			std::cout << jsonLine(f.path, f.markers, f.ms, f.error) << "\n";
-		} else if (f.error.empty()) {
-			std::printf("%s: %zu marker%s (%s) in %.2f ms\n", f.path.c_str(), f.markers.size(),
-				    f.markers.size() == 1 ? "" : "s", std::string(pipeline->detector().dictionary().name).c_str(), f.ms);
-			for (const Marker &m : f.markers) {
-				std::printf("  id %4d  hamming %d  margin %.2f  corners", m.id, m.hamming, m.margin);
-				for (const auto &p : m.corners)
-					std::printf(" (%.2f, %.2f)", p.x, p.y);
-				std::printf("\n");
-			}
-		}
-		if (opt.stats && f.error.empty()) {
-			std::printf("  stages:");
-			for (int s = 0; s < frappe::kStageCount; ++s)
-				std::printf(" %s %.3f ms", std::string(frappe::stageName(static_cast<frappe::Stage>(s))).c_str(),
-					    f.times.ms[s]);
-			std::printf("\n");
-		}
-	}
-
-	if (!opt.annotate.empty()) {
-		namespace fs = std::filesystem;
-		const bool many = frames.size() > 1;
-		if (many) {
-			std::error_code ec;
-			fs::create_directories(opt.annotate, ec);
-		}
-		for (const Frame &f : frames) {
-			if (!f.error.empty())
-				continue;
-			const std::string path = many ? (fs::path(opt.annotate) / fs::path(f.path).filename()).replace_extension(".png").string()
-						      : opt.annotate;
-			bool ok = false;
-			try {
-				ok = cv::imwrite(path, frappe::cli::annotate(f.gray, f.markers));
-			} catch (const cv::Exception &) {
-				ok = false;
-			}
-			if (!ok) {
-				std::cerr << "frappe-detect: cannot write " << path << "\n";
-				anyError = true;
-			}
-		}
-	}
+	if (runner.failed() > 0)
+		std::cerr << "frappe-detect: " << runner.failed() << " of " << runner.total() << " images failed\n";
 	/* With --list/--out the contract wants exit 0 when the run completed:
 	 * per-image errors are in the output. */
 	if (!opt.out.empty())
 		return 0;
-	return anyError ? 1 : 0;
+	return runner.failed() > 0 || runner.annotateFailed() ? 1 : 0;
 }

@@ -5,8 +5,10 @@
 //   frappe-render --scene --dictionary apriltag_36h11 --seed 3 scene.png   (+ scene.json truth)
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <limits>
 #include <random>
 #include <string>
 
@@ -15,6 +17,8 @@
 
 #include "frappe/frappe.h"
 #include "frappe/render.h"
+
+#include "cli_text.h"
 
 namespace {
 
@@ -28,8 +32,31 @@ const char kUsage[] =
 
 [[noreturn]] void fail(const std::string &m)
 {
-	std::cerr << "frappe-render: " << m << "\n(try --help)\n";
+	std::cerr << "frappe-render: " << m << "\n" << kUsage;
 	std::exit(2);
+}
+
+/* An integer option in [lo, hi]; anything else is a usage error, never an
+ * exception out of main. */
+int intOption(const std::string &opt, const std::string &text, int lo, int hi)
+{
+	int v = 0;
+	if (!frappe::cli::parseNumber(text, v) || v < lo || v > hi)
+		fail(opt + " needs a whole number in " + std::to_string(lo) + ".." + std::to_string(hi) + ", got '" +
+		     text + "'");
+	return v;
+}
+
+/* cv::imwrite throws for a name without a known extension. */
+bool writeImage(const std::string &path, const cv::Mat &img)
+{
+	try {
+		if (cv::imwrite(path, img))
+			return true;
+	} catch (const cv::Exception &) {
+	}
+	std::cerr << "frappe-render: cannot write " << path << "\n";
+	return false;
 }
 
 } // namespace
@@ -52,19 +79,23 @@ int main(int argc, char **argv)
 		} else if (a == "--dictionary" || a == "-d") {
 			dictName = value();
 		} else if (a == "--id") {
-			id = std::stoi(value());
+			id = intOption(a, value(), 0, 1 << 20); /* the dictionary's bound below */
 		} else if (a == "--cell") {
-			cell = std::stoi(value());
+			cell = intOption(a, value(), 1, 1000);
 		} else if (a == "--quiet") {
-			quiet = std::stoi(value());
+			quiet = intOption(a, value(), 0, 100);
 		} else if (a == "--seed") {
-			seed = std::stoi(value());
+			seed = intOption(a, value(), 0, std::numeric_limits<int>::max());
 		} else if (a == "--count") {
-			count = std::stoi(value());
+			count = intOption(a, value(), 1, 30); /* more only piles markers on each other */
 		} else if (a == "--scene") {
 			scene = true;
+		} else if (a.empty()) {
+			fail("an empty argument");
 		} else if (a[0] == '-') {
 			fail("unknown option " + a);
+		} else if (!out.empty()) {
+			fail("one output file, got '" + out + "' and '" + a + "'");
 		} else {
 			out = a;
 		}
@@ -78,10 +109,14 @@ int main(int argc, char **argv)
 	if (!scene) {
 		if (id < 0 || id >= dict->size())
 			fail("id must be in 0.." + std::to_string(dict->size() - 1));
+		/* the side in pixels stays within what an image file holds */
+		if (static_cast<long long>(cell) * (dict->bits + 2 + 2 * quiet) > 32768)
+			fail("--cell " + std::to_string(cell) + " with --quiet " + std::to_string(quiet) +
+			     " makes a marker wider than 32768 pixels");
 		int side = 0;
 		auto px = frappe::markerImage(*dict, id, cell, quiet, side);
 		cv::Mat img(side, side, CV_8UC1, px.data());
-		return cv::imwrite(out, img) ? 0 : 1;
+		return writeImage(out, img) ? 0 : 1;
 	}
 
 	/* A scene: a textured backdrop, markers in a loose grid, then optics. */
@@ -93,9 +128,14 @@ int main(int argc, char **argv)
 			img.at<std::uint8_t>(y, x) = static_cast<std::uint8_t>(
 				90 + 40 * std::sin(x * 0.021 + y * 0.013) + 25 * std::sin(x * 0.11) * std::cos(y * 0.07));
 	frappe::MutableImageView view{ img.data, 640, 480, static_cast<int>(img.step[0]) };
-	std::ofstream json(out.substr(0, out.find_last_of('.')) + ".json");
-	json << "{\"image\": \"" << out.substr(out.find_last_of('/') + 1) << "\", \"family\": \"" << dict->name
-	     << "\", \"markers\": [";
+	const std::string jsonPath = std::filesystem::path(out).replace_extension(".json").string();
+	std::ofstream json(jsonPath);
+	if (!json) {
+		std::cerr << "frappe-render: cannot write " << jsonPath << "\n";
+		return 1;
+	}
+	json << "{\"image\": \"" << frappe::cli::jsonEscape(std::filesystem::path(out).filename().string())
+	     << "\", \"family\": \"" << dict->name << "\", \"markers\": [";
 	const int cols = 3, rows = (count + cols - 1) / cols;
 	for (int k = 0; k < count; ++k) {
 		const int mid = static_cast<int>(U(rng) * dict->size());
@@ -121,5 +161,10 @@ int main(int argc, char **argv)
 	img.convertTo(wide, CV_16SC1);
 	wide += noise;
 	wide.convertTo(img, CV_8UC1);
-	return cv::imwrite(out, img) ? 0 : 1;
+	json.flush();
+	if (!json) {
+		std::cerr << "frappe-render: cannot write " << jsonPath << "\n";
+		return 1;
+	}
+	return writeImage(out, img) ? 0 : 1;
 }

@@ -1,0 +1,41 @@
+// SPDX-License-Identifier: MIT
+// image_check.h: what the CLI learns of an image file before decoding it.
+//
+// OpenCV 4.6 has no header-only query, and cv::imread both decodes a
+// 30000 x 30000 PNG of 1 MB into 900 MB and accepts a JPEG cut in half with
+// only a libjpeg warning. So the CLI reads the file itself (bounded), reads
+// the size from the header and checks that the data reaches the format's end
+// before handing the bytes to cv::imdecode.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace frappe::cli {
+
+enum class ImageFormat { Unknown, Png, Jpeg, Bmp, Pnm };
+
+struct ImageHeader {
+	ImageFormat format = ImageFormat::Unknown;
+	long long width = 0, height = 0; /* 0 x 0 when the format is unknown */
+	std::string error;               /* non-empty: malformed or truncated */
+};
+
+/// Reads the size and checks the completeness of PNG (IHDR ... IEND), JPEG
+/// (SOFn, then EOI after the first scan), BMP and binary PNM (the pixel data
+/// the header announces) files; other formats come back Unknown, without
+/// error. Never reads outside [data, data + size).
+ImageHeader inspectImage(const std::uint8_t *data, std::size_t size);
+
+/// The name of a format, for messages.
+const char *formatName(ImageFormat format);
+
+/// Reads a regular file of at most `limit` bytes into `bytes`; on failure
+/// returns false with `error` saying why ("cannot open X", "X is N bytes,
+/// more than ...").
+bool readFileBounded(const std::string &path, std::size_t limit, std::vector<std::uint8_t> &bytes,
+		     std::string &error);
+
+} // namespace frappe::cli
