@@ -66,6 +66,7 @@ struct FRAPPE_HIDDEN Detector::Impl {
 	detail::ContourTracer tracer;
 	detail::ContourTracer regionTracer;
 	std::vector<detail::Quad> regionQuads;
+	detail::QuadCornerGrid quadGrid; /* removeDuplicateQuads()'s */
 	detail::RegionScratch regionScratch; /* for a front end without a region map */
 	detail::WarpedMarker warped;
 	/* Candidates with large cells are read on the frame halved into blocks

@@ -13,10 +13,12 @@ namespace frappe::detail {
  * that puts the one to keep first (the tracer's scan; then smallest first,
  * a marker's own outline before its quiet zone's), so the caller keeps the
  * earlier one unless it has a better reason (a lower Hamming distance).
- * What counts as a repeat is the caller's: quads that coincide corner for
- * corner (removeDuplicateQuads()), a marker read twice (keepMarker()), the
- * outline of a decoded marker's quiet zone (surroundsMarker()). Quadratic
- * in the items kept, a few dozen at most; allocates nothing. */
+ * What counts as a repeat is the caller's: a marker read twice
+ * (keepMarker()), the outline of a decoded marker's quiet zone
+ * (surroundsMarker()). Quadratic in the items kept: the markers of a frame,
+ * which Config::max_candidates bounds. The traced quads, one per square of
+ * a tiled wall, are too many for that: removeDuplicateQuads() applies the
+ * same rule through a grid of their corners. Allocates nothing. */
 template<typename Kept, typename Item, typename Same>
 Kept *firstRepeated(std::span<Kept> kept, const Item &item, Same same)
 {

@@ -304,3 +304,37 @@ TEST(RenderedMarkers, MarkerInsideANearCodewordPanelIsFound)
 	ASSERT_NE(m, nullptr) << "the marker inside the panel";
 	EXPECT_LT(meanCornerError(m->corners, small), 0.3f);
 }
+
+/* A tiled wall (a candidate per tile) around two markers: over
+ * max_candidates the tiles beyond it are dropped and counted, and the
+ * markers, which the trace's quick read already decoded, are kept. Under
+ * it, nothing is dropped. */
+TEST(RenderedMarkers, CandidateCapKeepsTheMarkersAndCountsTheRest)
+{
+	const Dictionary &dict = *findDictionary("aruco_mip_36h12");
+	Image img(640, 480, 230);
+	squareGrid(img, 12, 20);
+	for (int y = 150; y < 330; ++y)
+		for (int x = 60; x < 580; ++x)
+			img.at(x, y) = 230;
+	renderMarker(img.mut(), dict, 3, squarePose(180.0f, 240.0f, 120.0f, 5.0f, 0.0f));
+	renderMarker(img.mut(), dict, 4, squarePose(460.0f, 240.0f, 120.0f, -5.0f, 0.0f));
+
+	Detector all{ Config{} };
+	const Result &r = all.detect(img.view());
+	EXPECT_EQ(r.candidates_dropped, 0);
+	EXPECT_EQ(r.markers.size(), 2u);
+	EXPECT_GT(r.candidates, 400); /* the tiles were candidates */
+
+	Config capped;
+	capped.max_candidates = 50;
+	Detector few(capped);
+	const Result &c = few.detect(img.view());
+	/* Dropped: every traced quad beyond 50, at least those that reached
+	 * decoding without a cap. */
+	EXPECT_GE(c.candidates_dropped, r.candidates - 50);
+	EXPECT_LE(c.candidates, 50);
+	ASSERT_EQ(c.markers.size(), 2u);
+	EXPECT_NE(findMarker(c.markers, 3), nullptr);
+	EXPECT_NE(findMarker(c.markers, 4), nullptr);
+}
