@@ -380,7 +380,7 @@ void Detector::Impl::finish(const ImageView &image, Slot &slot)
 	/* Smallest first, a block of a marker's code cells decoded before the
 	 * marker around it did: now that both are known, drop it. */
 	StageTimer timer(res.times, Stage::Decode);
-	detail::dropNestedMarkers(res.markers, dict->bits);
+	detail::dropNestedMarkers(res.markers, dict->bits, markerGrid);
 }
 
 } // namespace frappe

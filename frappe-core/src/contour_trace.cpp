@@ -944,55 +944,18 @@ bool ContourTracer::acceptQuad(const TraceParams &params, int w, int h, Quad &qu
 	return true;
 }
 
-void QuadCornerGrid::reset(std::size_t quads, float cell)
-{
-	/* Four corners a quad, and at least twice as many slots as corners:
-	 * chains of about one entry. */
-	std::size_t slots = 64;
-	while (slots < 8 * quads)
-		slots *= 2;
-	mask_ = slots - 1;
-	if (heads_.size() < slots)
-		heads_.resize(slots);
-	std::fill_n(heads_.begin(), slots, -1);
-	entries_.clear();
-	entries_.reserve(4 * quads);
-	invCell_ = 1.0f / cell;
-}
-
-int QuadCornerGrid::cellOf(float v) const
-{
-	/* Clamped (and NaN to 0): out-of-range cells only share slots, which
-	 * costs comparisons, never a missed neighbour. */
-	const float c = std::floor(v * invCell_);
-	return c >= -1e9f && c <= 1e9f ? static_cast<int>(c) : 0;
-}
-
-std::size_t QuadCornerGrid::slot(int x, int y) const
-{
-	const auto h = static_cast<std::uint32_t>(x) * 0x9E3779B1u ^ static_cast<std::uint32_t>(y) * 0x85EBCA77u;
-	return (h ^ h >> 15) & mask_;
-}
-
-void QuadCornerGrid::add(int quad, int corner, Point2f p)
-{
-	const std::size_t s = slot(cellOf(p.x), cellOf(p.y));
-	entries_.push_back({ quad, corner, heads_[s] });
-	heads_[s] = static_cast<int>(entries_.size() - 1);
-}
-
-void removeDuplicateQuads(std::vector<Quad> &quads, float tolerance, QuadCornerGrid &grid)
+void removeDuplicateQuads(std::vector<Quad> &quads, float tolerance, PointGrid &grid)
 {
 	const float tol2 = tolerance * tolerance;
 	/* A repeat has every corner within the tolerance of one of a kept
 	 * quad's, in the same order from some start `shift`: kept corner
 	 * `shift` lies within the tolerance of the repeat's first corner, so in
-	 * one of the 3 x 3 cells around it once cells are wider than the
-	 * tolerance (half as wide again: rounding in the cell index never
+	 * a cell the box of the tolerance around it touches (cells half as wide
+	 * again as the tolerance: a rounding of the box or the cell index never
 	 * moves a point by a whole cell). Each kept quad is filed under its
 	 * four corners; the corner found gives the shift. The same quads are
 	 * kept as comparing each with all kept ones did. */
-	grid.reset(quads.size(), std::max(1.5f * tolerance, 1e-3f));
+	grid.reset(4 * quads.size(), std::max(1.5f * tolerance, 1e-3f));
 	auto repeats = [&](const Quad &q, int keptAt, int shift) {
 		const Quad &k = quads[static_cast<std::size_t>(keptAt)];
 		for (int c = 0; c < 4; ++c)
@@ -1003,7 +966,9 @@ void removeDuplicateQuads(std::vector<Quad> &quads, float tolerance, QuadCornerG
 	std::size_t kept = 0;
 	for (std::size_t i = 0; i < quads.size(); ++i) {
 		const Quad q = quads[i];
-		if (grid.anyNear(q.corners[0], [&](int k, int shift) { return repeats(q, k, shift); }))
+		const Point2f p = q.corners[0];
+		if (grid.anyIn(p.x - tolerance, p.y - tolerance, p.x + tolerance, p.y + tolerance,
+			       [&](int k, int shift) { return repeats(q, k, shift); }))
 			continue;
 		for (int c = 0; c < 4; ++c)
 			grid.add(static_cast<int>(kept), c, q.corners[c]);
@@ -1014,7 +979,7 @@ void removeDuplicateQuads(std::vector<Quad> &quads, float tolerance, QuadCornerG
 
 void removeDuplicateQuads(std::vector<Quad> &quads, float tolerance)
 {
-	QuadCornerGrid grid;
+	PointGrid grid;
 	removeDuplicateQuads(quads, tolerance, grid);
 }
 

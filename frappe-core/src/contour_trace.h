@@ -10,6 +10,7 @@
 
 #include "frappe/edge_map.h"
 #include "frappe/image.h"
+#include "point_grid.h"
 
 namespace frappe::detail {
 
@@ -144,51 +145,11 @@ private:
 	std::int64_t radius2Floor_ = 16; ///< floor(cluster_radius^2)
 };
 
-/// removeDuplicateQuads()'s scratch: the kept quads' corners in a hash grid
-/// of cells at least `tolerance` wide, so that a quad is compared only with
-/// the kept quads that have a corner near its first one. Its vectors grow
-/// to the most quads a frame has had and are reused: a warm one allocates
-/// nothing.
-class QuadCornerGrid
-{
-public:
-	/// Empties the grid for up to `quads` quads, cells `cell` wide.
-	void reset(std::size_t quads, float cell);
-	/// Files corner `corner` of kept quad `quad` under its cell.
-	void add(int quad, int corner, Point2f p);
-	/// Calls visit(quad, corner) for every corner filed in the 3 x 3 cells
-	/// around p (and, through hash collisions, maybe a few more), until it
-	/// returns true; returns whether one did.
-	template<typename Visit>
-	bool anyNear(Point2f p, Visit visit) const
-	{
-		const int cx = cellOf(p.x), cy = cellOf(p.y);
-		for (int y = cy - 1; y <= cy + 1; ++y)
-			for (int x = cx - 1; x <= cx + 1; ++x)
-				for (int e = heads_[slot(x, y)]; e >= 0; e = entries_[static_cast<std::size_t>(e)].next)
-					if (visit(entries_[static_cast<std::size_t>(e)].quad,
-						  entries_[static_cast<std::size_t>(e)].corner))
-						return true;
-		return false;
-	}
-
-private:
-	struct Entry {
-		int quad, corner, next;
-	};
-	int cellOf(float v) const;
-	std::size_t slot(int x, int y) const;
-	float invCell_ = 1.0f;
-	std::size_t mask_ = 0;
-	std::vector<int> heads_; ///< per slot, the last entry filed there, -1: none
-	std::vector<Entry> entries_;
-};
-
 /// Drops quads whose corners all lie within `tolerance` of an earlier quad's
 /// (under some cyclic alignment), keeping the first; in place. The back
 /// end's one suppression rule (suppression.h), in time linear in the quads
 /// (a frame of thousands of small squares, a tiled wall, has as many).
-void removeDuplicateQuads(std::vector<Quad> &quads, float tolerance, QuadCornerGrid &grid);
+void removeDuplicateQuads(std::vector<Quad> &quads, float tolerance, PointGrid &grid);
 /// The same with a grid of its own, which it allocates: for tests.
 void removeDuplicateQuads(std::vector<Quad> &quads, float tolerance);
 

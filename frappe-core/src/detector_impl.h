@@ -66,7 +66,8 @@ struct FRAPPE_HIDDEN Detector::Impl {
 	detail::ContourTracer tracer;
 	detail::ContourTracer regionTracer;
 	std::vector<detail::Quad> regionQuads;
-	detail::QuadCornerGrid quadGrid; /* removeDuplicateQuads()'s */
+	detail::PointGrid quadGrid;   /* removeDuplicateQuads()'s, in trace() */
+	detail::PointGrid markerGrid; /* dropNestedMarkers()'s, in finish() */
 	detail::RegionScratch regionScratch; /* for a front end without a region map */
 	detail::WarpedMarker warped;
 	/* Candidates with large cells are read on the frame halved into blocks

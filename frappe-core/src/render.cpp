@@ -7,6 +7,7 @@
 #include <string>
 
 #include "frappe/homography.h"
+#include "quad_geometry.h"
 
 namespace frappe {
 
@@ -61,23 +62,17 @@ void checkRenderArguments(const MutableImageView &image, const Dictionary &dict,
 			fail("corner " + std::to_string(i) + " is not a finite point: " + pointText(corners[i]));
 	/* A square seen in perspective is a convex quadrilateral: every three
 	 * corners turn the same way. Collinear or coincident corners (a turn
-	 * of 0), or a crossed outline, are no view of a square. In double:
-	 * float corners multiply exactly. */
-	int sign = 0;
+	 * of 0), or a crossed outline, are no view of a square. */
 	for (int i = 0; i < 4; ++i) {
 		const Point2f a = corners[i], b = corners[(i + 1) & 3], c = corners[(i + 2) & 3];
-		const double turn = (static_cast<double>(b.x) - a.x) * (static_cast<double>(c.y) - b.y) -
-				    (static_cast<double>(b.y) - a.y) * (static_cast<double>(c.x) - b.x);
-		const int s = turn > 0.0 ? 1 : turn < 0.0 ? -1 : 0;
-		if (s == 0)
+		if (detail::turnSign(a, b, c) == 0)
 			fail("corners " + std::to_string(i) + ", " + std::to_string((i + 1) & 3) + " and " +
 			     std::to_string((i + 2) & 3) + " are collinear or coincide (" + pointText(a) + ", " +
 			     pointText(b) + ", " + pointText(c) + "): no perspective of a square");
-		if (sign != 0 && s != sign)
-			fail("corners do not make a convex quadrilateral (the outline crosses itself or folds "
-			     "in): no perspective of a square");
-		sign = s;
 	}
+	if (!detail::convexQuad(corners))
+		fail("corners do not make a convex quadrilateral (the outline crosses itself or folds "
+		     "in): no perspective of a square");
 }
 
 /* A pixel coordinate as an int clamped to [lo, hi]: the bounding box of a

@@ -662,7 +662,7 @@ TEST(RemoveDuplicateQuads, KeepsWhatComparingEveryPairKeeps)
 	quads.push_back(beyond);
 
 	const std::vector<Quad> expected = duplicatesRemovedPairwise(quads, 2.5f);
-	QuadCornerGrid grid;
+	PointGrid grid;
 	for (int frame = 0; frame < 2; ++frame) { /* a reused grid gives the same */
 		std::vector<Quad> got = quads;
 		removeDuplicateQuads(got, 2.5f, grid);

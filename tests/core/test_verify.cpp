@@ -348,6 +348,47 @@ TEST(Nesting, DropsMarkersInsideOthers)
 	EXPECT_EQ(found[1].id, 9);
 }
 
+/* Hundreds of markers of all sizes, many nested in others (some two deep),
+ * some tilted: the grid drops exactly the markers, and keeps the rest in
+ * their order, that testing every pair does. */
+TEST(Nesting, GridDropsWhatTestingEveryPairDrops)
+{
+	std::mt19937 rng(16);
+	std::uniform_real_distribution<float> place(0.0f, 3000.0f), side(10.0f, 300.0f), frac(0.0f, 1.0f);
+	std::vector<Marker> found;
+	for (int i = 0; i < 600; ++i) {
+		Marker m;
+		m.id = i;
+		if (!found.empty() && frac(rng) < 0.4f) {
+			/* Within (or straddling) an earlier one. */
+			const Marker &o = found[static_cast<std::size_t>(rng() % found.size())];
+			const float os = o.corners[1].x - o.corners[0].x, s = os * (0.1f + 0.5f * frac(rng));
+			m.corners = square(o.corners[0].x + (os - s) * frac(rng), o.corners[0].y + (os - s) * frac(rng), s);
+		} else {
+			m.corners = test::squarePose(place(rng), place(rng), side(rng), 90.0f * frac(rng), 0.0f);
+		}
+		found.push_back(m);
+	}
+	std::vector<int> expected;
+	for (const Marker &m : found) {
+		bool nested = false;
+		for (const Marker &outer : found)
+			nested = nested || (&outer != &m && detail::insideCodeArea(m.corners, outer.corners, 6));
+		if (!nested)
+			expected.push_back(m.id);
+	}
+	detail::PointGrid grid;
+	for (int frame = 0; frame < 2; ++frame) {
+		std::vector<Marker> got = found;
+		detail::dropNestedMarkers(got, 6, grid);
+		std::vector<int> ids;
+		for (const Marker &m : got)
+			ids.push_back(m.id);
+		EXPECT_EQ(ids, expected);
+	}
+	EXPECT_LT(expected.size(), 550u); /* many were nested */
+}
+
 /* ---- all of it, on one candidate ---- */
 
 TEST(ReadMarker, EachRejectionOnItsOwn)
