@@ -176,7 +176,7 @@ bool Detector::Impl::skipCandidate(const detail::Quad &q, const std::array<Point
 {
 	const int bits = dict->bits;
 	const int traced = q.probeRead;
-	if (detail::surroundsMarker(tracedOutline, quadArea(tracedOutline), traced, bits, found))
+	if (detail::surroundsMarker(tracedOutline, quadArea(tracedOutline), traced, bits, found, markerCentres))
 		return true;
 	/* The probe's read at the traced outline decides two things before
 	 * refinement. A frame with more white cells than twice what decode
@@ -369,13 +369,22 @@ void Detector::Impl::finish(const ImageView &image, Slot &slot)
 			for (Point2f &p : q.corners)
 				p = toFullResolution(p, scale);
 	}
+	/* Each marker found filed at its centre for surroundsMarker(), once
+	 * and again when replaced: at most two entries a candidate. Cells of
+	 * 32 px; a large candidate's box spans many, and then the grid visits
+	 * every entry instead. */
+	markerCentres.reset(2 * slot.quads.size(), 32.0f);
 	if (warper)
 		refineAndWarpAll(image, slot, search);
 	for (std::size_t k = 0; k < slot.quads.size(); ++k) {
 		StageTimer timer(res.times, Stage::Refine);
 		Marker m;
-		if (readCandidate(image, slot, k, search, timer, m))
-			detail::keepMarker(res.markers, m);
+		if (!readCandidate(image, slot, k, search, timer, m))
+			continue;
+		/* A replaced marker is filed again at its new centre; its old
+		 * entry only costs a test against it. */
+		if (const int at = detail::keepMarker(res.markers, m); at >= 0)
+			markerCentres.add(at, 0, detail::quadCentre(m.corners));
 	}
 	/* Smallest first, a block of a marker's code cells decoded before the
 	 * marker around it did: now that both are known, drop it. */

@@ -15,10 +15,12 @@ namespace frappe::detail {
  * earlier one unless it has a better reason (a lower Hamming distance).
  * What counts as a repeat is the caller's: a marker read twice
  * (keepMarker()), the outline of a decoded marker's quiet zone
- * (surroundsMarker()). Quadratic in the items kept: the markers of a frame,
- * which Config::max_candidates bounds. The traced quads, one per square of
- * a tiled wall, are too many for that: removeDuplicateQuads() applies the
- * same rule through a grid of their corners. Allocates nothing. */
+ * (surroundsMarker(), which only passes it the markers filed near the
+ * candidate). Quadratic in the items passed: keepMarker() passes all the
+ * frame's markers, which Config::max_candidates bounds, and compares ids
+ * first. The traced quads, one per square of a tiled wall, are too many
+ * for that: removeDuplicateQuads() applies the same rule through a grid
+ * of their corners (point_grid.h). Allocates nothing. */
 template<typename Kept, typename Item, typename Same>
 Kept *firstRepeated(std::span<Kept> kept, const Item &item, Same same)
 {

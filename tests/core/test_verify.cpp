@@ -13,6 +13,7 @@
 #include "frappe/frappe.h"
 #include "frappe/render.h"
 #include "scene.h"
+#include "marker_set.h"
 #include "verify.h"
 
 using namespace frappe;
@@ -387,6 +388,51 @@ TEST(Nesting, GridDropsWhatTestingEveryPairDrops)
 		EXPECT_EQ(ids, expected);
 	}
 	EXPECT_LT(expected.size(), 550u); /* many were nested */
+}
+
+/* Candidates around markers of all sizes: looking only at the markers
+ * whose centre is filed near a candidate's finds the quiet-zone outlines
+ * that testing every marker finds, and no others. */
+TEST(Nesting, SurroundsMarkerThroughTheGridAsThroughAll)
+{
+	std::mt19937 rng(17);
+	std::uniform_real_distribution<float> place(0.0f, 2000.0f), side(10.0f, 200.0f), frac(0.0f, 1.0f);
+	std::vector<Marker> found(300);
+	detail::PointGrid centres;
+	centres.reset(found.size(), 32.0f);
+	for (std::size_t i = 0; i < found.size(); ++i) {
+		found[i].id = static_cast<int>(i);
+		found[i].corners = square(place(rng), place(rng), side(rng));
+		centres.add(static_cast<int>(i), 0, detail::quadCentre(found[i].corners));
+	}
+	const detail::PointGrid none = [] {
+		detail::PointGrid g;
+		g.reset(0, 32.0f);
+		return g;
+	}();
+	int surrounding = 0;
+	for (int k = 0; k < 2000; ++k) {
+		const Marker &m = found[rng() % found.size()];
+		const float ms = m.corners[1].x - m.corners[0].x, grow = ms * (2.0f * frac(rng) - 0.3f);
+		const float shift = ms * (0.6f * frac(rng) - 0.3f);
+		const Quad q = square(m.corners[0].x - grow / 2 + shift, m.corners[0].y - grow / 2, ms + grow);
+		/* The rule, on every marker: about its size, centred on it. */
+		const float area = detail::quadArea(q);
+		const Point2f c = detail::quadCentre(q);
+		bool all = false;
+		for (const Marker &f : found) {
+			const float am = detail::quadArea(f.corners);
+			const Point2f cm = detail::quadCentre(f.corners);
+			const float dx = c.x - cm.x, dy = c.y - cm.y;
+			all = all || (area <= 3.0f * am && am <= 3.0f * area && dx * dx + dy * dy < 0.12f * am);
+		}
+		const bool grid = detail::surroundsMarker(q, detail::quadArea(q), -1, 6, found, centres);
+		EXPECT_EQ(grid, all) << "candidate " << k;
+		EXPECT_FALSE(detail::surroundsMarker(q, detail::quadArea(q), -1, 6, found, none));
+		surrounding += grid;
+	}
+	EXPECT_GT(surrounding, 200); /* both answers were asked */
+	EXPECT_LT(surrounding, 1800);
 }
 
 /* ---- all of it, on one candidate ---- */
