@@ -103,13 +103,7 @@ Detector::Impl::BlockView Detector::Impl::blockView(const ImageView &image, int 
 		detail::halveImage(level, out);
 	};
 	const int W = image.width / f, H = image.height / f;
-	float x0 = outline[0].x, x1 = x0, y0 = outline[0].y, y1 = y0;
-	for (const Point2f &p : outline) {
-		x0 = std::min(x0, p.x);
-		x1 = std::max(x1, p.x);
-		y0 = std::min(y0, p.y);
-		y1 = std::max(y1, p.y);
-	}
+	const auto [x0, y0, x1, y1] = detail::quadBox(outline);
 	const float ff = static_cast<float>(f);
 	const int bx0 = std::clamp(static_cast<int>(std::floor((x0 - margin) / ff)), 0, W);
 	const int by0 = std::clamp(static_cast<int>(std::floor((y0 - margin) / ff)), 0, H);

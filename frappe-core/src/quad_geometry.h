@@ -42,6 +42,22 @@ inline bool convexQuad(const QuadCorners &q)
 	return sign != 0;
 }
 
+/* A quad's bounding box. */
+struct QuadBox {
+	float x0, y0, x1, y1;
+};
+inline QuadBox quadBox(const QuadCorners &q)
+{
+	QuadBox b{ q[0].x, q[0].y, q[0].x, q[0].y };
+	for (const Point2f &p : q) {
+		b.x0 = std::min(b.x0, p.x);
+		b.x1 = std::max(b.x1, p.x);
+		b.y0 = std::min(b.y0, p.y);
+		b.y1 = std::max(b.y1, p.y);
+	}
+	return b;
+}
+
 /* The square of the shortest of a quad's four sides. */
 inline float shortestSide2(const QuadCorners &q)
 {

@@ -235,17 +235,10 @@ void dropNestedMarkers(std::vector<Marker> &markers, int bits, PointGrid &grid)
 		};
 		/* Only a convex outline holds what maps into its unit square;
 		 * otherwise (never for a verified marker) every marker is tested. */
-		const auto &q = outer.corners;
-		float x0 = q[0].x, x1 = x0, y0 = q[0].y, y1 = y0;
-		for (const Point2f &p : q) {
-			x0 = std::min(x0, p.x);
-			x1 = std::max(x1, p.x);
-			y0 = std::min(y0, p.y);
-			y1 = std::max(y1, p.y);
-		}
-		const float pad = 1.0f + 1e-3f * std::max(x1 - x0, y1 - y0);
-		if (convexQuad(q) && std::isfinite(pad))
-			grid.anyIn(x0 - pad, y0 - pad, x1 + pad, y1 + pad, mark);
+		const QuadBox b = quadBox(outer.corners);
+		const float pad = 1.0f + 1e-3f * std::max(b.x1 - b.x0, b.y1 - b.y0);
+		if (convexQuad(outer.corners) && std::isfinite(pad))
+			grid.anyIn(b.x0 - pad, b.y0 - pad, b.x1 + pad, b.y1 + pad, mark);
 		else
 			for (std::size_t i = 0; i < markers.size(); ++i)
 				mark(static_cast<int>(i), 0);
