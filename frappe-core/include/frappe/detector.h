@@ -53,9 +53,10 @@ struct Result {
 	float scale = 1.0f;     ///< resolution the frame was traced at
 	int candidates = 0;     ///< quadrilaterals that reached decoding
 	/// Candidate outlines the trace found beyond Config::max_candidates and
-	/// left unread (the largest ones): 0 unless the frame is full of
-	/// squares (a tiled wall, a dot grid, a checkerboard). Markers among
-	/// them are missed; a caller may report it as a warning.
+	/// left unread (the largest of those its quick read did not find to be
+	/// markers): 0 unless the frame is full of squares (a tiled wall, a dot
+	/// grid). Markers among them are missed; a caller may report it as a
+	/// warning.
 	int candidates_dropped = 0;
 };
 
