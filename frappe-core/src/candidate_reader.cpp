@@ -103,13 +103,7 @@ Detector::Impl::BlockView Detector::Impl::blockView(const ImageView &image, int 
 		detail::halveImage(level, out);
 	};
 	const int W = image.width / f, H = image.height / f;
-	float x0 = outline[0].x, x1 = x0, y0 = outline[0].y, y1 = y0;
-	for (const Point2f &p : outline) {
-		x0 = std::min(x0, p.x);
-		x1 = std::max(x1, p.x);
-		y0 = std::min(y0, p.y);
-		y1 = std::max(y1, p.y);
-	}
+	const auto [x0, y0, x1, y1] = detail::quadBox(outline);
 	const float ff = static_cast<float>(f);
 	const int bx0 = std::clamp(static_cast<int>(std::floor((x0 - margin) / ff)), 0, W);
 	const int by0 = std::clamp(static_cast<int>(std::floor((y0 - margin) / ff)), 0, H);
@@ -176,7 +170,7 @@ bool Detector::Impl::skipCandidate(const detail::Quad &q, const std::array<Point
 {
 	const int bits = dict->bits;
 	const int traced = q.probeRead;
-	if (detail::surroundsMarker(tracedOutline, quadArea(tracedOutline), traced, bits, found))
+	if (detail::surroundsMarker(tracedOutline, quadArea(tracedOutline), traced, bits, found, markerCentres))
 		return true;
 	/* The probe's read at the traced outline decides two things before
 	 * refinement. A frame with more white cells than twice what decode
@@ -369,18 +363,27 @@ void Detector::Impl::finish(const ImageView &image, Slot &slot)
 			for (Point2f &p : q.corners)
 				p = toFullResolution(p, scale);
 	}
+	/* Each marker found filed at its centre for surroundsMarker(), once
+	 * and again when replaced: at most two entries a candidate. Cells of
+	 * 32 px; a large candidate's box spans many, and then the grid visits
+	 * every entry instead. */
+	markerCentres.reset(2 * slot.quads.size(), 32.0f);
 	if (warper)
 		refineAndWarpAll(image, slot, search);
 	for (std::size_t k = 0; k < slot.quads.size(); ++k) {
 		StageTimer timer(res.times, Stage::Refine);
 		Marker m;
-		if (readCandidate(image, slot, k, search, timer, m))
-			detail::keepMarker(res.markers, m);
+		if (!readCandidate(image, slot, k, search, timer, m))
+			continue;
+		/* A replaced marker is filed again at its new centre; its old
+		 * entry only costs a test against it. */
+		if (const int at = detail::keepMarker(res.markers, m); at >= 0)
+			markerCentres.add(at, 0, detail::quadCentre(m.corners));
 	}
 	/* Smallest first, a block of a marker's code cells decoded before the
 	 * marker around it did: now that both are known, drop it. */
 	StageTimer timer(res.times, Stage::Decode);
-	detail::dropNestedMarkers(res.markers, dict->bits);
+	detail::dropNestedMarkers(res.markers, dict->bits, markerGrid);
 }
 
 } // namespace frappe

@@ -16,7 +16,6 @@
 #include "contour_trace.h"
 #include "quad_geometry.h"
 #include "rounding.h"
-#include "suppression.h"
 #include "trace_kernels.h"
 
 #include <algorithm>
@@ -365,8 +364,10 @@ void ContourTracer::trace(const TraceMap &edges, const TraceParams &params, std:
 		if ((!tooManyClusters_ && clusters_.size() >= 4 && quadFromClusters(quad) &&
 		     acceptQuad(params, w, h, quad)) ||
 		    (clusters_.size() >= static_cast<std::size_t>(params.min_clusters) && quadFromOutline(quad) && acceptQuad(params, w, h, quad))) {
-			if (probe && probe->isMarker(quad))
+			if (probe && probe->isMarker(quad)) {
+				quad.probeDecoded = true;
 				sealInside(quad, w, h);
+			}
 			out.push_back(quad);
 		}
 	};
@@ -943,27 +944,64 @@ bool ContourTracer::acceptQuad(const TraceParams &params, int w, int h, Quad &qu
 	return true;
 }
 
-void removeDuplicateQuads(std::vector<Quad> &quads, float tolerance)
+void removeDuplicateQuads(std::vector<Quad> &quads, float tolerance, PointGrid &grid)
 {
 	const float tol2 = tolerance * tolerance;
-	/* Every corner within the tolerance of one of the kept quad's, in
-	 * the same order from any start. */
-	auto same = [tol2](const Quad &kept, const Quad &q) {
-		for (int shift = 0; shift < 4; ++shift) {
-			bool all = true;
-			for (int k = 0; k < 4 && all; ++k)
-				all = dist2(q.corners[k], kept.corners[(k + shift) & 3]) <= tol2;
-			if (all)
-				return true;
-		}
-		return false;
+	/* A repeat has every corner within the tolerance of one of a kept
+	 * quad's, in the same order from some start `shift`: kept corner
+	 * `shift` lies within the tolerance of the repeat's first corner, so in
+	 * a cell the box of the tolerance around it touches (cells half as wide
+	 * again as the tolerance: a rounding of the box or the cell index never
+	 * moves a point by a whole cell). Each kept quad is filed under its
+	 * four corners; the corner found gives the shift. The same quads are
+	 * kept as comparing each with all kept ones did. */
+	grid.reset(4 * quads.size(), std::max(1.5f * tolerance, 1e-3f));
+	auto repeats = [&](const Quad &q, int keptAt, int shift) {
+		const Quad &k = quads[static_cast<std::size_t>(keptAt)];
+		for (int c = 0; c < 4; ++c)
+			if (!(dist2(q.corners[c], k.corners[(c + shift) & 3]) <= tol2))
+				return false;
+		return true;
 	};
 	std::size_t kept = 0;
 	for (std::size_t i = 0; i < quads.size(); ++i) {
-		if (!firstRepeated(std::span(quads).first(kept), quads[i], same))
-			quads[kept++] = quads[i];
+		const Quad q = quads[i];
+		const Point2f p = q.corners[0];
+		if (grid.anyIn(p.x - tolerance, p.y - tolerance, p.x + tolerance, p.y + tolerance,
+			       [&](int k, int shift) { return repeats(q, k, shift); }))
+			continue;
+		for (int c = 0; c < 4; ++c)
+			grid.add(static_cast<int>(kept), c, q.corners[c]);
+		quads[kept++] = q;
 	}
 	quads.resize(kept);
+}
+
+void removeDuplicateQuads(std::vector<Quad> &quads, float tolerance)
+{
+	PointGrid grid;
+	removeDuplicateQuads(quads, tolerance, grid);
+}
+
+int capCandidates(std::vector<Quad> &quads, int most)
+{
+	const std::size_t n = quads.size(), cap = static_cast<std::size_t>(std::max(most, 0));
+	if (n <= cap)
+		return 0;
+	const auto decoded = static_cast<std::size_t>(
+		std::count_if(quads.begin(), quads.end(), [](const Quad &q) { return q.probeDecoded; }));
+	/* What is left of the cap once the probe's markers have their places. */
+	std::size_t decodedLeft = std::min(decoded, cap), othersLeft = cap - decodedLeft;
+	std::size_t kept = 0;
+	for (std::size_t i = 0; i < n; ++i) {
+		std::size_t &left = quads[i].probeDecoded ? decodedLeft : othersLeft;
+		if (left == 0)
+			continue;
+		--left;
+		quads[kept++] = quads[i];
+	}
+	quads.resize(kept);
+	return static_cast<int>(n - kept);
 }
 
 } // namespace frappe::detail

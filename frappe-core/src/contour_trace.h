@@ -4,11 +4,13 @@
 #pragma once
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
 #include "frappe/edge_map.h"
 #include "frappe/image.h"
+#include "point_grid.h"
 
 namespace frappe::detail {
 
@@ -25,6 +27,9 @@ struct Quad {
 	/// Where the quad came from: the edge map, or the region map (whose
 	/// outline lies up to a region pixel inside the marker's).
 	bool fromRegion = false;
+	/// The probe read it as a marker (and the tracer sealed its inside):
+	/// kept first when a frame has more candidates than it may read.
+	bool probeDecoded = false;
 };
 
 struct TraceParams {
@@ -142,7 +147,15 @@ private:
 
 /// Drops quads whose corners all lie within `tolerance` of an earlier quad's
 /// (under some cyclic alignment), keeping the first; in place. The back
-/// end's one suppression rule (firstRepeated(), suppression.h).
+/// end's one suppression rule (suppression.h), in time linear in the quads
+/// (a frame of thousands of small squares, a tiled wall, has as many).
+void removeDuplicateQuads(std::vector<Quad> &quads, float tolerance, PointGrid &grid);
+/// The same with a grid of its own, which it allocates: for tests.
 void removeDuplicateQuads(std::vector<Quad> &quads, float tolerance);
+
+/// Keeps at most `most` of `quads`, in their order: first those the probe
+/// read as markers (probeDecoded), then the others from the front. Returns
+/// how many it dropped. In place; allocates nothing.
+int capCandidates(std::vector<Quad> &quads, int most);
 
 } // namespace frappe::detail

@@ -48,6 +48,8 @@ void validate(const Config &c, const Dictionary &d)
 		fail("threads must be in [0, 256], got " + std::to_string(c.threads));
 	if (c.max_pixels < 1 || c.max_pixels > (1LL << 30))
 		fail("max_pixels must be in [1, 2^30], got " + std::to_string(c.max_pixels));
+	if (c.max_candidates < 1 || c.max_candidates > (1 << 20))
+		fail("max_candidates must be in [1, 2^20], got " + std::to_string(c.max_candidates));
 }
 
 /* Reads a traced quad as a marker, so that the tracer can skip the
@@ -161,12 +163,13 @@ void Detector::Impl::trace(Slot &slot)
 			quads.push_back(q);
 		}
 	}
-	detail::removeDuplicateQuads(quads, 2.5f);
+	detail::removeDuplicateQuads(quads, 2.5f, quadGrid);
 	/* Smallest first: a marker's own outline decodes before the outline of
 	 * its quiet zone, which can then be skipped. */
 	std::sort(quads.begin(), quads.end(), [](const detail::Quad &a, const detail::Quad &b) {
 		return quadArea(a.corners) < quadArea(b.corners);
 	});
+	slot.result.candidates_dropped = detail::capCandidates(quads, config.max_candidates);
 }
 
 Detector::Detector(const Config &config) : impl_(std::make_unique<Impl>())

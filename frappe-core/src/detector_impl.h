@@ -66,6 +66,9 @@ struct FRAPPE_HIDDEN Detector::Impl {
 	detail::ContourTracer tracer;
 	detail::ContourTracer regionTracer;
 	std::vector<detail::Quad> regionQuads;
+	detail::PointGrid quadGrid;   /* removeDuplicateQuads()'s, in trace() */
+	detail::PointGrid markerGrid; /* dropNestedMarkers()'s, in finish() */
+	detail::PointGrid markerCentres; /* the frame's markers so far, for skipCandidate() */
 	detail::RegionScratch regionScratch; /* for a front end without a region map */
 	detail::WarpedMarker warped;
 	/* Candidates with large cells are read on the frame halved into blocks

@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
 #include "dictionary_table.h"
 
@@ -101,6 +103,11 @@ std::string dictionaryNames(std::string_view separator)
 
 std::uint64_t rotateCode(std::uint64_t code, int bits)
 {
+	/* bits^2 cells must fit the 64 bits of a code: shifting by 64 or more,
+	 * or by a negative count, is undefined. */
+	if (bits < 1 || bits > 8)
+		throw std::invalid_argument("rotateCode: bits must be in [1, 8] (bits^2 cells in a 64-bit code), got " +
+					    std::to_string(bits));
 	/* Bit index of cell (row r, col c) is n*n-1 - (r*n + c). After a
 	 * quarter turn clockwise, the cell at (r, c) comes from (n-1-c, r). */
 	const int n = bits;

@@ -2,12 +2,15 @@
 // The markers of one frame as a set.
 #include "marker_set.h"
 
+#include <cmath>
+
 #include "suppression.h"
 #include "verify.h"
 
 namespace frappe::detail {
 
-bool surroundsMarker(const QuadCorners &q, float area, int probeRead, int bits, std::span<const Marker> found)
+bool surroundsMarker(const QuadCorners &q, float area, int probeRead, int bits, std::span<const Marker> found,
+		     const PointGrid &centres)
 {
 	if (probeRead >= 0 && probeRead <= allowedBorderErrors(bits))
 		return false;
@@ -20,10 +23,17 @@ bool surroundsMarker(const QuadCorners &q, float area, int probeRead, int bits, 
 		const float dx = c.x - cm.x, dy = c.y - cm.y;
 		return dx * dx + dy * dy < 0.12f * am;
 	};
-	return firstRepeated(found, q, surrounds) != nullptr;
+	/* A marker it surrounds has an area of at most 3 * area, so its centre
+	 * lies within sqrt(0.12 * 3 * area) of q's (padded: the test rounds). */
+	const float r = 1.0f + 1.01f * std::sqrt(0.36f * area);
+	if (!(r < 1e9f) || !std::isfinite(c.x) || !std::isfinite(c.y))
+		return firstRepeated(found, q, surrounds) != nullptr;
+	return centres.anyIn(c.x - r, c.y - r, c.x + r, c.y + r, [&](int i, int) {
+		return surrounds(found[static_cast<std::size_t>(i)], q);
+	});
 }
 
-void keepMarker(std::vector<Marker> &markers, const Marker &m)
+int keepMarker(std::vector<Marker> &markers, const Marker &m)
 {
 	/* The first corner of the same id within half of m's first side. */
 	auto sameMarker = [](const Marker &other, const Marker &m) {
@@ -35,10 +45,15 @@ void keepMarker(std::vector<Marker> &markers, const Marker &m)
 		return dx * dx + dy * dy < 0.25f * (sx * sx + sy * sy);
 	};
 	Marker *other = firstRepeated(std::span(markers), m, sameMarker);
-	if (!other)
+	if (!other) {
 		markers.push_back(m);
-	else if (m.hamming < other->hamming)
+		return static_cast<int>(markers.size() - 1);
+	}
+	if (m.hamming < other->hamming) {
 		*other = m;
+		return static_cast<int>(other - markers.data());
+	}
+	return -1;
 }
 
 } // namespace frappe::detail

@@ -22,6 +22,42 @@ inline float dist2(Point2f a, Point2f b)
 	return dx * dx + dy * dy;
 }
 
+/* Which way a -> b -> c turns: 1 or -1, 0 when the three are collinear or
+ * two coincide. In double, where float coordinates multiply exactly. */
+inline int turnSign(Point2f a, Point2f b, Point2f c)
+{
+	const double turn = (static_cast<double>(b.x) - a.x) * (static_cast<double>(c.y) - b.y) -
+			    (static_cast<double>(b.y) - a.y) * (static_cast<double>(c.x) - b.x);
+	return turn > 0.0 ? 1 : turn < 0.0 ? -1 : 0;
+}
+
+/* Every three corners turn the same way, none by 0: a convex quad, as a
+ * square seen in perspective is. */
+inline bool convexQuad(const QuadCorners &q)
+{
+	const int sign = turnSign(q[0], q[1], q[2]);
+	for (int i = 1; i < 4; ++i)
+		if (turnSign(q[i], q[(i + 1) & 3], q[(i + 2) & 3]) != sign)
+			return false;
+	return sign != 0;
+}
+
+/* A quad's bounding box. */
+struct QuadBox {
+	float x0, y0, x1, y1;
+};
+inline QuadBox quadBox(const QuadCorners &q)
+{
+	QuadBox b{ q[0].x, q[0].y, q[0].x, q[0].y };
+	for (const Point2f &p : q) {
+		b.x0 = std::min(b.x0, p.x);
+		b.x1 = std::max(b.x1, p.x);
+		b.y0 = std::min(b.y0, p.y);
+		b.y1 = std::max(b.y1, p.y);
+	}
+	return b;
+}
+
 /* The square of the shortest of a quad's four sides. */
 inline float shortestSide2(const QuadCorners &q)
 {

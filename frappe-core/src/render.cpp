@@ -7,10 +7,16 @@
 #include <string>
 
 #include "frappe/homography.h"
+#include "quad_geometry.h"
 
 namespace frappe {
 
 namespace {
+
+/* Beyond these, sizes overflow an int: supersample^2 samples a pixel, and
+ * markerImage()'s side^2 pixels. */
+constexpr int kMaxSupersample = 256;
+constexpr long long kMaxMarkerImageSide = 1 << 15;
 
 /* 1 = white, 0 = black; -1 outside the marker and its quiet zone. */
 int cellValue(const Dictionary &dict, std::uint64_t code, int cx, int cy, int quiet)
@@ -26,20 +32,68 @@ int cellValue(const Dictionary &dict, std::uint64_t code, int cx, int cy, int qu
 	return static_cast<int>((code >> bit) & 1u);
 }
 
+std::string pointText(Point2f p)
+{
+	return "(" + std::to_string(p.x) + ", " + std::to_string(p.y) + ")";
+}
+
+/* The arguments renderMarker() cannot draw from, refused before any of them
+ * reaches an index, a cast to int or a division. */
+void checkRenderArguments(const MutableImageView &image, const Dictionary &dict, int id,
+			  const std::array<Point2f, 4> &corners, const RenderOptions &opt)
+{
+	auto fail = [](const std::string &what) { throw std::invalid_argument("renderMarker: " + what); };
+	if (image.width < 0 || image.height < 0)
+		fail("image size must not be negative, got " + std::to_string(image.width) + "x" +
+		     std::to_string(image.height));
+	if (image.width > 0 && image.height > 0 && !image.data)
+		fail("image data is null");
+	if (image.height > 1 && image.stride < image.width)
+		fail("image stride (" + std::to_string(image.stride) + ") is smaller than its width (" +
+		     std::to_string(image.width) + ")");
+	if (opt.supersample > kMaxSupersample)
+		fail("supersample must be at most " + std::to_string(kMaxSupersample) + ", got " +
+		     std::to_string(opt.supersample));
+	if (id < 0 || id >= dict.size())
+		throw std::out_of_range("renderMarker: id " + std::to_string(id) + " not in " + std::string(dict.name) +
+					" (0.." + std::to_string(dict.size() - 1) + ")");
+	for (int i = 0; i < 4; ++i)
+		if (!std::isfinite(corners[i].x) || !std::isfinite(corners[i].y))
+			fail("corner " + std::to_string(i) + " is not a finite point: " + pointText(corners[i]));
+	/* A square seen in perspective is a convex quadrilateral: every three
+	 * corners turn the same way. Collinear or coincident corners (a turn
+	 * of 0), or a crossed outline, are no view of a square. */
+	for (int i = 0; i < 4; ++i) {
+		const Point2f a = corners[i], b = corners[(i + 1) & 3], c = corners[(i + 2) & 3];
+		if (detail::turnSign(a, b, c) == 0)
+			fail("corners " + std::to_string(i) + ", " + std::to_string((i + 1) & 3) + " and " +
+			     std::to_string((i + 2) & 3) + " are collinear or coincide (" + pointText(a) + ", " +
+			     pointText(b) + ", " + pointText(c) + "): no perspective of a square");
+	}
+	if (!detail::convexQuad(corners))
+		fail("corners do not make a convex quadrilateral (the outline crosses itself or folds "
+		     "in): no perspective of a square");
+}
+
+/* A pixel coordinate as an int clamped to [lo, hi]: the bounding box of a
+ * strongly foreshortened quiet zone can reach far beyond the image. */
+int clampedPixel(double v, int lo, int hi)
+{
+	return static_cast<int>(std::clamp(v, static_cast<double>(lo), static_cast<double>(hi)));
+}
+
 } // namespace
 
 void renderMarker(MutableImageView image, const Dictionary &dict, int id,
 		  const std::array<Point2f, 4> &corners, const RenderOptions &opt)
 {
-	if (id < 0 || id >= dict.size())
-		throw std::out_of_range("renderMarker: id " + std::to_string(id) + " not in " +
-					std::string(dict.name));
+	checkRenderArguments(image, dict, id, corners, opt);
 	const auto H = Homography::fromUnitSquare(corners);
-	if (!H)
-		throw std::invalid_argument("renderMarker: degenerate corners");
-	const auto Hinv = H->inverse();
+	const auto Hinv = H ? H->inverse() : std::nullopt;
 	if (!Hinv)
-		throw std::invalid_argument("renderMarker: degenerate corners");
+		throw std::invalid_argument("renderMarker: corners too close together for a perspective of a square");
+	if (image.width == 0 || image.height == 0)
+		return;
 	const std::uint64_t code = dict.codes[id];
 	const int cells = dict.bits + 2;
 	const int q = std::max(0, opt.quiet_cells);
@@ -47,8 +101,14 @@ void renderMarker(MutableImageView image, const Dictionary &dict, int id,
 	/* Bounding box of the marker with its quiet zone. */
 	const double lo = -static_cast<double>(q) / cells, hi = 1.0 + static_cast<double>(q) / cells;
 	double minX = 1e18, minY = 1e18, maxX = -1e18, maxY = -1e18;
+	bool beyondHorizon = false;
 	for (double u : { lo, hi }) {
 		for (double v : { lo, hi }) {
+			/* w is 1 at the marker's first corner and positive over
+			 * it: where it is not, the quiet zone's corner lies past
+			 * the horizon and maps to the wrong side. */
+			const auto &m = H->h;
+			beyondHorizon |= !(m[6] * u + m[7] * v + m[8] > 0.0);
 			const Point2f p = H->map(u, v);
 			minX = std::min(minX, static_cast<double>(p.x));
 			maxX = std::max(maxX, static_cast<double>(p.x));
@@ -56,10 +116,18 @@ void renderMarker(MutableImageView image, const Dictionary &dict, int id,
 			maxY = std::max(maxY, static_cast<double>(p.y));
 		}
 	}
-	const int x0 = std::max(0, static_cast<int>(std::floor(minX)) - 1);
-	const int y0 = std::max(0, static_cast<int>(std::floor(minY)) - 1);
-	const int x1 = std::min(image.width - 1, static_cast<int>(std::ceil(maxX)) + 1);
-	const int y1 = std::min(image.height - 1, static_cast<int>(std::ceil(maxY)) + 1);
+	/* A quiet zone reaching the horizon maps to no finite box: then the
+	 * whole image. */
+	if (beyondHorizon || !std::isfinite(minX) || !std::isfinite(minY) || !std::isfinite(maxX) ||
+	    !std::isfinite(maxY)) {
+		minX = minY = 0.0;
+		maxX = image.width;
+		maxY = image.height;
+	}
+	const int x0 = clampedPixel(std::floor(minX) - 1.0, 0, image.width);
+	const int y0 = clampedPixel(std::floor(minY) - 1.0, 0, image.height);
+	const int x1 = clampedPixel(std::ceil(maxX) + 1.0, -1, image.width - 1);
+	const int y1 = clampedPixel(std::ceil(maxY) + 1.0, -1, image.height - 1);
 	const int ss = std::max(1, opt.supersample);
 	const double inv = 1.0 / ss;
 	for (int y = y0; y <= y1; ++y) {
@@ -108,6 +176,20 @@ std::array<Point2f, 4> perspectiveSquare(float cx, float cy, float side, float r
 std::vector<std::uint8_t> markerImage(const Dictionary &dict, int id, int cell_px, int quiet_cells,
 				      int &side)
 {
+	auto fail = [](const std::string &what) { throw std::invalid_argument("markerImage: " + what); };
+	if (cell_px < 1)
+		fail("cell_px must be at least 1, got " + std::to_string(cell_px));
+	if (quiet_cells < 0)
+		fail("quiet_cells must not be negative, got " + std::to_string(quiet_cells));
+	if (id < 0 || id >= dict.size())
+		throw std::out_of_range("markerImage: id " + std::to_string(id) + " not in " + std::string(dict.name) +
+					" (0.." + std::to_string(dict.size() - 1) + ")");
+	/* In 64 bits: the side, then its square, must not overflow. */
+	const long long wide = (static_cast<long long>(dict.bits) + 2 + 2LL * quiet_cells) * cell_px;
+	if (wide > kMaxMarkerImageSide)
+		fail("the image would be " + std::to_string(wide) + " pixels a side, more than " +
+		     std::to_string(kMaxMarkerImageSide) + " (cell_px " + std::to_string(cell_px) + ", quiet_cells " +
+		     std::to_string(quiet_cells) + ")");
 	const int cells = dict.bits + 2 + 2 * quiet_cells;
 	side = cells * cell_px;
 	std::vector<std::uint8_t> img(static_cast<std::size_t>(side) * side, 255);

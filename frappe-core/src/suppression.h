@@ -13,10 +13,14 @@ namespace frappe::detail {
  * that puts the one to keep first (the tracer's scan; then smallest first,
  * a marker's own outline before its quiet zone's), so the caller keeps the
  * earlier one unless it has a better reason (a lower Hamming distance).
- * What counts as a repeat is the caller's: quads that coincide corner for
- * corner (removeDuplicateQuads()), a marker read twice (keepMarker()), the
- * outline of a decoded marker's quiet zone (surroundsMarker()). Quadratic
- * in the items kept, a few dozen at most; allocates nothing. */
+ * What counts as a repeat is the caller's: a marker read twice
+ * (keepMarker()), the outline of a decoded marker's quiet zone
+ * (surroundsMarker(), which only passes it the markers filed near the
+ * candidate). Quadratic in the items passed: keepMarker() passes all the
+ * frame's markers, which Config::max_candidates bounds, and compares ids
+ * first. The traced quads, one per square of a tiled wall, are too many
+ * for that: removeDuplicateQuads() applies the same rule through a grid
+ * of their corners (point_grid.h). Allocates nothing. */
 template<typename Kept, typename Item, typename Same>
 Kept *firstRepeated(std::span<Kept> kept, const Item &item, Same same)
 {

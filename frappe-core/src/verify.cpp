@@ -7,6 +7,7 @@
 #include <optional>
 
 #include "frappe/homography.h"
+#include "quad_geometry.h"
 #include "sampling.h"
 
 namespace frappe::detail {
@@ -202,10 +203,21 @@ bool insideCodeArea(const std::array<Point2f, 4> &inner, const std::array<Point2
 	return toUnit && insideWith(*toUnit, inner, bits);
 }
 
-void dropNestedMarkers(std::vector<Marker> &markers, int bits)
+void dropNestedMarkers(std::vector<Marker> &markers, int bits, PointGrid &grid)
 {
 	if (markers.size() < 2)
 		return;
+	/* Each marker filed under its first corner, in cells as wide as the
+	 * markers' mean first side: a marker nested in another has all four
+	 * corners inside that one's outline, so its first corner in that
+	 * outline's box (padded: the test maps corners in floats). */
+	double sides = 0.0;
+	for (const Marker &m : markers)
+		sides += std::hypot(m.corners[1].x - m.corners[0].x, m.corners[1].y - m.corners[0].y);
+	const double mean = sides / static_cast<double>(markers.size());
+	grid.reset(markers.size(), std::isfinite(mean) ? static_cast<float>(std::max(mean, 4.0)) : 4.0f);
+	for (std::size_t i = 0; i < markers.size(); ++i)
+		grid.add(static_cast<int>(i), 0, markers[i].corners[0]);
 	/* Marks by id = -1 first: a marker inside one that is itself nested
 	 * still shows where the outer one's code is. */
 	std::size_t dropped = 0;
@@ -213,15 +225,32 @@ void dropNestedMarkers(std::vector<Marker> &markers, int bits)
 		const auto toUnit = unitSquareOf(outer.corners);
 		if (!toUnit)
 			continue;
-		for (Marker &m : markers) {
+		auto mark = [&](int i, int) {
+			Marker &m = markers[static_cast<std::size_t>(i)];
 			if (&m != &outer && m.id >= 0 && insideWith(*toUnit, m.corners, bits)) {
 				m.id = -1;
 				++dropped;
 			}
-		}
+			return false; /* every one */
+		};
+		/* Only a convex outline holds what maps into its unit square;
+		 * otherwise (never for a verified marker) every marker is tested. */
+		const QuadBox b = quadBox(outer.corners);
+		const float pad = 1.0f + 1e-3f * std::max(b.x1 - b.x0, b.y1 - b.y0);
+		if (convexQuad(outer.corners) && std::isfinite(pad))
+			grid.anyIn(b.x0 - pad, b.y0 - pad, b.x1 + pad, b.y1 + pad, mark);
+		else
+			for (std::size_t i = 0; i < markers.size(); ++i)
+				mark(static_cast<int>(i), 0);
 	}
 	if (dropped)
 		std::erase_if(markers, [](const Marker &m) { return m.id < 0; });
+}
+
+void dropNestedMarkers(std::vector<Marker> &markers, int bits)
+{
+	PointGrid grid;
+	dropNestedMarkers(markers, bits, grid);
 }
 
 MarkerRead readMarker(const ImageView &image, const std::array<Point2f, 4> &corners, const CodeBook &codes,

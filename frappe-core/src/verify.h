@@ -12,6 +12,7 @@
 #include "frappe/dictionary.h"
 #include "frappe/image.h"
 #include "frappe/marker.h"
+#include "point_grid.h"
 
 namespace frappe::detail {
 
@@ -101,7 +102,12 @@ bool insideCodeArea(const std::array<Point2f, 4> &inner, const std::array<Point2
 /// code cells that read as a marker. In place, without allocating. Not a
 /// repeat of the kind suppression.h drops (what it drops is no copy of
 /// the marker around it, and is known only once every candidate is read):
-/// it runs once on the frame's whole marker set.
+/// it runs once on the frame's whole marker set. A marker is tested only
+/// against those whose first corner lies in its box (`grid`, reused: a
+/// warm one allocates nothing), so a frame of thousands of markers costs
+/// in proportion to them.
+void dropNestedMarkers(std::vector<Marker> &markers, int bits, PointGrid &grid);
+/// The same with a grid of its own, which it allocates: for tests.
 void dropNestedMarkers(std::vector<Marker> &markers, int bits);
 
 /// What a detector corrects.

@@ -47,6 +47,9 @@ TEST(BadInput, OutOfRangeParameters)
 	c = Config{};
 	c.max_pixels = 0;
 	EXPECT_NE(errorOf([&] { Detector d(c); }).find("max_pixels"), std::string::npos);
+	c = Config{};
+	c.max_candidates = 0;
+	EXPECT_NE(errorOf([&] { Detector d(c); }).find("max_candidates must be in [1, 2^20], got 0"), std::string::npos);
 }
 
 /* A frame beyond max_pixels is refused before any buffer grows to it (no

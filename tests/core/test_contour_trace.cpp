@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: MIT
 // Suzuki border following and candidate selection on hand-made edge maps.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <random>
@@ -597,4 +598,105 @@ TEST(ContourTrace, BothWalksGiveTheSameQuads)
 			EXPECT_EQ(qa[k].corners[i].x, qb[k].corners[i].x);
 			EXPECT_EQ(qa[k].corners[i].y, qb[k].corners[i].y);
 		}
+}
+
+namespace {
+
+/* The rule removeDuplicateQuads() keeps, as it was first written: each quad
+ * compared with every kept one. */
+std::vector<Quad> duplicatesRemovedPairwise(std::vector<Quad> quads, float tolerance)
+{
+	std::vector<Quad> kept;
+	for (const Quad &q : quads) {
+		bool repeat = false;
+		for (const Quad &k : kept)
+			for (int shift = 0; shift < 4 && !repeat; ++shift) {
+				bool all = true;
+				for (int c = 0; c < 4 && all; ++c) {
+					const float dx = q.corners[c].x - k.corners[(c + shift) & 3].x;
+					const float dy = q.corners[c].y - k.corners[(c + shift) & 3].y;
+					all = dx * dx + dy * dy <= tolerance * tolerance;
+				}
+				repeat = all;
+			}
+		if (!repeat)
+			kept.push_back(q);
+	}
+	return kept;
+}
+
+} // namespace
+
+/* Quads around a few hundred places, each repeated with its corners moved
+ * by up to 1.5 px each way (mostly repeats, some not), its start turned,
+ * or its corners out of order: the grid keeps exactly the quads, in the
+ * order, that comparing with every kept quad keeps. */
+TEST(RemoveDuplicateQuads, KeepsWhatComparingEveryPairKeeps)
+{
+	std::mt19937 rng(16);
+	std::uniform_real_distribution<float> place(-50.0f, 2000.0f), side(8.0f, 60.0f), jitter(-1.5f, 1.5f);
+	std::uniform_int_distribution<int> turn(0, 3), copies(1, 6);
+	std::vector<Quad> quads;
+	for (int p = 0; p < 300; ++p) {
+		const float x = place(rng), y = place(rng), s = side(rng);
+		const std::array<Point2f, 4> base{ Point2f{ x, y }, { x + s, y }, { x + s, y + s }, { x, y + s } };
+		for (int c = copies(rng); c > 0; --c) {
+			Quad q;
+			const int t = turn(rng);
+			for (int k = 0; k < 4; ++k)
+				q.corners[k] = { base[(k + t) & 3].x + jitter(rng), base[(k + t) & 3].y + jitter(rng) };
+			if (c == 2)
+				std::swap(q.corners[1], q.corners[3]); /* the other way round: not a repeat */
+			q.probeRead = static_cast<int>(quads.size()); /* which one it was */
+			quads.push_back(q);
+		}
+	}
+	std::shuffle(quads.begin(), quads.end(), rng);
+	/* A corner exactly at the tolerance is a repeat; just beyond, not. */
+	Quad edge = quads[0], beyond = quads[0];
+	edge.corners[2].x += 2.5f;
+	beyond.corners[2].x += 2.5f + 1e-3f;
+	edge.probeRead = -2;
+	beyond.probeRead = -3;
+	quads.push_back(edge);
+	quads.push_back(beyond);
+
+	const std::vector<Quad> expected = duplicatesRemovedPairwise(quads, 2.5f);
+	PointGrid grid;
+	for (int frame = 0; frame < 2; ++frame) { /* a reused grid gives the same */
+		std::vector<Quad> got = quads;
+		removeDuplicateQuads(got, 2.5f, grid);
+		ASSERT_EQ(got.size(), expected.size());
+		for (std::size_t i = 0; i < got.size(); ++i)
+			EXPECT_EQ(got[i].probeRead, expected[i].probeRead) << "kept quad " << i;
+	}
+	EXPECT_LT(expected.size(), quads.size() * 2 / 3); /* many were repeats */
+	EXPECT_GT(expected.size(), 300u);		   /* and some not */
+	EXPECT_TRUE(std::none_of(expected.begin(), expected.end(), [](const Quad &q) { return q.probeRead == -2; }));
+	EXPECT_TRUE(std::any_of(expected.begin(), expected.end(), [](const Quad &q) { return q.probeRead == -3; }));
+}
+
+/* Over the cap: the probe's markers first, then the others from the front,
+ * each kept in its place; the count of the dropped returned. */
+TEST(CapCandidates, KeepsTheProbesMarkersThenTheFirst)
+{
+	std::vector<Quad> quads(10);
+	for (int i = 0; i < 10; ++i) {
+		quads[i].probeRead = i;
+		quads[i].probeDecoded = i == 7 || i == 9;
+	}
+	std::vector<Quad> under = quads;
+	EXPECT_EQ(capCandidates(under, 10), 0);
+	EXPECT_EQ(under.size(), 10u);
+
+	EXPECT_EQ(capCandidates(quads, 5), 5);
+	std::vector<int> kept;
+	for (const Quad &q : quads)
+		kept.push_back(q.probeRead);
+	EXPECT_EQ(kept, (std::vector<int>{ 0, 1, 2, 7, 9 }));
+
+	std::vector<Quad> one = quads;
+	EXPECT_EQ(capCandidates(one, 1), 4);
+	ASSERT_EQ(one.size(), 1u);
+	EXPECT_EQ(one[0].probeRead, 7);
 }

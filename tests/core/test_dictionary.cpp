@@ -4,6 +4,8 @@
 #include <bit>
 #include <random>
 #include <set>
+#include <stdexcept>
+#include <string>
 
 #include <gtest/gtest.h>
 
@@ -68,6 +70,25 @@ TEST(Dictionary, RotateCodeTurnsTheGridClockwise)
 			ASSERT_EQ(c, d.codes[id]) << d.name << " id " << id;
 		}
 	}
+}
+
+/* n^2 cells must fit 64 bits: n above 8, or below 1, is refused with the
+ * argument named, not shifted out of range. */
+TEST(Dictionary, RotateCodeRefusesGridsBeyondSixtyFourBits)
+{
+	for (int bits : { 0, -1, 9, 64 }) {
+		try {
+			rotateCode(1, bits);
+			ADD_FAILURE() << "bits " << bits << " accepted";
+		} catch (const std::invalid_argument &e) {
+			EXPECT_NE(std::string(e.what()).find("bits must be in [1, 8]"), std::string::npos) << e.what();
+			EXPECT_NE(std::string(e.what()).find("got " + std::to_string(bits)), std::string::npos) << e.what();
+		}
+	}
+	/* 8 x 8 uses every bit: the top-left cell (bit 63) turns to the
+	 * top-right (bit 56). */
+	EXPECT_EQ(rotateCode(1ull << 63, 8), 1ull << 56);
+	EXPECT_EQ(rotateCode(1, 1), 1u);
 }
 
 namespace {

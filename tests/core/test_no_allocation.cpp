@@ -86,6 +86,25 @@ TEST_P(NoAllocation, SecondFrameOfTheSameSizeAllocatesNothing)
 	EXPECT_EQ(after - before, 0) << "detect() allocated on a frame of a size it had seen";
 }
 
+/* A tiled wall, a candidate per tile, some beyond max_candidates: the
+ * duplicate removal's grid and the cap reuse what the first frame grew. */
+TEST_P(NoAllocation, FrameFullOfSquaresAllocatesNothingOnceWarm)
+{
+	Image wall(640, 480, 230);
+	squareGrid(wall, 12, 20);
+	renderMarker(wall.mut(), *findDictionary("aruco_mip_36h12"), 5, squarePose(320.0f, 240.0f, 110.0f, 0.0f, 0.0f));
+	Config config;
+	config.threads = GetParam();
+	config.max_candidates = 300;
+	Detector det(config);
+	det.detect(wall.view());
+	const long before = gAllocations.load();
+	const Result &r = det.detect(wall.view());
+	const long after = gAllocations.load();
+	EXPECT_GT(r.candidates_dropped, 0);
+	EXPECT_EQ(after - before, 0) << "detect() allocated on a frame of a size it had seen";
+}
+
 INSTANTIATE_TEST_SUITE_P(Threads, NoAllocation, ::testing::Values(1, 2, 4));
 
 /* Whole frames on several threads: which detector runs a frame depends on

@@ -2,7 +2,11 @@
 // Markers of every dictionary rendered under known homographies, blur and
 // noise: the detector must find each with the right id and corners within
 // 0.3 px of the truth, in the canonical corner order.
+#include <algorithm>
 #include <cstdio>
+#include <limits>
+#include <stdexcept>
+#include <string>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -303,4 +307,153 @@ TEST(RenderedMarkers, MarkerInsideANearCodewordPanelIsFound)
 	const Marker *m = findMarker(res.markers, 7);
 	ASSERT_NE(m, nullptr) << "the marker inside the panel";
 	EXPECT_LT(meanCornerError(m->corners, small), 0.3f);
+}
+
+/* A tiled wall (a candidate per tile) around two markers: over
+ * max_candidates the tiles beyond it are dropped and counted, and the
+ * markers, which the trace's quick read already decoded, are kept. Under
+ * it, nothing is dropped. */
+TEST(RenderedMarkers, CandidateCapKeepsTheMarkersAndCountsTheRest)
+{
+	const Dictionary &dict = *findDictionary("aruco_mip_36h12");
+	Image img(640, 480, 230);
+	squareGrid(img, 12, 20);
+	for (int y = 150; y < 330; ++y)
+		for (int x = 60; x < 580; ++x)
+			img.at(x, y) = 230;
+	renderMarker(img.mut(), dict, 3, squarePose(180.0f, 240.0f, 120.0f, 5.0f, 0.0f));
+	renderMarker(img.mut(), dict, 4, squarePose(460.0f, 240.0f, 120.0f, -5.0f, 0.0f));
+
+	Detector all{ Config{} };
+	const Result &r = all.detect(img.view());
+	EXPECT_EQ(r.candidates_dropped, 0);
+	EXPECT_EQ(r.markers.size(), 2u);
+	EXPECT_GT(r.candidates, 400); /* the tiles were candidates */
+
+	Config capped;
+	capped.max_candidates = 50;
+	Detector few(capped);
+	const Result &c = few.detect(img.view());
+	/* Dropped: every traced quad beyond 50, at least those that reached
+	 * decoding without a cap. */
+	EXPECT_GE(c.candidates_dropped, r.candidates - 50);
+	EXPECT_LE(c.candidates, 50);
+	ASSERT_EQ(c.markers.size(), 2u);
+	EXPECT_NE(findMarker(c.markers, 3), nullptr);
+	EXPECT_NE(findMarker(c.markers, 4), nullptr);
+}
+
+namespace {
+
+/* The message of the exception of type E that f throws; fails the test
+ * when it throws none or another. */
+template<typename E, typename F>
+std::string messageOf(F f)
+{
+	try {
+		f();
+	} catch (const E &e) {
+		return e.what();
+	} catch (const std::exception &e) {
+		ADD_FAILURE() << "other exception: " << e.what();
+		return {};
+	}
+	ADD_FAILURE() << "no exception";
+	return {};
+}
+
+bool has(const std::string &message, const std::string &part)
+{
+	return message.find(part) != std::string::npos;
+}
+
+} // namespace
+
+/* Corners no perspective maps a square onto are refused, naming them, and
+ * the image is left as it was. */
+TEST(RenderArguments, DegenerateCornersAreRefused)
+{
+	const Dictionary &dict = *findDictionary("aruco_mip_36h12");
+	Image img(64, 64, 128);
+	auto render = [&](std::array<Point2f, 4> c) { return [&, c] { renderMarker(img.mut(), dict, 0, c); }; };
+	const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+	using Corners = std::array<Point2f, 4>;
+	EXPECT_TRUE(has(messageOf<std::invalid_argument>(render(Corners{ Point2f{ 10, 10 }, { 50, 10 }, { 50, nan }, { 10, 50 } })),
+			"corner 2 is not a finite point"));
+	EXPECT_TRUE(has(messageOf<std::invalid_argument>(render(Corners{ Point2f{ inf, 10 }, { 50, 10 }, { 50, 50 }, { 10, 50 } })),
+			"corner 0 is not a finite point"));
+	/* Three collinear corners, two coincident, all four at one point. */
+	EXPECT_TRUE(has(messageOf<std::invalid_argument>(render(Corners{ Point2f{ 10, 10 }, { 30, 10 }, { 50, 10 }, { 10, 50 } })),
+			"collinear or coincide"));
+	EXPECT_TRUE(has(messageOf<std::invalid_argument>(render(Corners{ Point2f{ 10, 10 }, { 10, 10 }, { 50, 50 }, { 10, 50 } })),
+			"collinear or coincide"));
+	EXPECT_TRUE(has(messageOf<std::invalid_argument>(render(Corners{ Point2f{ 5, 5 }, { 5, 5 }, { 5, 5 }, { 5, 5 } })),
+			"collinear or coincide"));
+	/* A crossed outline (a bow tie). */
+	EXPECT_TRUE(has(messageOf<std::invalid_argument>(render(Corners{ Point2f{ 10, 10 }, { 50, 50 }, { 50, 10 }, { 10, 50 } })),
+			"not make a convex quadrilateral"));
+	EXPECT_TRUE(std::all_of(img.pixels.begin(), img.pixels.end(), [](std::uint8_t v) { return v == 128; }));
+	/* A mirrored view (corners anticlockwise) is a perspective still. */
+	renderMarker(img.mut(), dict, 0, Corners{ Point2f{ 10, 10 }, { 10, 50 }, { 50, 50 }, { 50, 10 } });
+	EXPECT_EQ(img.at(12, 30), 0);
+}
+
+TEST(RenderArguments, BadImagesIdsAndOptionsAreRefused)
+{
+	const Dictionary &dict = *findDictionary("aruco_mip_36h12");
+	Image img(64, 64, 128);
+	const std::array<Point2f, 4> c{ Point2f{ 10, 10 }, { 50, 10 }, { 50, 50 }, { 10, 50 } };
+	EXPECT_TRUE(has(messageOf<std::out_of_range>([&] { renderMarker(img.mut(), dict, dict.size(), c); }),
+			"id " + std::to_string(dict.size()) + " not in aruco_mip_36h12"));
+	EXPECT_TRUE(has(messageOf<std::out_of_range>([&] { renderMarker(img.mut(), dict, -1, c); }), "id -1"));
+	MutableImageView view = img.mut();
+	view.width = -4;
+	EXPECT_TRUE(has(messageOf<std::invalid_argument>([&] { renderMarker(view, dict, 0, c); }), "must not be negative"));
+	view = img.mut();
+	view.data = nullptr;
+	EXPECT_TRUE(has(messageOf<std::invalid_argument>([&] { renderMarker(view, dict, 0, c); }), "data is null"));
+	view = img.mut();
+	view.stride = 32;
+	EXPECT_TRUE(has(messageOf<std::invalid_argument>([&] { renderMarker(view, dict, 0, c); }),
+			"stride (32) is smaller than its width (64)"));
+	RenderOptions opt;
+	opt.supersample = 100000; /* 10^10 samples a pixel would overflow */
+	EXPECT_TRUE(has(messageOf<std::invalid_argument>([&] { renderMarker(img.mut(), dict, 0, c, opt); }),
+			"supersample must be at most 256, got 100000"));
+	/* An empty image: nothing to draw, nothing refused. */
+	EXPECT_NO_THROW(renderMarker(MutableImageView{}, dict, 0, c));
+}
+
+/* A quiet zone reaching past the horizon (around a strongly foreshortened
+ * square) has no bounding box from its corners: the marker is drawn all
+ * the same, and no infinite box is cast to int. */
+TEST(RenderArguments, QuietZoneBeyondTheHorizonStaysInTheImage)
+{
+	const Dictionary &dict = *findDictionary("aruco_mip_36h12");
+	Image img(64, 64, 128);
+	RenderOptions opt;
+	opt.quiet_cells = 40;
+	opt.supersample = 1;
+	EXPECT_NO_THROW(renderMarker(img.mut(), dict, 0,
+				     { Point2f{ 20, 20 }, { 44, 20 }, { 60, 40 }, { 4, 40 } }, opt));
+	EXPECT_EQ(img.at(21, 21), 0);	/* the border, by its first corner */
+	EXPECT_NE(img.at(32, 30), 128); /* the code */
+}
+
+TEST(RenderArguments, MarkerImageRefusesBadSizesAndIds)
+{
+	const Dictionary &dict = *findDictionary("aruco_mip_36h12");
+	int side = -1;
+	EXPECT_TRUE(has(messageOf<std::invalid_argument>([&] { markerImage(dict, 0, 0, 1, side); }),
+			"cell_px must be at least 1, got 0"));
+	EXPECT_TRUE(has(messageOf<std::invalid_argument>([&] { markerImage(dict, 0, -3, 1, side); }), "got -3"));
+	EXPECT_TRUE(has(messageOf<std::invalid_argument>([&] { markerImage(dict, 0, 4, -5, side); }),
+			"quiet_cells must not be negative, got -5"));
+	EXPECT_TRUE(has(messageOf<std::invalid_argument>([&] { markerImage(dict, 0, 1 << 28, 1, side); }),
+			"more than 32768"));
+	EXPECT_TRUE(has(messageOf<std::out_of_range>([&] { markerImage(dict, dict.size(), 4, 1, side); }), "not in"));
+	EXPECT_EQ(side, -1); /* untouched by a refused call */
+	const std::vector<std::uint8_t> px = markerImage(dict, 0, 4, 1, side);
+	EXPECT_EQ(side, (dict.bits + 4) * 4);
+	EXPECT_EQ(px.size(), static_cast<std::size_t>(side) * side);
 }

@@ -13,6 +13,7 @@
 #include "frappe/frappe.h"
 #include "frappe/render.h"
 #include "scene.h"
+#include "marker_set.h"
 #include "verify.h"
 
 using namespace frappe;
@@ -346,6 +347,92 @@ TEST(Nesting, DropsMarkersInsideOthers)
 	ASSERT_EQ(found.size(), 2u);
 	EXPECT_EQ(found[0].id, 3);
 	EXPECT_EQ(found[1].id, 9);
+}
+
+/* Hundreds of markers of all sizes, many nested in others (some two deep),
+ * some tilted: the grid drops exactly the markers, and keeps the rest in
+ * their order, that testing every pair does. */
+TEST(Nesting, GridDropsWhatTestingEveryPairDrops)
+{
+	std::mt19937 rng(16);
+	std::uniform_real_distribution<float> place(0.0f, 3000.0f), side(10.0f, 300.0f), frac(0.0f, 1.0f);
+	std::vector<Marker> found;
+	for (int i = 0; i < 600; ++i) {
+		Marker m;
+		m.id = i;
+		if (!found.empty() && frac(rng) < 0.4f) {
+			/* Within (or straddling) an earlier one. */
+			const Marker &o = found[static_cast<std::size_t>(rng() % found.size())];
+			const float os = o.corners[1].x - o.corners[0].x, s = os * (0.1f + 0.5f * frac(rng));
+			m.corners = square(o.corners[0].x + (os - s) * frac(rng), o.corners[0].y + (os - s) * frac(rng), s);
+		} else {
+			m.corners = test::squarePose(place(rng), place(rng), side(rng), 90.0f * frac(rng), 0.0f);
+		}
+		found.push_back(m);
+	}
+	std::vector<int> expected;
+	for (const Marker &m : found) {
+		bool nested = false;
+		for (const Marker &outer : found)
+			nested = nested || (&outer != &m && detail::insideCodeArea(m.corners, outer.corners, 6));
+		if (!nested)
+			expected.push_back(m.id);
+	}
+	detail::PointGrid grid;
+	for (int frame = 0; frame < 2; ++frame) {
+		std::vector<Marker> got = found;
+		detail::dropNestedMarkers(got, 6, grid);
+		std::vector<int> ids;
+		for (const Marker &m : got)
+			ids.push_back(m.id);
+		EXPECT_EQ(ids, expected);
+	}
+	EXPECT_LT(expected.size(), 550u); /* many were nested */
+}
+
+/* Candidates around markers of all sizes: looking only at the markers
+ * whose centre is filed near a candidate's finds the quiet-zone outlines
+ * that testing every marker finds, and no others. */
+TEST(Nesting, SurroundsMarkerThroughTheGridAsThroughAll)
+{
+	std::mt19937 rng(17);
+	std::uniform_real_distribution<float> place(0.0f, 2000.0f), side(10.0f, 200.0f), frac(0.0f, 1.0f);
+	std::vector<Marker> found(300);
+	detail::PointGrid centres;
+	centres.reset(found.size(), 32.0f);
+	for (std::size_t i = 0; i < found.size(); ++i) {
+		found[i].id = static_cast<int>(i);
+		found[i].corners = square(place(rng), place(rng), side(rng));
+		centres.add(static_cast<int>(i), 0, detail::quadCentre(found[i].corners));
+	}
+	const detail::PointGrid none = [] {
+		detail::PointGrid g;
+		g.reset(0, 32.0f);
+		return g;
+	}();
+	int surrounding = 0;
+	for (int k = 0; k < 2000; ++k) {
+		const Marker &m = found[rng() % found.size()];
+		const float ms = m.corners[1].x - m.corners[0].x, grow = ms * (2.0f * frac(rng) - 0.3f);
+		const float shift = ms * (0.6f * frac(rng) - 0.3f);
+		const Quad q = square(m.corners[0].x - grow / 2 + shift, m.corners[0].y - grow / 2, ms + grow);
+		/* The rule, on every marker: about its size, centred on it. */
+		const float area = detail::quadArea(q);
+		const Point2f c = detail::quadCentre(q);
+		bool all = false;
+		for (const Marker &f : found) {
+			const float am = detail::quadArea(f.corners);
+			const Point2f cm = detail::quadCentre(f.corners);
+			const float dx = c.x - cm.x, dy = c.y - cm.y;
+			all = all || (area <= 3.0f * am && am <= 3.0f * area && dx * dx + dy * dy < 0.12f * am);
+		}
+		const bool grid = detail::surroundsMarker(q, detail::quadArea(q), -1, 6, found, centres);
+		EXPECT_EQ(grid, all) << "candidate " << k;
+		EXPECT_FALSE(detail::surroundsMarker(q, detail::quadArea(q), -1, 6, found, none));
+		surrounding += grid;
+	}
+	EXPECT_GT(surrounding, 200); /* both answers were asked */
+	EXPECT_LT(surrounding, 1800);
 }
 
 /* ---- all of it, on one candidate ---- */

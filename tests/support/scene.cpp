@@ -74,6 +74,14 @@ void addNoise(Image &img, float sigma, std::mt19937 &rng)
 			img.at(x, y) = static_cast<std::uint8_t>(std::clamp(std::lround(img.at(x, y) + n(rng)), 0L, 255L));
 }
 
+void squareGrid(Image &img, int square, int pitch, std::uint8_t dark)
+{
+	for (int y = 0; y < img.height; ++y)
+		for (int x = 0; x < img.width; ++x)
+			if (x % pitch < square && y % pitch < square)
+				img.at(x, y) = dark;
+}
+
 float meanCornerError(const std::array<Point2f, 4> &a, const std::array<Point2f, 4> &b)
 {
 	float e = 0;

@@ -42,6 +42,10 @@ void motionBlur(Image &img, float length, float angle);
 /// Adds Gaussian noise of standard deviation `sigma` grey levels.
 void addNoise(Image &img, float sigma, std::mt19937 &rng);
 
+/// Dark squares (`dark`) of `square` px, one every `pitch` px both ways, on
+/// the whole image: a tiled wall, a candidate per square.
+void squareGrid(Image &img, int square, int pitch, std::uint8_t dark = 25);
+
 /// Mean distance between corresponding corners.
 float meanCornerError(const std::array<Point2f, 4> &a, const std::array<Point2f, 4> &b);
 

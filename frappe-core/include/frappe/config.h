@@ -93,6 +93,17 @@ struct Config {
 	/// 2^30].
 	long long max_pixels = 1LL << 26;
 
+	/// The most candidate outlines one frame reads (refines, warps,
+	/// decodes); the rest are dropped and counted in
+	/// Result::candidates_dropped. A bound on the back end's time whatever
+	/// the frame shows: a frame full of small squares (a tiled wall, a dot
+	/// grid, a perforated sheet) has one candidate per square, tens of
+	/// thousands at 4K, where a frame of markers has a few dozen. Those
+	/// the trace's quick read found to be markers are kept first, then the
+	/// smallest. Lower bounds a frame's time tighter, at the risk of
+	/// missing markers among such clutter. Range [1, 2^20].
+	int max_candidates = 4096;
+
 	/// Threads; 1 = strictly single-threaded, 0 = one per hardware core. A
 	/// Pipeline (Mode::Frames) runs this many whole frames at once, one per
 	/// thread: what pays on a stream (1.8x with two threads, for a frame of

@@ -52,6 +52,12 @@ struct Result {
 	StageTimes times;
 	float scale = 1.0f;     ///< resolution the frame was traced at
 	int candidates = 0;     ///< quadrilaterals that reached decoding
+	/// Candidate outlines the trace found beyond Config::max_candidates and
+	/// left unread (the largest of those its quick read did not find to be
+	/// markers): 0 unless the frame is full of squares (a tiled wall, a dot
+	/// grid). Markers among them are missed; a caller may report it as a
+	/// warning.
+	int candidates_dropped = 0;
 };
 
 /// Finds markers of one dictionary in 8-bit luma images.

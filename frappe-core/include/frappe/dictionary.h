@@ -58,7 +58,9 @@ FRAPPE_EXPORT const Dictionary *findDictionary(std::string_view name);
 FRAPPE_EXPORT std::string dictionaryNames(std::string_view separator = ", ");
 
 /// Rotates an n x n code by 90 degrees clockwise (as the marker would look
-/// after turning it a quarter turn clockwise).
+/// after turning it a quarter turn clockwise). `bits` is n: throws
+/// std::invalid_argument unless it is 1..8 (n^2 cells in 64 bits); bits of
+/// `code` above the n^2 cells are ignored.
 FRAPPE_EXPORT std::uint64_t rotateCode(std::uint64_t code, int bits);
 
 } // namespace frappe

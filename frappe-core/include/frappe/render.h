@@ -24,8 +24,8 @@ struct MutableImageView {
 };
 
 struct RenderOptions {
-	int quiet_cells = 1;      ///< white margin around the black border, in cells
-	int supersample = 4;      ///< samples per pixel side (anti-aliasing)
+	int quiet_cells = 1;      ///< white margin around the black border, in cells; below 0 counts as 0
+	int supersample = 4;      ///< samples per pixel side (anti-aliasing); below 1 counts as 1, at most 256
 	std::uint8_t black = 0;
 	std::uint8_t white = 255;
 };
@@ -34,7 +34,12 @@ struct RenderOptions {
 /// `corners` (top-left, top-right, bottom-right, bottom-left in the marker's
 /// canonical orientation; pixel centres at integers), through the
 /// homography those corners define. Pixels are area-averaged, so edges fall
-/// at their exact sub-pixel place. Throws std::out_of_range for a bad id.
+/// at their exact sub-pixel place. Throws std::out_of_range for an id not
+/// in `dict`, and std::invalid_argument (the message says which argument
+/// and why) for corners that are no perspective view of a square
+/// (non-finite, three of them collinear or coincident, or not a convex
+/// quadrilateral), an image of negative size, null data or a stride
+/// smaller than its width, or a supersample above 256.
 FRAPPE_EXPORT void renderMarker(MutableImageView image, const Dictionary &dict, int id,
 		  const std::array<Point2f, 4> &corners, const RenderOptions &options = {});
 
@@ -47,7 +52,9 @@ FRAPPE_EXPORT std::array<Point2f, 4> perspectiveSquare(float cx, float cy, float
 					 float distance = 4.0f);
 
 /// An upright marker image, `cell_px` pixels a cell, with its quiet zone:
-/// side = (bits + 2 + 2 * quiet_cells) * cell_px.
+/// side = (bits + 2 + 2 * quiet_cells) * cell_px. Throws
+/// std::out_of_range for an id not in `dict`, and std::invalid_argument
+/// for a cell_px under 1, a negative quiet_cells, or a side beyond 32768.
 FRAPPE_EXPORT std::vector<std::uint8_t> markerImage(const Dictionary &dict, int id, int cell_px,
 				      int quiet_cells, int &side);
 
