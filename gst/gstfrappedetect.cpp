@@ -150,7 +150,7 @@ struct FrappeDetectPrivate {
 	std::vector<MappedFrame> held;   /* in the pipeline, oldest first */
 	std::vector<GstBuffer *> output; /* finished, waiting for generate_output */
 	frappe::gst::BufferLog bufferLog;
-	bool warnedFallback = false;
+	bool warnedFallback = false, warnedDropped = false;
 	guint64 frames = 0;
 	frappe::gst::StatsWindow window;
 };
@@ -237,6 +237,7 @@ static void update_stats(GstFrappeDetect *self, const frappe::Result &result, do
 						      priv->active.pipelined);
 
 	GST_LOG_OBJECT(self, "stats %" GST_PTR_FORMAT, static_cast<void *>(s));
+	frappe::gst::reportDroppedCandidates(GST_ELEMENT(self), priv->frames, result, priv->warnedDropped);
 
 	if (const auto line = priv->window.add(priv->frames, result, poseMs))
 		GST_INFO_OBJECT(self, "last 100 frames, ms per frame: %s%s", line->c_str(),
@@ -582,6 +583,7 @@ static gboolean gst_frappe_detect_start(GstBaseTransform *trans)
 	self->priv->frames = 0;
 	self->priv->window.reset();
 	self->priv->bufferLog.reset();
+	self->priv->warnedDropped = false;
 	return TRUE;
 }
 

@@ -9,10 +9,14 @@
 #include <cstddef>
 #include <cstdio>
 #include <string>
+#include <utility>
 
 #include <gst/video/video.h>
 
 #include "gstfrappemeta.h"
+
+GST_DEBUG_CATEGORY_EXTERN(gst_frappe_detect_debug);
+#define GST_CAT_DEFAULT gst_frappe_detect_debug
 
 namespace frappe::gst {
 
@@ -128,12 +132,27 @@ GstStructure *frameMessage(GstBuffer *buffer, const GstSegment &segment, const R
 	return msg;
 }
 
+void reportDroppedCandidates(GstElement *element, guint64 frame, const Result &result, bool &warned)
+{
+	if (result.candidates_dropped == 0)
+		return;
+	GST_DEBUG_OBJECT(element, "frame %" G_GUINT64_FORMAT ": %d candidates over the cap not read", frame,
+			 result.candidates_dropped);
+	if (std::exchange(warned, true))
+		return;
+	GST_ELEMENT_WARNING(element, STREAM, FAILED, ("Too many marker candidates in a frame; some were not read"),
+			    ("frame %" G_GUINT64_FORMAT ": %d candidates beyond the %d read (a frame full of "
+			     "squares?); markers among them are missed. Later frames: the stats property",
+			     frame, result.candidates_dropped, result.candidates));
+}
+
 GstStructure *statsStructure(guint64 frames, const Result &result, double poseMs, const char *backend,
 			     bool pipelined)
 {
 	GstStructure *s = gst_structure_new("frappe-stats", "frames", G_TYPE_UINT64, frames, "markers",
 					    G_TYPE_UINT, static_cast<guint>(result.markers.size()), "candidates",
-					    G_TYPE_INT, result.candidates, "scale", G_TYPE_DOUBLE,
+					    G_TYPE_INT, result.candidates, "candidates-dropped", G_TYPE_INT,
+					    result.candidates_dropped, "scale", G_TYPE_DOUBLE,
 					    static_cast<double>(result.scale), nullptr);
 	for (int i = 0; i < kStageCount; ++i) {
 		std::string name(stageName(static_cast<Stage>(i)));

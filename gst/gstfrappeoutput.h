@@ -34,6 +34,12 @@ GstStructure *frameMessage(GstBuffer *buffer, const GstSegment &segment, const R
 GstStructure *statsStructure(guint64 frames, const Result &result, double poseMs, const char *backend,
 			     bool pipelined);
 
+/* A frame full of squares (a tiled wall, a dot grid) had more candidates
+ * than frappe::Config::max_candidates, and markers among those dropped may
+ * be missed: a GST_ELEMENT_WARNING the first time in a stream (`warned`),
+ * a debug line on every such frame. */
+void reportDroppedCandidates(GstElement *element, guint64 frame, const Result &result, bool &warned);
+
 /* Sums of the stage times over 100 frames, for one INFO line per 100
  * frames: GST_DEBUG=frappedetect:4 shows the speed without any tooling. */
 class StatsWindow

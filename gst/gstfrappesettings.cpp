@@ -196,7 +196,8 @@ void installProperties(GObjectClass *gobject_class)
 	g_object_class_install_property(
 		gobject_class, PROP_STATS,
 		g_param_spec_boxed("stats", "Statistics",
-				   "Per-stage timings (ms) and counts of the last frame", GST_TYPE_STRUCTURE,
+				   "Per-stage timings (ms) and counts of the last frame (candidates read, "
+				   "candidates-dropped over the cap)", GST_TYPE_STRUCTURE,
 				   static_cast<GParamFlags>(G_PARAM_READABLE | G_PARAM_STATIC_STRINGS)));
 }
 

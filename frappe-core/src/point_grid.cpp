@@ -2,7 +2,6 @@
 #include "point_grid.h"
 
 #include <algorithm>
-#include <cmath>
 #include <cstdint>
 
 namespace frappe::detail {
@@ -25,11 +24,16 @@ void PointGrid::reset(std::size_t points, float cell)
 int PointGrid::cellOf(float v) const
 {
 	/* Clamped, which keeps the order (NaN to 0): cells beyond only share
-	 * slots, which costs comparisons, never a missed point. */
-	const float c = std::floor(v * invCell_);
-	if (c != c)
-		return 0;
-	return static_cast<int>(std::clamp(c, -1e9f, 1e9f));
+	 * slots, which costs comparisons, never a missed point. The floor by
+	 * hand: std::floor is a library call on the Pi Zero's ARMv6, a
+	 * conversion to int one instruction. */
+	const float c = v * invCell_;
+	if (!(c > -1e9f))
+		return c != c ? 0 : -1000000000;
+	if (c > 1e9f)
+		return 1000000000;
+	const int i = static_cast<int>(c); /* towards zero */
+	return c < static_cast<float>(i) ? i - 1 : i;
 }
 
 std::size_t PointGrid::slot(int x, int y) const

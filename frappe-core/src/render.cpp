@@ -32,9 +32,16 @@ int cellValue(const Dictionary &dict, std::uint64_t code, int cx, int cy, int qu
 	return static_cast<int>((code >> bit) & 1u);
 }
 
+/* Appended piece by piece: GCC 12 warns falsely (-Wrestrict, its bug
+ * 105329) on "(" + std::string. */
 std::string pointText(Point2f p)
 {
-	return "(" + std::to_string(p.x) + ", " + std::to_string(p.y) + ")";
+	std::string s = "(";
+	s += std::to_string(p.x);
+	s += ", ";
+	s += std::to_string(p.y);
+	s += ")";
+	return s;
 }
 
 /* The arguments renderMarker() cannot draw from, refused before any of them

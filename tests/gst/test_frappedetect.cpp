@@ -16,6 +16,8 @@
 #include <gst/video/video.h>
 #include <gtest/gtest.h>
 
+#include <frappe/config.h>
+
 #include "gstfrappemeta.h"
 #include "helpers.h"
 
@@ -501,4 +503,51 @@ TEST(Memory, DmabufIsNotCopied)
 	gst_harness_teardown(h);
 	gst_buffer_unref(frame);
 	gst_object_unref(alloc);
+}
+
+/* A frame full of squares (a tiled wall) has more candidates than
+ * Config::max_candidates reads: one element warning for the stream, the
+ * count in the stats on every such frame, and the buffer still out. */
+TEST(Stats, DroppedCandidatesAreReported)
+{
+	const FrameSpec spec{ GST_VIDEO_FORMAT_GRAY8, 1600, 1600, 0, 230 };
+	GstHarness *h = newHarness("frappedetect", spec);
+	GstBus *bus = gst_bus_new();
+	gst_element_set_bus(h->element, bus);
+	auto tiledWall = [&](GstClockTime pts) {
+		GstBuffer *buf = makeFrame(spec, {}, dict("aruco_mip_36h12"), pts);
+		GstMapInfo map;
+		EXPECT_TRUE(gst_buffer_map(buf, &map, GST_MAP_WRITE));
+		/* 12 px dark squares on a 20 px pitch: 6400 candidates. */
+		for (int y = 0; y < spec.height; ++y)
+			for (int x = 0; x < spec.width; ++x)
+				if (x % 20 >= 4 && x % 20 < 16 && y % 20 >= 4 && y % 20 < 16)
+					map.data[static_cast<std::size_t>(y) * spec.width + x] = 20;
+		gst_buffer_unmap(buf, &map);
+		return buf;
+	};
+	for (int i = 0; i < 2; ++i) {
+		GstBuffer *out = gst_harness_push_and_pull(h, tiledWall(static_cast<GstClockTime>(i) * GST_SECOND / 30));
+		ASSERT_NE(out, nullptr) << "frame " << i;
+		gst_buffer_unref(out);
+		GstStructure *stats = nullptr;
+		g_object_get(detector(h), "stats", &stats, nullptr);
+		ASSERT_NE(stats, nullptr);
+		gint dropped = 0, read = 0;
+		EXPECT_TRUE(gst_structure_get_int(stats, "candidates-dropped", &dropped));
+		EXPECT_TRUE(gst_structure_get_int(stats, "candidates", &read));
+		EXPECT_GT(dropped, 0) << "frame " << i;
+		EXPECT_EQ(read, frappe::Config{}.max_candidates) << "frame " << i;
+		gst_structure_free(stats);
+	}
+	GstMessage *msg = gst_bus_pop_filtered(bus, GST_MESSAGE_WARNING);
+	ASSERT_NE(msg, nullptr) << "no warning";
+	GError *err = nullptr;
+	gst_message_parse_warning(msg, &err, nullptr);
+	EXPECT_NE(std::string(err->message).find("Too many marker candidates"), std::string::npos) << err->message;
+	g_error_free(err);
+	gst_message_unref(msg);
+	EXPECT_EQ(gst_bus_pop_filtered(bus, GST_MESSAGE_WARNING), nullptr) << "one warning for the stream";
+	gst_object_unref(bus);
+	gst_harness_teardown(h);
 }
