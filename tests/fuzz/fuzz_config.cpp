@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: MIT
 // libFuzzer target: the settings a user types. A dictionary name (any bytes)
 // and every Config field from the input, then a Detector and a Pipeline on
-// them and a frame of a fuzzed size. The library's promise: a bad setting or
+// them and a frame of a fuzzed size; and the public helpers (rotateCode,
+// markerImage) on fuzzed arguments. The library's promise: a bad setting or
 // frame is a std::invalid_argument, nothing else; a good one detects.
 #include <algorithm>
 #include <cmath>
@@ -96,14 +97,33 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t *data, std::size_t size
 					 static_cast<std::size_t>(std::max(0, h)) + 1, 128);
 	const frappe::ImageView view(pixels.data(), w, h, stride);
 
+	/* After the frame, so that the seeds keep their layout (zeros past
+	 * the end keep the default). */
+	const std::uint8_t pipelineMode = in.get<std::uint8_t>();
+	if ((in.get<std::uint8_t>() & 1) != 0)
+		c.max_candidates = in.get<std::int32_t>();
+
+	/* The public helpers: a bad argument is std::invalid_argument (or
+	 * std::out_of_range for an id), never undefined behaviour. Cells stay
+	 * small: a 32768 px marker image is legal, and a gigabyte. */
+	try {
+		const frappe::Dictionary &d = dicts[in.get<std::uint8_t>() % dicts.size()];
+		frappe::rotateCode(in.get<std::uint64_t>(), in.get<std::int8_t>());
+		int side = 0;
+		frappe::markerImage(d, in.get<std::int16_t>(), in.get<std::int8_t>() % 24, in.get<std::int8_t>() % 8,
+				    side);
+	} catch (const std::invalid_argument &) {
+	} catch (const std::out_of_range &) {
+	}
+
 	try {
 		frappe::Detector det(c);
 		try {
 			det.detect(view);
 		} catch (const std::invalid_argument &) {
 		}
-		frappe::Pipeline pipeline(c, (in.get<std::uint8_t>() & 1) != 0 ? frappe::Pipeline::Mode::Stages
-										 : frappe::Pipeline::Mode::Frames);
+		frappe::Pipeline pipeline(c, (pipelineMode & 1) != 0 ? frappe::Pipeline::Mode::Stages
+								     : frappe::Pipeline::Mode::Frames);
 		try {
 			pipeline.push(view);
 		} catch (const std::invalid_argument &) {
