@@ -560,9 +560,7 @@ int main(int argc, char **argv)
 	}
 	if (runner.failed() > 0)
 		std::cerr << "frappe-detect: " << runner.failed() << " of " << runner.total() << " images failed\n";
-	/* With --list/--out the contract wants exit 0 when the run completed:
-	 * per-image errors are in the output. */
-	if (!opt.out.empty())
-		return 0;
+	/* Every image has its line either way; a script that only looks at the
+	 * exit status still learns that some failed (issue 16). */
 	return runner.failed() > 0 || runner.annotateFailed() ? 1 : 0;
 }

@@ -67,7 +67,7 @@ def hostile_input(exe, render, sample, tmp):
     r = run(exe, '--list', lst, '--out', out)
     elapsed = time.monotonic() - t0
     lines = [json.loads(l) for l in open(out)]
-    check(r.returncode == 0 and len(lines) == 3, 'a too-large image in a list: one line each, exit 0 (the contract)')
+    check(r.returncode == 1 and len(lines) == 3, 'a too-large image in a list: one line each, then exit 1')
     check('error' in lines[1] and '30000 x 30000' in lines[1]['error'] and 'not decoded' in lines[1]['error'],
           'the too-large image is an error line: %s' % lines[1].get('error'))
     check(len(lines[0]['markers']) > 0 and len(lines[2]['markers']) > 0, 'the images around it are detected')
@@ -215,7 +215,7 @@ def main():
         out = os.path.join(tmp, 'dets.jsonl')
         r = run(exe, '--dictionary', 'aruco_mip_36h12', '--list', lst, '--out', out, '--repeat', '3',
                 '--threads', '1')
-        check(r.returncode == 0, 'contract mode exits 0 with bad images in the list')
+        check(r.returncode == 1, 'contract mode: every line written, then exit 1 for the bad images')
         lines = [json.loads(l) for l in open(out)]
         check(len(lines) == 3, 'one JSON line per listed image')
         check(lines[0]['image'] == sample, 'image path exactly as listed')
