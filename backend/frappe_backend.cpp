@@ -12,19 +12,24 @@
 
 namespace frappe {
 
-std::string selectBackend(Detector &detector, std::string_view name, int threads)
+std::string selectBackend(Pipeline &pipeline, std::string_view name)
 {
-	/* The detector's own front end already is the CPU one. */
+	/* The detectors' own front end already is the CPU one. */
 	if (name == "cpu")
 		return {};
 #ifdef FRAPPE_HAVE_VC4
-	vc4::BackendChoice choice = vc4::selectFrontEnd(name, threads);
-	detector.setFrontEnd(std::move(choice.frontEnd));
-	detector.setWarper(std::move(choice.warper));
-	return choice.fallback;
+	std::string fallback;
+	for (int i = 0; i < pipeline.detectorCount(); ++i) {
+		vc4::BackendChoice choice = vc4::selectFrontEnd(name, 1);
+		Detector &detector = pipeline.detector(i);
+		detector.setFrontEnd(std::move(choice.frontEnd));
+		detector.setWarper(std::move(choice.warper));
+		if (fallback.empty())
+			fallback = std::move(choice.fallback);
+	}
+	return fallback;
 #else
-	(void)detector;
-	(void)threads;
+	(void)pipeline;
 	if (name == "auto")
 		return {};
 	if (name == "vc4" || name == "vc4-emu")

@@ -10,7 +10,7 @@
 #include <string>
 #include <string_view>
 
-#include <frappe/detector.h>
+#include <frappe/pipeline.h>
 
 namespace frappe {
 
@@ -22,15 +22,16 @@ public:
 };
 
 /*
- * Puts the front end named `name` into `detector`: "cpu" keeps the CPU front
- * end the detector has; "vc4", "vc4-emu" and "auto" go to vc4/backend, which decides
- * what runs ("auto" without vc4/ in the build keeps the CPU). `threads` are
- * the bands of a CPU front end that "auto" falls back to.
+ * Puts the front end named `name` into every detector of `pipeline`: "cpu"
+ * keeps the CPU front end they have; "vc4", "vc4-emu" and "auto" go to
+ * vc4/backend, which decides what runs ("auto" without vc4/ in the build
+ * keeps the CPU). Each detector runs on one thread, so a CPU front end that
+ * "auto" falls back to has one band.
  *
  * Returns why "auto" fell back to the CPU, in one sentence for a single
  * warning, or an empty string. Throws std::invalid_argument for an unknown
  * name, BackendNotBuilt, and std::runtime_error when the QPUs cannot be used.
  */
-std::string selectBackend(Detector &detector, std::string_view name, int threads);
+std::string selectBackend(Pipeline &pipeline, std::string_view name);
 
 } /* namespace frappe */

@@ -177,13 +177,14 @@ static GstStaticPadTemplate src_template =
  * Detection
  */
 
-/* Puts the front end the backend property names into a detector. */
-static bool select_front_end(GstFrappeDetect *self, frappe::Detector &detector)
+/* Puts the front end the backend property names into the pipeline's
+ * detectors. */
+static bool select_front_end(GstFrappeDetect *self, frappe::Pipeline &pipeline)
 {
 	FrappeDetectPrivate *priv = self->priv;
 	const char *name = gst_frappe_backend_nick(priv->active.backend);
 	try {
-		const std::string fallback = frappe::selectBackend(detector, name, 1);
+		const std::string fallback = frappe::selectBackend(pipeline, name);
 		if (!fallback.empty() && !priv->warnedFallback) {
 			priv->warnedFallback = true;
 			GST_ELEMENT_WARNING(self, RESOURCE, NOT_FOUND, ("The GPU cannot be used; detecting on the CPU"),
@@ -215,11 +216,9 @@ static bool ensure_pipeline(GstFrappeDetect *self)
 		GST_ELEMENT_ERROR(self, LIBRARY, SETTINGS, ("Invalid detector settings"), ("%s", e.what()));
 		return false;
 	}
-	for (int i = 0; i < priv->pipeline->detectorCount(); ++i) {
-		if (!select_front_end(self, priv->pipeline->detector(i))) {
-			priv->pipeline.reset();
-			return false;
-		}
+	if (!select_front_end(self, *priv->pipeline)) {
+		priv->pipeline.reset();
+		return false;
 	}
 	priv->held.reserve(static_cast<std::size_t>(priv->pipeline->latency()) + 1);
 	GST_DEBUG_OBJECT(self, "pipeline for %s, mode %s, max-hamming %d, front end %s, %d thread(s)",

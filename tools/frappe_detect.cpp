@@ -301,19 +301,16 @@ double median(std::vector<double> v)
 std::unique_ptr<frappe::Pipeline> makePipeline(const Options &opt)
 {
 	auto pipeline = std::make_unique<frappe::Pipeline>(opt.config, frappe::Pipeline::Mode::Frames);
-	for (int i = 0; i < pipeline->detectorCount(); ++i) {
-		std::string fallback;
-		try {
-			fallback = frappe::selectBackend(pipeline->detector(i), opt.backend, 1);
-		} catch (const frappe::BackendNotBuilt &) {
-			throw std::runtime_error("backend " + opt.backend + " needs the vc4 part, which this build lacks");
-		} catch (const std::exception &e) {
-			throw std::runtime_error("backend " + opt.backend + " cannot be used: " + e.what());
-		}
-		if (!fallback.empty() && i == 0)
-			std::cerr << "frappe-detect: the QPUs cannot be used (" << fallback
-				  << "); using the CPU front end\n";
+	std::string fallback;
+	try {
+		fallback = frappe::selectBackend(*pipeline, opt.backend);
+	} catch (const frappe::BackendNotBuilt &) {
+		throw std::runtime_error("backend " + opt.backend + " needs the vc4 part, which this build lacks");
+	} catch (const std::exception &e) {
+		throw std::runtime_error("backend " + opt.backend + " cannot be used: " + e.what());
 	}
+	if (!fallback.empty())
+		std::cerr << "frappe-detect: the QPUs cannot be used (" << fallback << "); using the CPU front end\n";
 	return pipeline;
 }
 
