@@ -2,7 +2,10 @@
 // frappe/config.h: every parameter of the detector, in one place.
 #pragma once
 
+#include <memory>
 #include <string>
+
+#include "frappe/dictionary.h"
 
 namespace frappe {
 
@@ -24,6 +27,10 @@ struct Config {
 	/// Marker family, a name from dictionaryNames() ("aruco_mip_36h12",
 	/// "apriltag_36h11", "6x6_250", ...).
 	std::string dictionary = "aruco_mip_36h12";
+	/// A dictionary of the user's own (loadDictionary()): when set, it is
+	/// used and `dictionary` is ignored. Shared, never copied: a Detector
+	/// keeps it alive.
+	std::shared_ptr<const Dictionary> custom_dictionary;
 
 	Mode mode = Mode::Normal;
 

@@ -5,6 +5,7 @@
 #include "frappe/export.h"
 
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <string>
 #include <string_view>
@@ -62,5 +63,30 @@ FRAPPE_EXPORT std::string dictionaryNames(std::string_view separator = ", ");
 /// std::invalid_argument unless it is 1..8 (n^2 cells in 64 bits); bits of
 /// `code` above the n^2 cells are ignored.
 FRAPPE_EXPORT std::uint64_t rotateCode(std::uint64_t code, int bits);
+
+/// Reads a dictionary of the user's own from a file, in either of two
+/// formats (told by the content):
+/// - the built-in dictionaries' text format (frappe-core/dictionaries/
+///   README.md): `#` comments, one 0x-hex codeword a line, id = line
+///   index; the side n is taken from a `# marker_side_bits: n` header, else
+///   from the codes' hex digits (ceil(n*n/4));
+/// - OpenCV's aruco YAML (what cv::aruco::Dictionary::writeDictionary
+///   writes): markersize, nmarkers, marker_0 .. marker_{N-1} as strings of
+///   n*n '0'/'1' characters, row-major, 1 = white (the same bits).
+/// The dictionary is named after the file (its stem) unless a `#
+/// dictionary:` header or a `name` key gives one. Its min_hamming is
+/// computed over the codes and their rotations; opencv_max_correction is
+/// the file's maxCorrectionBits, or 0.
+/// Throws std::runtime_error when the file cannot be read (missing, not a
+/// regular file, over 64 MiB) and std::invalid_argument, naming the file
+/// and line, when its content is not a dictionary: no codes, more than
+/// 65536, a side outside 3..8, a code with bits beyond n*n, a codeword
+/// that does not parse, a count that disagrees with nmarkers, two ids with
+/// the same code in some rotation.
+FRAPPE_EXPORT std::shared_ptr<const Dictionary> loadDictionary(const std::string &path);
+
+/// The same from a file's text; `name` is the dictionary's unless the text
+/// names one, and names it in messages.
+FRAPPE_EXPORT std::shared_ptr<const Dictionary> parseDictionary(std::string_view text, std::string_view name);
 
 } // namespace frappe

@@ -2,6 +2,7 @@
 // frappe/frappe.h: the whole public API of frappe-core.
 #pragma once
 
+#include "frappe/camera.h"
 #include "frappe/candidate_warp.h"
 #include "frappe/config.h"
 #include "frappe/detector.h"
@@ -11,5 +12,6 @@
 #include "frappe/image.h"
 #include "frappe/marker.h"
 #include "frappe/pipeline.h"
+#include "frappe/pose.h"
 #include "frappe/render.h"
 #include "frappe/version.h"
