@@ -79,8 +79,10 @@ GST_ELEMENT_REGISTER_DEFINE(frappejson, "frappejson", GST_RANK_NONE, GST_TYPE_FR
 #define FRAPPE_JSON_CAPS "application/x-json"
 
 /* What frappedetect's src pad gives. */
-static GstStaticPadTemplate sink_template = GST_STATIC_PAD_TEMPLATE(
-	"sink", GST_PAD_SINK, GST_PAD_ALWAYS, GST_STATIC_CAPS(GST_VIDEO_CAPS_MAKE("{ GRAY8, I420, YV12, NV12, NV21 }")));
+#define FRAPPE_VIDEO_CAPS GST_VIDEO_CAPS_MAKE("{ GRAY8, I420, YV12, NV12, NV21 }")
+
+static GstStaticPadTemplate sink_template =
+	GST_STATIC_PAD_TEMPLATE("sink", GST_PAD_SINK, GST_PAD_ALWAYS, GST_STATIC_CAPS(FRAPPE_VIDEO_CAPS));
 static GstStaticPadTemplate src_template =
 	GST_STATIC_PAD_TEMPLATE("src", GST_PAD_SRC, GST_PAD_ALWAYS, GST_STATIC_CAPS(FRAPPE_JSON_CAPS));
 

@@ -467,7 +467,8 @@ bool selectFrontEnd(GstElement *element, frappe::Pipeline &pipeline, GstFrappeBa
 		const std::string fallback = frappe::selectBackend(pipeline, name);
 		if (!fallback.empty() && !warnedFallback) {
 			warnedFallback = true;
-			GST_ELEMENT_WARNING(element, RESOURCE, NOT_FOUND, ("The GPU cannot be used; detecting on the CPU"),
+			GST_ELEMENT_WARNING(element, RESOURCE, NOT_FOUND,
+					    ("The GPU cannot be used; detecting on the CPU"),
 					    ("backend=auto: %s", fallback.c_str()));
 		}
 	} catch (const frappe::BackendNotBuilt &) {

@@ -69,7 +69,8 @@ TEST(Dictionary, ByLibraryNameAndByNick)
 
 	const FrameSpec spec{ GST_VIDEO_FORMAT_GRAY8, 320, 240 };
 	const Placed marker = square(11, 80.4f, 50.2f, 120.0f);
-	for (const char *launch : { "frappedetect dictionary=apriltag_36h11", "frappedetect dictionary=apriltag-36h11" }) {
+	for (const char *launch :
+	     { "frappedetect dictionary=apriltag_36h11", "frappedetect dictionary=apriltag-36h11" }) {
 		SCOPED_TRACE(launch);
 		BusHarness t(launch, spec);
 		GstBuffer *out = gst_harness_push_and_pull(t.h, makeFrame(spec, { marker }, dict("apriltag_36h11")));

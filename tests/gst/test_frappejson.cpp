@@ -170,9 +170,9 @@ TEST(Json, AppsinkGetsOneLinePerFrame)
 		GstBuffer *buf = gst_sample_get_buffer(sample);
 		EXPECT_EQ(GST_BUFFER_PTS(buf), static_cast<GstClockTime>(i) * GST_SECOND / 30);
 		const std::string line = text(buf);
-		EXPECT_EQ(line.rfind("{\"pts\": " + std::to_string(GST_BUFFER_PTS(buf)) + ", \"markers\": [{\"id\": ", 0),
-			  0u)
-			<< line;
+		const std::string head =
+			"{\"pts\": " + std::to_string(GST_BUFFER_PTS(buf)) + ", \"markers\": [{\"id\": ";
+		EXPECT_EQ(line.rfind(head, 0), 0u) << line;
 		EXPECT_EQ(line.find('\n'), line.size() - 1) << line;
 		EXPECT_NE(line.find("\"id\": 7, \"dictionary\": \"aruco_mip_36h12\""), std::string::npos) << line;
 		EXPECT_NE(line.find("\"id\": 42, \"dictionary\": \"aruco_mip_36h12\""), std::string::npos) << line;
