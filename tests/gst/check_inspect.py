@@ -16,6 +16,13 @@ KNOWN_LICENSES = ["LGPL", "GPL", "QPL", "GPL/QPL", "MPL", "BSD", "MIT/X11", "0BS
                   "unknown"]
 
 
+def missing_formats(element, inspected):
+    missing = [f for f in ("GRAY8", "I420", "YV12", "NV12", "NV21") if f not in inspected]
+    if missing:
+        print(f"{element}: missing formats {missing}")
+    return missing
+
+
 def main():
     inspect = sys.argv[1]
     for args in (["frappedetect"], ["frappejson"], ["frappe"]):
@@ -42,10 +49,8 @@ def main():
     if licence == []:
         print("no License line in gst-inspect-1.0 frappe")
         return 1
-    for fmt in ("GRAY8", "I420", "YV12", "NV12", "NV21"):
-        if fmt not in out:
-            print("missing format " + fmt)
-            return 1
+    if missing_formats("frappedetect", out):
+        return 1
     # Both spellings of a dictionary: the library's name and the nick.
     if "apriltag_36h11" not in out or "apriltag-36h11" not in out:
         print("dictionary values should show the library's names and the nicks")
@@ -54,10 +59,8 @@ def main():
     if "application/x-json" not in json or "frappejson" not in plugin:
         print("frappejson: no application/x-json src pad, or not in the plugin")
         return 1
-    for fmt in ("GRAY8", "I420", "YV12", "NV12", "NV21"):
-        if fmt not in json:
-            print("frappejson: missing format " + fmt)
-            return 1
+    if missing_formats("frappejson", json):
+        return 1
     print("gst-inspect-1.0 frappedetect, frappejson: clean")
     return 0
 

@@ -219,6 +219,7 @@ struct BusMessages {
 
 /// The text and domain of a WARNING or ERROR message.
 struct MessageError {
+	MessageError() = default;
 	explicit MessageError(GstMessage *m)
 	{
 		GError *err = nullptr;
@@ -234,10 +235,30 @@ struct MessageError {
 		g_error_free(err);
 		g_free(dbg);
 	}
-	GQuark domain;
-	gint code;
+	GQuark domain = 0;
+	gint code = 0;
 	std::string text, debug;
 };
+
+/// The element error that keeps the pipeline `launch`, whose frappedetect is
+/// named "d", from starting (state change to PAUSED fails).
+inline MessageError startError(const std::string &launch)
+{
+	GstElement *pipeline = gst_parse_launch(launch.c_str(), nullptr);
+	EXPECT_NE(pipeline, nullptr);
+	EXPECT_EQ(gst_element_set_state(pipeline, GST_STATE_PAUSED), GST_STATE_CHANGE_FAILURE);
+	GstBus *bus = gst_element_get_bus(pipeline);
+	GstMessage *msg = gst_bus_pop_filtered(bus, GST_MESSAGE_ERROR);
+	EXPECT_NE(msg, nullptr);
+	EXPECT_STREQ(msg ? GST_OBJECT_NAME(GST_MESSAGE_SRC(msg)) : "", "d");
+	const MessageError e = msg ? MessageError(msg) : MessageError();
+	if (msg)
+		gst_message_unref(msg);
+	gst_object_unref(bus);
+	gst_element_set_state(pipeline, GST_STATE_NULL);
+	gst_object_unref(pipeline);
+	return e;
+}
 
 /// A rotation matrix, row-major, of `angle` radians about the unit axis.
 inline std::array<double, 9> rotation(const std::array<double, 3> &axis, double angle)

@@ -76,6 +76,14 @@ std::string stringProperty(GstElement *e, const char *name)
 	return s;
 }
 
+/* A 640x480 calibration of focal 600 in a file, and a launch line using it
+ * for 8 cm markers. */
+struct Calibrated {
+	TempDir dir;
+	const std::string file = dir.write("camera.yaml", rosCalibration(640, 480, 600, 600, 319.5, 239.5));
+	const std::string launch = "frappedetect marker-size=0.08 calibration-file=\"" + file + "\"";
+};
+
 constexpr const char *kWrongMatrix = "<300.0, 0.0, 100.0, 0.0, 300.0, 100.0, 0.0, 0.0, 1.0>";
 
 } // namespace
@@ -84,13 +92,12 @@ constexpr const char *kWrongMatrix = "<300.0, 0.0, 100.0, 0.0, 300.0, 100.0, 0.0
  * first. */
 TEST(Calibration, FileGivesThePoseAndWinsOverTheMatrix)
 {
-	TempDir dir;
-	const std::string file = dir.write("camera.yaml", rosCalibration(640, 480, 600, 600, 319.5, 239.5));
+	const Calibrated c;
+	const std::string &file = c.file;
 	const FrameSpec spec{ GST_VIDEO_FORMAT_GRAY8, 640, 480 };
 	const Placed marker = posed(5, 640, 480, 600);
 
-	const std::string fileFirst = "frappedetect marker-size=0.08 calibration-file=\"" + file +
-				      "\" camera-matrix=\"" + kWrongMatrix + "\"";
+	const std::string fileFirst = c.launch + " camera-matrix=\"" + kWrongMatrix + "\"";
 	const std::string matrixFirst = "frappedetect marker-size=0.08 camera-matrix=\"" + std::string(kWrongMatrix) +
 					"\" calibration-file=\"" + file + "\"";
 	for (const std::string &launch : { fileFirst, matrixFirst }) {
@@ -113,17 +120,14 @@ TEST(Calibration, FileGivesThePoseAndWinsOverTheMatrix)
 /* A 640x480 calibration on 320x240 frames is scaled: the same pose. */
 TEST(Calibration, ScaledToTheFrameSize)
 {
-	TempDir dir;
-	const std::string file = dir.write("camera.yaml", rosCalibration(640, 480, 600, 600, 319.5, 239.5));
-	const std::string launch = "frappedetect marker-size=0.08 calibration-file=\"" + file + "\"";
-
+	const Calibrated c;
 	const FrameSpec full{ GST_VIDEO_FORMAT_I420, 640, 480 };
-	BusHarness a(launch.c_str(), full);
+	BusHarness a(c.launch.c_str(), full);
 	const GstFrappeMarkerMeta big = posePushed(a.h, full, posed(5, 640, 480, 600));
 
 	/* Half the size: focal 300, centre (319.5 + 0.5) / 2 - 0.5. */
 	const FrameSpec half{ GST_VIDEO_FORMAT_I420, 320, 240 };
-	BusHarness b(launch.c_str(), half);
+	BusHarness b(c.launch.c_str(), half);
 	const GstFrappeMarkerMeta small = posePushed(b.h, half, posed(5, 320, 240, 300));
 
 	expectTvec(big, kTvec, 0.01);
@@ -137,11 +141,9 @@ TEST(Calibration, ScaledToTheFrameSize)
 /* Another aspect ratio cannot be scaled: one warning, no pose. */
 TEST(Calibration, OtherAspectRatioWarnsOnceAndGivesNoPose)
 {
-	TempDir dir;
-	const std::string file = dir.write("camera.yaml", rosCalibration(640, 480, 600, 600, 319.5, 239.5));
-	const std::string launch = "frappedetect marker-size=0.08 calibration-file=\"" + file + "\"";
+	const Calibrated c;
 	const FrameSpec wide{ GST_VIDEO_FORMAT_NV12, 640, 360 };
-	BusHarness t(launch.c_str(), wide);
+	BusHarness t(c.launch.c_str(), wide);
 	for (int i = 0; i < 2; ++i) {
 		const GstFrappeMarkerMeta m = posePushed(t.h, wide, posed(5, 640, 360, 600), i * GST_SECOND / 30);
 		EXPECT_EQ(m.id, 5);
@@ -165,24 +167,12 @@ TEST(Calibration, BadFileIsAnErrorAtStart)
 	const std::string missing = dir.path + "/missing.yaml";
 	for (const std::string &file : { malformed, missing }) {
 		SCOPED_TRACE(file);
-		const std::string launch = "videotestsrc num-buffers=1 ! video/x-raw,format=GRAY8 ! "
-					   "frappedetect name=d marker-size=0.05 calibration-file=\"" +
-					   file + "\" ! fakesink";
-		GstElement *pipeline = gst_parse_launch(launch.c_str(), nullptr);
-		ASSERT_NE(pipeline, nullptr);
-		EXPECT_EQ(gst_element_set_state(pipeline, GST_STATE_PAUSED), GST_STATE_CHANGE_FAILURE);
-		GstBus *bus = gst_element_get_bus(pipeline);
-		GstMessage *msg = gst_bus_pop_filtered(bus, GST_MESSAGE_ERROR);
-		ASSERT_NE(msg, nullptr);
-		EXPECT_STREQ(GST_OBJECT_NAME(GST_MESSAGE_SRC(msg)), "d");
-		const MessageError e(msg);
+		const MessageError e = startError("videotestsrc num-buffers=1 ! video/x-raw,format=GRAY8 ! "
+						  "frappedetect name=d marker-size=0.05 calibration-file=\"" +
+						  file + "\" ! fakesink");
 		EXPECT_EQ(e.domain, GST_RESOURCE_ERROR);
 		EXPECT_EQ(e.code, GST_RESOURCE_ERROR_SETTINGS);
 		EXPECT_NE(e.text.find(file), std::string::npos) << e.text;
-		gst_message_unref(msg);
-		gst_object_unref(bus);
-		gst_element_set_state(pipeline, GST_STATE_NULL);
-		gst_object_unref(pipeline);
 	}
 }
 
