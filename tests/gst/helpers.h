@@ -240,6 +240,20 @@ struct MessageError {
 	std::string text, debug;
 };
 
+/// Exactly one warning on the bus since it was last read, no error: a
+/// GST_RESOURCE_ERROR_SETTINGS one whose text holds `words`.
+inline void expectOneSettingsWarning(GstBus *bus, const std::string &words)
+{
+	const BusMessages msgs(bus);
+	EXPECT_TRUE(msgs.of(GST_MESSAGE_ERROR).empty());
+	const auto warnings = msgs.of(GST_MESSAGE_WARNING);
+	ASSERT_EQ(warnings.size(), 1u);
+	const MessageError w(warnings[0]);
+	EXPECT_EQ(w.domain, GST_RESOURCE_ERROR);
+	EXPECT_EQ(w.code, GST_RESOURCE_ERROR_SETTINGS);
+	EXPECT_NE(w.text.find(words), std::string::npos) << w.text;
+}
+
 /// The element error that keeps the pipeline `launch`, whose frappedetect is
 /// named "d", from starting (state change to PAUSED fails).
 inline MessageError startError(const std::string &launch)

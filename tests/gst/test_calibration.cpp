@@ -149,13 +149,7 @@ TEST(Calibration, OtherAspectRatioWarnsOnceAndGivesNoPose)
 		EXPECT_EQ(m.id, 5);
 		EXPECT_FALSE(m.has_pose);
 	}
-	const BusMessages msgs(t.bus);
-	const auto warnings = msgs.of(GST_MESSAGE_WARNING);
-	ASSERT_EQ(warnings.size(), 1u);
-	const MessageError w(warnings[0]);
-	EXPECT_EQ(w.domain, GST_RESOURCE_ERROR);
-	EXPECT_NE(w.text.find("640x480"), std::string::npos) << w.text;
-	EXPECT_NE(w.text.find("640x360"), std::string::npos) << w.text;
+	expectOneSettingsWarning(t.bus, "640x480 frames, not 640x360");
 }
 
 /* A file that cannot be used is an element error at start naming it, and
@@ -192,15 +186,7 @@ TEST(Calibration, SetWhilePlaying)
 	g_object_set(detector(t.h), "calibration-file", bad.c_str(), nullptr);
 	EXPECT_EQ(stringProperty(detector(t.h), "calibration-file"), good);
 	expectTvec(posePushed(t.h, spec, marker, GST_SECOND), kTvec, 0.01);
-	{
-		const BusMessages msgs(t.bus);
-		const auto warnings = msgs.of(GST_MESSAGE_WARNING);
-		ASSERT_EQ(warnings.size(), 1u);
-		const MessageError w(warnings[0]);
-		EXPECT_EQ(w.code, GST_RESOURCE_ERROR_SETTINGS);
-		EXPECT_NE(w.text.find(bad), std::string::npos) << w.text;
-		EXPECT_TRUE(msgs.of(GST_MESSAGE_ERROR).empty());
-	}
+	expectOneSettingsWarning(t.bus, bad);
 
 	/* Half the focal length: the marker seems half as far. */
 	g_object_set(detector(t.h), "calibration-file", other.c_str(), nullptr);
@@ -254,12 +240,7 @@ TEST(MarkerSizes, MalformedIsRefusedWithAWarning)
 		SCOPED_TRACE(bad);
 		g_object_set(e, "marker-sizes", bad, nullptr);
 		EXPECT_EQ(stringProperty(e, "marker-sizes"), "0:0.05");
-		const BusMessages msgs(t.bus);
-		const auto warnings = msgs.of(GST_MESSAGE_WARNING);
-		ASSERT_EQ(warnings.size(), 1u);
-		const MessageError w(warnings[0]);
-		EXPECT_EQ(w.code, GST_RESOURCE_ERROR_SETTINGS);
-		EXPECT_NE(w.text.find(bad), std::string::npos) << w.text;
+		expectOneSettingsWarning(t.bus, bad);
 	}
 }
 
@@ -281,11 +262,7 @@ TEST(CameraMatrix, RefusedValuesWarn)
 	for (const auto &c : cases) {
 		SCOPED_TRACE(c.value);
 		gst_util_set_object_arg(G_OBJECT(e), c.property, c.value);
-		const BusMessages msgs(t.bus);
-		const auto warnings = msgs.of(GST_MESSAGE_WARNING);
-		ASSERT_EQ(warnings.size(), 1u);
-		const MessageError w(warnings[0]);
-		EXPECT_NE(w.text.find(c.words), std::string::npos) << w.text;
+		expectOneSettingsWarning(t.bus, c.words);
 	}
 	GValue v = G_VALUE_INIT;
 	g_value_init(&v, GST_TYPE_ARRAY);

@@ -135,8 +135,5 @@ TEST(DictionaryFile, BadFileRefused)
 	g_object_get(detector(t.h), "dictionary-file", &path, nullptr);
 	EXPECT_STREQ(path, good.c_str());
 	g_free(path);
-	const BusMessages msgs(t.bus);
-	const auto warnings = msgs.of(GST_MESSAGE_WARNING);
-	ASSERT_EQ(warnings.size(), 1u);
-	EXPECT_NE(MessageError(warnings[0]).text.find(bad), std::string::npos);
+	expectOneSettingsWarning(t.bus, bad);
 }
