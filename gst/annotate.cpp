@@ -123,8 +123,9 @@ void Canvas::number(int value, double cx, double cy, int cell)
 	}
 }
 
-void annotateMarkers(GstVideoFrame *frame, const Result &result, const std::vector<std::optional<Pose>> &poses,
-		     double markerSize, const Camera &camera)
+void annotateMarkers(GstVideoFrame *frame, const Result &result,
+		     const std::vector<std::optional<frappe::Pose>> &poses, const frappe::MarkerSizes &sizes,
+		     const frappe::Camera &camera)
 {
 	Canvas canvas(frame);
 	for (std::size_t i = 0; i < result.markers.size(); ++i) {
@@ -149,9 +150,11 @@ void annotateMarkers(GstVideoFrame *frame, const Result &result, const std::vect
 		canvas.fillRect(cx - r, cy - r, cx + r, cy + r, colours::firstCorner);
 
 		if (poses[i]) {
-			const double h = markerSize / 2.0;
-			const auto p = projectPoints({ { 0, 0, 0 }, { h, 0, 0 }, { 0, h, 0 }, { 0, 0, h } },
-						     *poses[i], camera);
+			const double h = sizes(m.id) / 2.0;
+			const std::array<std::array<double, 3>, 4> axes{
+				{ { 0, 0, 0 }, { h, 0, 0 }, { 0, h, 0 }, { 0, 0, h } }
+			};
+			const auto p = frappe::projectPoints(axes, *poses[i], camera);
 			if (p.size() == 4) {
 				canvas.haloLine(p[0].x, p[0].y, p[1].x, p[1].y, thickness, colours::axisX);
 				canvas.haloLine(p[0].x, p[0].y, p[2].x, p[2].y, thickness, colours::axisY);

@@ -13,9 +13,9 @@
 
 #include <gst/video/video.h>
 
+#include <frappe/camera.h>
 #include <frappe/detector.h>
-
-#include "pose.h"
+#include <frappe/pose.h>
 
 namespace frappe::gst {
 
@@ -68,8 +68,9 @@ constexpr Yuv axisZ{ 41, 240, 110 };  // blue
 
 /// What frappedetect's annotate property draws for a frame's markers:
 /// outlines, first corners, ids and, where `poses` has one, the axes of a
-/// marker of side `markerSize` (metres).
-void annotateMarkers(GstVideoFrame *frame, const Result &result, const std::vector<std::optional<Pose>> &poses,
-		     double markerSize, const Camera &camera);
+/// marker of its side in `sizes` (metres).
+void annotateMarkers(GstVideoFrame *frame, const Result &result,
+		     const std::vector<std::optional<frappe::Pose>> &poses, const frappe::MarkerSizes &sizes,
+		     const frappe::Camera &camera);
 
 } // namespace frappe::gst

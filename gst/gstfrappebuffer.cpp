@@ -143,4 +143,22 @@ void askOneMoreBuffer(GstElement *element, GstQuery *query)
 	}
 }
 
+void addHeldFrameLatency(GstElement *element, GstQuery *query, const GstVideoInfo *info)
+{
+	gint n = GST_VIDEO_INFO_FPS_N(info), d = GST_VIDEO_INFO_FPS_D(info);
+	if (n <= 0 || d <= 0) {
+		n = 25;
+		d = 1;
+	}
+	const GstClockTime frame = gst_util_uint64_scale_int(GST_SECOND, d, n);
+	gboolean live;
+	GstClockTime min, max;
+	gst_query_parse_latency(query, &live, &min, &max);
+	min += frame;
+	if (GST_CLOCK_TIME_IS_VALID(max))
+		max += frame;
+	GST_DEBUG_OBJECT(element, "adding %" GST_TIME_FORMAT " of latency (one frame held)", GST_TIME_ARGS(frame));
+	gst_query_set_latency(query, live, min, max);
+}
+
 } /* namespace frappe::gst */

@@ -62,4 +62,8 @@ private:
  * query by one: the buffer held while pipelined. */
 void askOneMoreBuffer(GstElement *element, GstQuery *query);
 
+/* Adds one frame of `info`'s frame rate (25 fps when unknown or variable)
+ * to a LATENCY query's answer: the buffer held while pipelined. */
+void addHeldFrameLatency(GstElement *element, GstQuery *query, const GstVideoInfo *info);
+
 } /* namespace frappe::gst */

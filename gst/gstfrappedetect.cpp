@@ -45,12 +45,25 @@
  *   `alternative-reprojection-error` (double: the error of the other planar
  *   solution; close to `reprojection-error` when the pose is ambiguous).
  *
+ * #GstFrappeDetect:dictionary takes the library's names (`apriltag_36h11`)
+ * or the same with dashes (`apriltag-36h11`); #GstFrappeDetect:dictionary-file
+ * a dictionary of one's own (frappe::loadDictionary), used instead; metas
+ * and messages carry the dictionary's name.
+ *
  * Pose: set #GstFrappeDetect:marker-size (metres, the side of the black
- * square) and #GstFrappeDetect:camera-matrix (and optionally
- * #GstFrappeDetect:distortion). The pose comes from OpenCV's IPPE square
- * solver on the refined corners. It is given in OpenCV's camera frame (x
- * right, y down, z forward) for the marker frame of OpenCV aruco: origin at
- * the marker centre, x right, y up, z out of the marker towards the camera.
+ * square; #GstFrappeDetect:marker-sizes, e.g. "0:0.05,7:0.10", for ids of
+ * other sizes) and a camera: #GstFrappeDetect:calibration-file (ROS
+ * camera_info YAML, OpenCV FileStorage YAML or XML), or
+ * #GstFrappeDetect:camera-matrix and #GstFrappeDetect:distortion; the file
+ * wins when both are set. A calibration made at another frame size of the
+ * same aspect ratio is scaled to the caps; another aspect ratio posts a
+ * warning and gives no pose. A file that cannot be used is an error at
+ * start; set while playing, it is a warning and the previous file is kept
+ * (a refused marker-sizes, camera-matrix or distortion: a warning too).
+ * The pose (frappe::estimatePose: IPPE, refined by Gauss-Newton) is in
+ * OpenCV's camera frame (x right, y down, z forward) for the marker frame
+ * of OpenCV aruco: origin at the marker centre, x right, y up, z out of the
+ * marker towards the camera.
  *
  * #GstFrappeDetect:backend chooses where the front end (Sobel, edges,
  * corners, empty tiles) runs: `cpu`; `vc4`, the QPUs of a Raspberry Pi Zero,
@@ -100,9 +113,9 @@
  * ]| Draws the markers into the video and writes it to a file.
  * |[
  * gst-launch-1.0 -m libcamerasrc ! video/x-raw,format=NV12,width=640,height=480 ! \
- *     frappedetect dictionary=apriltag-36h11 marker-size=0.1 \
- *     camera-matrix="<600.0,0.0,320.0,0.0,600.0,240.0,0.0,0.0,1.0>" ! fakesink
- * ]| Poses of AprilTag markers of 10 cm seen by a camera, on the bus.
+ *     frappedetect dictionary=apriltag_36h11 marker-size=0.1 \
+ *     calibration-file=camera.yaml ! frappejson ! fdsink
+ * ]| Poses of AprilTag markers of 10 cm seen by a camera, as JSON lines.
  */
 
 #include "gstfrappedetect.h"
@@ -119,13 +132,12 @@
 #include <frappe/frappe.h>
 
 #include "annotate.h"
-#include "frappe_backend.h"
 #include "gstfrappebuffer.h"
+#include "gstfrappecamera.h"
 #include "gstfrappeenums.h"
 #include "gstfrappeoutput.h"
 #include "gstfrappesettings.h"
 #include "gstfrappeframe.h"
-#include "pose.h"
 
 /* Not static: the settings log through it too. */
 GST_DEBUG_CATEGORY(gst_frappe_detect_debug);
@@ -143,9 +155,14 @@ struct FrappeDetectPrivate {
 	/* Under the object lock. */
 	Settings props;
 	GstStructure *stats = nullptr;
+	bool running = false; /* started: files are read when set */
 
 	/* Streaming thread only. */
 	Settings active;
+	frappe::gst::PoseCamera camera; /* active's, fitted to the caps */
+	frappe::gst::Poses poses;       /* the frame's, reused */
+	std::vector<std::optional<frappe::Pose>> bestPoses;
+	std::string dictionary;         /* the pipeline's dictionary name */
 	std::unique_ptr<frappe::Pipeline> pipeline;
 	std::vector<MappedFrame> held;   /* in the pipeline, oldest first */
 	std::vector<GstBuffer *> output; /* finished, waiting for generate_output */
@@ -177,30 +194,6 @@ static GstStaticPadTemplate src_template =
  * Detection
  */
 
-/* Puts the front end the backend property names into the pipeline's
- * detectors. */
-static bool select_front_end(GstFrappeDetect *self, frappe::Pipeline &pipeline)
-{
-	FrappeDetectPrivate *priv = self->priv;
-	const char *name = gst_frappe_backend_nick(priv->active.backend);
-	try {
-		const std::string fallback = frappe::selectBackend(pipeline, name);
-		if (!fallback.empty() && !priv->warnedFallback) {
-			priv->warnedFallback = true;
-			GST_ELEMENT_WARNING(self, RESOURCE, NOT_FOUND, ("The GPU cannot be used; detecting on the CPU"),
-					    ("backend=auto: %s", fallback.c_str()));
-		}
-	} catch (const frappe::BackendNotBuilt &) {
-		GST_ELEMENT_ERROR(self, LIBRARY, SETTINGS, ("Backend %s is not in this build", name),
-				  ("the plugin was built without vc4/"));
-		return false;
-	} catch (const std::exception &e) {
-		GST_ELEMENT_ERROR(self, RESOURCE, OPEN_READ, ("Backend %s cannot be used", name), ("%s", e.what()));
-		return false;
-	}
-	return true;
-}
-
 /* The pipeline of the active settings: frames on one thread, or whole
  * frames on two with one frame of latency (pipelined: one buffer held). */
 static bool ensure_pipeline(GstFrappeDetect *self)
@@ -216,13 +209,15 @@ static bool ensure_pipeline(GstFrappeDetect *self)
 		GST_ELEMENT_ERROR(self, LIBRARY, SETTINGS, ("Invalid detector settings"), ("%s", e.what()));
 		return false;
 	}
-	if (!select_front_end(self, *priv->pipeline)) {
+	if (!frappe::gst::selectFrontEnd(GST_ELEMENT(self), *priv->pipeline, priv->active.backend,
+					 priv->warnedFallback)) {
 		priv->pipeline.reset();
 		return false;
 	}
 	priv->held.reserve(static_cast<std::size_t>(priv->pipeline->latency()) + 1);
+	priv->dictionary = priv->pipeline->detector().dictionary().name;
 	GST_DEBUG_OBJECT(self, "pipeline for %s, mode %s, max-hamming %d, front end %s, %d thread(s)",
-			 config.dictionary.c_str(), config.mode == frappe::Mode::AScale ? "ascale" : "normal",
+			 priv->dictionary.c_str(), config.mode == frappe::Mode::AScale ? "ascale" : "normal",
 			 priv->pipeline->detector().maxHamming(), priv->pipeline->detector().frontEnd().name(),
 			 priv->pipeline->threads());
 	return true;
@@ -263,22 +258,25 @@ static void finish(GstFrappeDetect *self, MappedFrame &f, const frappe::Result &
 {
 	FrappeDetectPrivate *priv = self->priv;
 	const Settings &s = priv->active;
-	const std::string dictName(priv->pipeline->detector().dictionary().name);
+	const char *dictName = priv->dictionary.c_str();
+	const frappe::gst::Poses &poses = priv->poses;
 
 	const gint64 t0 = g_get_monotonic_time();
-	const frappe::gst::Poses poses = frappe::gst::estimatePoses(result.markers, s.markerSize, s.camera);
+	frappe::gst::estimatePoses(result.markers, s.sizes, priv->camera.camera(), priv->poses);
 	const double poseMs = static_cast<double>(g_get_monotonic_time() - t0) / 1000.0;
 
 	frappe::gst::attachMarkerMetas(f.buffer, GST_VIDEO_FRAME_WIDTH(&f.frame), GST_VIDEO_FRAME_HEIGHT(&f.frame),
-				       result, poses, dictName.c_str());
-	if (f.writable && s.annotate && !result.markers.empty())
-		frappe::gst::annotateMarkers(&f.frame, result, poses, s.markerSize, s.camera);
+				       result, poses, dictName);
+	if (f.writable && s.annotate && !result.markers.empty()) {
+		frappe::gst::bestPoses(poses, priv->bestPoses);
+		frappe::gst::annotateMarkers(&f.frame, result, priv->bestPoses, s.sizes, priv->camera.fitted());
+	}
 
 	GstBuffer *buffer = f.release();
 
 	if (s.postMessages) {
 		GstStructure *msg = frappe::gst::frameMessage(buffer, GST_BASE_TRANSFORM(self)->segment, result,
-							      poses, dictName.c_str());
+							      poses, dictName);
 		gst_element_post_message(GST_ELEMENT(self), gst_message_new_element(GST_OBJECT(self), msg));
 	}
 
@@ -368,11 +366,15 @@ static GstFlowReturn drain(GstFrappeDetect *self)
 }
 
 /* Picks up property changes; a new pipeline finishes the held frames of
- * the old one first. */
+ * the old one first, a new camera is fitted to the frames. */
 static GstFlowReturn apply_settings(GstFrappeDetect *self)
 {
 	FrappeDetectPrivate *priv = self->priv;
 	GST_OBJECT_LOCK(self);
+	if (priv->props.generation == priv->active.generation) {
+		GST_OBJECT_UNLOCK(self);
+		return GST_FLOW_OK;
+	}
 	Settings next = priv->props;
 	GST_OBJECT_UNLOCK(self);
 
@@ -381,7 +383,13 @@ static GstFlowReturn apply_settings(GstFrappeDetect *self)
 	GstFlowReturn ret = GST_FLOW_OK;
 	if (rebuild)
 		ret = finish_held(self);
+	const bool newCamera = next.cameraGeneration != priv->active.cameraGeneration;
 	priv->active = next;
+	if (newCamera) {
+		const GstVideoInfo *info = &GST_VIDEO_FILTER(self)->in_info;
+		priv->camera.fit(GST_ELEMENT(self), priv->active.poseCamera(), GST_VIDEO_INFO_WIDTH(info),
+				 GST_VIDEO_INFO_HEIGHT(info));
+	}
 	if (rebuild && priv->pipeline) {
 		GST_DEBUG_OBJECT(self, "settings changed, rebuilding the pipeline");
 		priv->pipeline.reset();
@@ -534,25 +542,8 @@ static gboolean gst_frappe_detect_query(GstBaseTransform *trans, GstPadDirection
 		GST_OBJECT_LOCK(self);
 		const gboolean pipelined = self->priv->props.pipelined;
 		GST_OBJECT_UNLOCK(self);
-		if (pipelined) {
-			GstVideoInfo *info = &GST_VIDEO_FILTER(self)->in_info;
-			gint n = GST_VIDEO_INFO_FPS_N(info), d = GST_VIDEO_INFO_FPS_D(info);
-			if (n <= 0 || d <= 0) {
-				/* Unknown or variable frame rate: assume 25 fps. */
-				n = 25;
-				d = 1;
-			}
-			const GstClockTime frame = gst_util_uint64_scale_int(GST_SECOND, d, n);
-			gboolean live;
-			GstClockTime min, max;
-			gst_query_parse_latency(query, &live, &min, &max);
-			min += frame;
-			if (GST_CLOCK_TIME_IS_VALID(max))
-				max += frame;
-			GST_DEBUG_OBJECT(self, "adding %" GST_TIME_FORMAT " of latency (one frame held)",
-					 GST_TIME_ARGS(frame));
-			gst_query_set_latency(query, live, min, max);
-		}
+		if (pipelined)
+			frappe::gst::addHeldFrameLatency(GST_ELEMENT(self), query, &GST_VIDEO_FILTER(self)->in_info);
 	}
 	return ret;
 }
@@ -576,9 +567,12 @@ static gboolean gst_frappe_detect_propose_allocation(GstBaseTransform *trans, Gs
 static gboolean gst_frappe_detect_start(GstBaseTransform *trans)
 {
 	GstFrappeDetect *self = GST_FRAPPE_DETECT(trans);
+	if (!frappe::gst::startSettings(GST_ELEMENT(self), self->priv->props, self->priv->running))
+		return FALSE;
 	GST_OBJECT_LOCK(self);
 	self->priv->active = self->priv->props;
 	GST_OBJECT_UNLOCK(self);
+	self->priv->camera.reset();
 	self->priv->frames = 0;
 	self->priv->window.reset();
 	self->priv->bufferLog.reset();
@@ -592,6 +586,9 @@ static gboolean gst_frappe_detect_stop(GstBaseTransform *trans)
 	drop_held(self);
 	clear_output(self);
 	self->priv->pipeline.reset();
+	GST_OBJECT_LOCK(self);
+	self->priv->running = false;
+	GST_OBJECT_UNLOCK(self);
 	return TRUE;
 }
 
@@ -610,6 +607,8 @@ static gboolean gst_frappe_detect_set_info(GstVideoFilter *filter, GstCaps *, Gs
 				  (nullptr));
 		return FALSE;
 	}
+	GstFrappeDetect *self = GST_FRAPPE_DETECT(filter);
+	self->priv->camera.fit(GST_ELEMENT(self), self->priv->active.poseCamera(), w, h);
 	return TRUE;
 }
 
@@ -620,11 +619,8 @@ static gboolean gst_frappe_detect_set_info(GstVideoFilter *filter, GstCaps *, Gs
 static void gst_frappe_detect_set_property(GObject *object, guint prop_id, const GValue *value, GParamSpec *pspec)
 {
 	GstFrappeDetect *self = GST_FRAPPE_DETECT(object);
-
-	GST_OBJECT_LOCK(self);
-	if (!frappe::gst::setProperty(object, self->priv->props, prop_id, value))
+	if (!frappe::gst::setProperty(GST_ELEMENT(self), self->priv->props, self->priv->running, prop_id, value))
 		G_OBJECT_WARN_INVALID_PROPERTY_ID(object, prop_id, pspec);
-	GST_OBJECT_UNLOCK(self);
 }
 
 static void gst_frappe_detect_get_property(GObject *object, guint prop_id, GValue *value, GParamSpec *pspec)

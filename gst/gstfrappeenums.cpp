@@ -45,6 +45,9 @@ GType gst_frappe_backend_get_type(void)
 	return type;
 }
 
+/* Value names are the library's dictionary names ("apriltag_36h11"), nicks
+ * the same with dashes ("apriltag-36h11"): GStreamer parses an enum by name
+ * or by nick, so `dictionary=` takes both spellings. */
 GType gst_frappe_dictionary_get_type(void)
 {
 	static GType type = 0;
@@ -52,14 +55,11 @@ GType gst_frappe_dictionary_get_type(void)
 		const auto dicts = frappe::dictionaries();
 		GEnumValue *values = g_new0(GEnumValue, dicts.size() + 1);
 		for (std::size_t i = 0; i < dicts.size(); ++i) {
-			std::string nick(dicts[i].name);
+			const std::string name(dicts[i].name);
+			std::string nick = name;
 			std::replace(nick.begin(), nick.end(), '_', '-');
-			const std::string desc = std::string(dicts[i].name) + " (" +
-						 std::to_string(dicts[i].size()) + " markers, " +
-						 std::to_string(dicts[i].bits) + "x" +
-						 std::to_string(dicts[i].bits) + " bits)";
 			values[i].value = static_cast<gint>(i);
-			values[i].value_name = g_intern_string(desc.c_str());
+			values[i].value_name = g_intern_string(name.c_str());
 			values[i].value_nick = g_intern_string(nick.c_str());
 		}
 		GType t = g_enum_register_static("GstFrappeDictionary", values);

@@ -28,8 +28,9 @@ GType gst_frappe_mode_get_type(void);
 #define GST_TYPE_FRAPPE_BACKEND (gst_frappe_backend_get_type())
 GType gst_frappe_backend_get_type(void);
 
-/* One value per built-in dictionary, in the library's stable order; nicks
- * are the dictionary names with dashes ("6x6-250"). */
+/* One value per built-in dictionary, in the library's stable order; value
+ * names are the library's names ("6x6_250"), nicks the same with dashes
+ * ("6x6-250"). */
 #define GST_TYPE_FRAPPE_DICTIONARY (gst_frappe_dictionary_get_type())
 GType gst_frappe_dictionary_get_type(void);
 

@@ -35,7 +35,8 @@ void addDoubleArray(GstStructure *s, const char *field, const double *v, int n)
 	gst_structure_take_value(s, field, &array);
 }
 
-GstStructure *markerStructure(const Marker &m, const std::optional<Pose> &pose, const char *dictionary)
+GstStructure *markerStructure(const Marker &m, const std::optional<frappe::MarkerPose> &pose,
+			      const char *dictionary)
 {
 	GstStructure *ms = gst_structure_new("marker", "id", G_TYPE_INT, m.id, "dictionary", G_TYPE_STRING,
 					     dictionary, nullptr);
@@ -48,10 +49,10 @@ GstStructure *markerStructure(const Marker &m, const std::optional<Pose> &pose, 
 	gst_structure_set(ms, "hamming", G_TYPE_UINT, static_cast<guint>(m.hamming), "margin", G_TYPE_DOUBLE,
 			  static_cast<gdouble>(m.margin), nullptr);
 	if (pose) {
-		addDoubleArray(ms, "rvec", pose->rvec.data(), 3);
-		addDoubleArray(ms, "tvec", pose->tvec.data(), 3);
-		gst_structure_set(ms, "reprojection-error", G_TYPE_DOUBLE, pose->reprojectionError,
-				  "alternative-reprojection-error", G_TYPE_DOUBLE, pose->alternativeError, nullptr);
+		addDoubleArray(ms, "rvec", pose->pose.rvec.data(), 3);
+		addDoubleArray(ms, "tvec", pose->pose.tvec.data(), 3);
+		gst_structure_set(ms, "reprojection-error", G_TYPE_DOUBLE, pose->pose.error,
+				  "alternative-reprojection-error", G_TYPE_DOUBLE, pose->alternative.error, nullptr);
 	}
 	return ms;
 }
@@ -81,11 +82,11 @@ void attachMarkerMetas(GstBuffer *buffer, gint width, gint height, const Result 
 		if (meta && poses[i]) {
 			meta->has_pose = TRUE;
 			for (int k = 0; k < 3; ++k) {
-				meta->rvec[k] = poses[i]->rvec[static_cast<std::size_t>(k)];
-				meta->tvec[k] = poses[i]->tvec[static_cast<std::size_t>(k)];
+				meta->rvec[k] = poses[i]->pose.rvec[static_cast<std::size_t>(k)];
+				meta->tvec[k] = poses[i]->pose.tvec[static_cast<std::size_t>(k)];
 			}
-			meta->reprojection_error = poses[i]->reprojectionError;
-			meta->alternative_reprojection_error = poses[i]->alternativeError;
+			meta->reprojection_error = poses[i]->pose.error;
+			meta->alternative_reprojection_error = poses[i]->alternative.error;
 		}
 
 		/* The ROI covers the pixels the corners touch, clipped to the frame. */

@@ -14,11 +14,9 @@
 
 #include <frappe/detector.h>
 
-#include "pose.h"
+#include "gstfrappecamera.h"
 
 namespace frappe::gst {
-
-using Poses = std::vector<std::optional<Pose>>;
 
 /* A GstFrappeMarkerMeta and a "fiducial" GstVideoRegionOfInterestMeta per
  * marker, on a writable buffer of a frame of width x height. */

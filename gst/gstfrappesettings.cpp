@@ -6,10 +6,13 @@
 
 #include <algorithm>
 #include <cstddef>
+#include <exception>
 #include <string>
 #include <vector>
 
 #include <frappe/dictionary.h>
+
+#include "frappe_backend.h"
 
 GST_DEBUG_CATEGORY_EXTERN(gst_frappe_detect_debug);
 #define GST_CAT_DEFAULT gst_frappe_detect_debug
@@ -67,6 +70,55 @@ void getDoubleArray(GValue *value, const double *v, std::size_t n)
 	}
 }
 
+/* The files of calibration-file and dictionary-file: std::nullopt or
+ * nullptr, and `error` set, when they cannot be used. */
+std::optional<frappe::Camera> readCalibrationFile(const std::string &path, std::string &error)
+{
+	try {
+		return frappe::readCalibration(path);
+	} catch (const std::exception &e) {
+		error = e.what();
+		return std::nullopt;
+	}
+}
+
+std::shared_ptr<const frappe::Dictionary> readDictionaryFile(const std::string &path, std::string &error)
+{
+	try {
+		return frappe::loadDictionary(path);
+	} catch (const std::exception &e) {
+		error = e.what();
+		return nullptr;
+	}
+}
+
+/* A file property's value, read when the element is running. */
+struct FileValue {
+	std::string path;
+	std::optional<frappe::Camera> calibration;
+	std::shared_ptr<const frappe::Dictionary> dictionary;
+};
+
+/* Outside the object lock (a dictionary may take a while to check):
+ * false, and `warning` set, when the file cannot be used. */
+bool readFileProperty(guint propId, const GValue *value, bool running, FileValue &out, std::string &warning)
+{
+	const gchar *path = g_value_get_string(value);
+	out.path = path ? path : "";
+	if (!running || out.path.empty())
+		return true;
+	std::string error;
+	if (propId == PROP_CALIBRATION_FILE)
+		out.calibration = readCalibrationFile(out.path, error);
+	else
+		out.dictionary = readDictionaryFile(out.path, error);
+	if (error.empty())
+		return true;
+	warning = "Ignoring " + std::string(propId == PROP_CALIBRATION_FILE ? "calibration" : "dictionary") +
+		  " file " + out.path + ", keeping the previous one: " + error;
+	return false;
+}
+
 } /* namespace */
 
 bool Settings::samePipeline(const Settings &o) const
@@ -75,15 +127,16 @@ bool Settings::samePipeline(const Settings &o) const
 	       cornerThreshold == o.cornerThreshold && regionContrast == o.regionContrast &&
 	       maxHamming == o.maxHamming &&
 	       scaledSize == o.scaledSize && maxScaledFrames == o.maxScaledFrames &&
-	       backend == o.backend && pipelined == o.pipelined;
+	       backend == o.backend && pipelined == o.pipelined && customDictionary == o.customDictionary;
 }
 
 frappe::Config Settings::config() const
 {
 	frappe::Config config;
 	const auto dicts = frappe::dictionaries();
-	const auto &dict = dicts[static_cast<std::size_t>(dictionary)];
-	config.dictionary = std::string(dict.name);
+	const auto &dict = customDictionary ? *customDictionary : dicts[static_cast<std::size_t>(dictionary)];
+	config.dictionary = std::string(dicts[static_cast<std::size_t>(dictionary)].name);
+	config.custom_dictionary = customDictionary;
 	config.mode = gst_frappe_mode_to_library(mode);
 	config.edge_threshold = edgeThreshold;
 	config.corner_threshold = cornerThreshold;
@@ -93,6 +146,13 @@ frappe::Config Settings::config() const
 	config.max_scaled_frames = maxScaledFrames;
 	config.threads = pipelined ? 2 : 1; /* whole frames on two threads */
 	return config;
+}
+
+const frappe::Camera *Settings::poseCamera() const
+{
+	if (!calibrationFile.empty())
+		return calibration ? &*calibration : nullptr;
+	return camera.valid() ? &camera : nullptr;
 }
 
 void installProperties(GObjectClass *gobject_class)
@@ -181,18 +241,36 @@ void installProperties(GObjectClass *gobject_class)
 		gobject_class, PROP_CAMERA_MATRIX,
 		gst_param_spec_array("camera-matrix", "Camera matrix",
 				     "Camera intrinsics for the pose, 9 numbers row-major: "
-				     "<fx, 0, cx, 0, fy, cy, 0, 0, 1> (empty = no pose)",
+				     "<fx, 0, cx, 0, fy, cy, 0, 0, 1> (empty = no pose; calibration-file wins)",
 				     g_param_spec_double("element", "Element", "A matrix element", -G_MAXDOUBLE,
 							 G_MAXDOUBLE, 0.0, rw),
 				     live));
 	g_object_class_install_property(
 		gobject_class, PROP_DISTORTION,
 		gst_param_spec_array("distortion", "Distortion",
-				     "Lens distortion in OpenCV's order <k1, k2, p1, p2[, k3[, k4, k5, k6"
-				     "[, s1, s2, s3, s4[, tx, ty]]]]> (empty = none)",
+				     "Lens distortion in OpenCV's order <k1, k2, p1, p2[, k3[, k4, k5, k6]]> "
+				     "(empty = none)",
 				     g_param_spec_double("coefficient", "Coefficient", "A distortion coefficient",
 							 -G_MAXDOUBLE, G_MAXDOUBLE, 0.0, rw),
 				     live));
+	g_object_class_install_property(
+		gobject_class, PROP_CALIBRATION_FILE,
+		g_param_spec_string("calibration-file", "Calibration file",
+				    "Camera calibration for the pose: ROS camera_info YAML or OpenCV FileStorage "
+				    "YAML/XML, scaled to the frame size; wins over camera-matrix and distortion",
+				    nullptr, live));
+	g_object_class_install_property(
+		gobject_class, PROP_MARKER_SIZES,
+		g_param_spec_string("marker-sizes", "Marker sizes",
+				    "Sides in metres of some ids, \"id:size,...\" (e.g. \"0:0.05,7:0.10\"); "
+				    "other ids have marker-size",
+				    "", live));
+	g_object_class_install_property(
+		gobject_class, PROP_DICTIONARY_FILE,
+		g_param_spec_string("dictionary-file", "Dictionary file",
+				    "A dictionary of your own (frappe's text format or OpenCV aruco YAML); when set, "
+				    "used instead of dictionary",
+				    nullptr, live));
 	g_object_class_install_property(
 		gobject_class, PROP_STATS,
 		g_param_spec_boxed("stats", "Statistics",
@@ -201,7 +279,11 @@ void installProperties(GObjectClass *gobject_class)
 				   static_cast<GParamFlags>(G_PARAM_READABLE | G_PARAM_STATIC_STRINGS)));
 }
 
-bool setProperty(GObject *self, Settings &p, guint propId, const GValue *value)
+namespace {
+
+/* A value that needs no file; `warning` set when it is refused (and the
+ * previous one kept). */
+bool setValue(Settings &p, guint propId, const GValue *value, std::string &warning)
 {
 	switch (propId) {
 	case PROP_DICTIONARY:
@@ -241,33 +323,161 @@ bool setProperty(GObject *self, Settings &p, guint propId, const GValue *value)
 		p.backend = static_cast<GstFrappeBackend>(g_value_get_enum(value));
 		break;
 	case PROP_MARKER_SIZE:
-		p.markerSize = g_value_get_double(value);
+	case PROP_MARKER_SIZES: {
+		const double size = propId == PROP_MARKER_SIZE ? g_value_get_double(value) : p.markerSize;
+		const gchar *spec = propId == PROP_MARKER_SIZES ? g_value_get_string(value) : nullptr;
+		const std::string text = propId == PROP_MARKER_SIZES ? (spec ? spec : "") : p.markerSizesSpec;
+		try {
+			p.sizes = frappe::MarkerSizes::parse(text, size);
+		} catch (const std::exception &e) {
+			warning = "marker-sizes \"" + text + "\" refused: " + e.what();
+			return true;
+		}
+		p.markerSize = size;
+		p.markerSizesSpec = text;
 		break;
+	}
 	case PROP_CAMERA_MATRIX: {
 		std::vector<double> m;
 		setDoubleArray(value, m);
+		frappe::Camera c = p.camera;
 		if (m.empty()) {
 			p.camera.matrix = {};
-		} else if (m.size() == 9) {
-			std::copy(m.begin(), m.end(), p.camera.matrix.begin());
-		} else {
-			GST_WARNING_OBJECT(self, "camera-matrix needs 9 numbers (row-major 3x3), got %zu; ignored",
-					   m.size());
+			break;
 		}
+		if (m.size() != 9) {
+			warning = "camera-matrix needs 9 numbers (row-major 3x3), got " + std::to_string(m.size()) +
+				  "; ignored";
+			return true;
+		}
+		std::copy(m.begin(), m.end(), c.matrix.begin());
+		try {
+			c.validate();
+		} catch (const std::exception &e) {
+			warning = std::string("camera-matrix ignored: ") + e.what();
+			return true;
+		}
+		p.camera = c;
 		break;
 	}
 	case PROP_DISTORTION: {
-		std::vector<double> d;
-		setDoubleArray(value, d);
-		const std::size_t n = d.size();
-		if (n == 0 || n == 4 || n == 5 || n == 8 || n == 12 || n == 14)
-			p.camera.distortion = d;
-		else
-			GST_WARNING_OBJECT(self, "distortion needs 4, 5, 8, 12 or 14 coefficients, got %zu; ignored",
-					   n);
+		/* Checked as the library would with any valid matrix. */
+		frappe::Camera c = frappe::Camera::pinhole(1.0, 1.0, 0.0, 0.0);
+		setDoubleArray(value, c.distortion);
+		try {
+			c.validate();
+		} catch (const std::exception &e) {
+			warning = std::string("distortion ignored: ") + e.what();
+			return true;
+		}
+		p.camera.distortion = c.distortion;
 		break;
 	}
 	default:
+		return false;
+	}
+	return true;
+}
+
+} /* namespace */
+
+bool setProperty(GstElement *element, Settings &props, const bool &running, guint propId, const GValue *value)
+{
+	std::string warning;
+	if (propId == PROP_CALIBRATION_FILE || propId == PROP_DICTIONARY_FILE) {
+		GST_OBJECT_LOCK(element);
+		const bool read = running;
+		GST_OBJECT_UNLOCK(element);
+		FileValue file;
+		if (readFileProperty(propId, value, read, file, warning)) {
+			GST_OBJECT_LOCK(element);
+			if (propId == PROP_CALIBRATION_FILE) {
+				props.calibrationFile = file.path;
+				props.calibration = file.calibration;
+				++props.cameraGeneration;
+			} else {
+				props.dictionaryFile = file.path;
+				props.customDictionary = file.dictionary;
+			}
+			++props.generation;
+			GST_OBJECT_UNLOCK(element);
+		}
+	} else {
+		GST_OBJECT_LOCK(element);
+		const guint cameraGeneration = props.cameraGeneration;
+		if (!setValue(props, propId, value, warning)) {
+			GST_OBJECT_UNLOCK(element);
+			return false;
+		}
+		if (warning.empty()) {
+			++props.generation;
+			if (propId == PROP_CAMERA_MATRIX || propId == PROP_DISTORTION)
+				props.cameraGeneration = cameraGeneration + 1;
+		}
+		GST_OBJECT_UNLOCK(element);
+	}
+	if (!warning.empty())
+		GST_ELEMENT_WARNING(element, RESOURCE, SETTINGS, ("%s", warning.c_str()), (nullptr));
+	return true;
+}
+
+bool startSettings(GstElement *element, Settings &props, bool &running)
+{
+	/* Running first: a file set from now on is read when set. */
+	GST_OBJECT_LOCK(element);
+	running = true;
+	const std::string calibrationFile = props.calibrationFile, dictionaryFile = props.dictionaryFile;
+	GST_OBJECT_UNLOCK(element);
+
+	std::string error;
+	std::optional<frappe::Camera> calibration;
+	std::shared_ptr<const frappe::Dictionary> dictionary;
+	if (!calibrationFile.empty() && !(calibration = readCalibrationFile(calibrationFile, error))) {
+		GST_ELEMENT_ERROR(element, RESOURCE, SETTINGS,
+				  ("Cannot use calibration file %s: %s", calibrationFile.c_str(), error.c_str()),
+				  (nullptr));
+	} else if (!dictionaryFile.empty() && !(dictionary = readDictionaryFile(dictionaryFile, error))) {
+		GST_ELEMENT_ERROR(element, RESOURCE, SETTINGS,
+				  ("Cannot use dictionary file %s: %s", dictionaryFile.c_str(), error.c_str()),
+				  (nullptr));
+	}
+
+	GST_OBJECT_LOCK(element);
+	if (!error.empty()) {
+		running = false;
+	} else {
+		/* Unless set again meanwhile (then read when set). */
+		if (calibration && props.calibrationFile == calibrationFile) {
+			props.calibration = calibration;
+			++props.cameraGeneration;
+		}
+		if (dictionary && props.dictionaryFile == dictionaryFile)
+			props.customDictionary = dictionary;
+		++props.generation;
+	}
+	GST_OBJECT_UNLOCK(element);
+	return error.empty();
+}
+
+bool selectFrontEnd(GstElement *element, frappe::Pipeline &pipeline, GstFrappeBackend backend,
+		    bool &warnedFallback)
+{
+	const char *name = gst_frappe_backend_nick(backend);
+	try {
+		const std::string fallback = frappe::selectBackend(pipeline, name);
+		if (!fallback.empty() && !warnedFallback) {
+			warnedFallback = true;
+			GST_ELEMENT_WARNING(element, RESOURCE, NOT_FOUND,
+					    ("The GPU cannot be used; detecting on the CPU"),
+					    ("backend=auto: %s", fallback.c_str()));
+		}
+	} catch (const frappe::BackendNotBuilt &) {
+		GST_ELEMENT_ERROR(element, LIBRARY, SETTINGS, ("Backend %s is not in this build", name),
+				  ("the plugin was built without vc4/"));
+		return false;
+	} catch (const std::exception &e) {
+		GST_ELEMENT_ERROR(element, RESOURCE, OPEN_READ, ("Backend %s cannot be used", name),
+				  ("%s", e.what()));
 		return false;
 	}
 	return true;
@@ -314,6 +524,15 @@ bool getProperty(const Settings &p, guint propId, GValue *value)
 		break;
 	case PROP_MARKER_SIZE:
 		g_value_set_double(value, p.markerSize);
+		break;
+	case PROP_MARKER_SIZES:
+		g_value_set_string(value, p.markerSizesSpec.c_str());
+		break;
+	case PROP_CALIBRATION_FILE:
+		g_value_set_string(value, p.calibrationFile.empty() ? nullptr : p.calibrationFile.c_str());
+		break;
+	case PROP_DICTIONARY_FILE:
+		g_value_set_string(value, p.dictionaryFile.empty() ? nullptr : p.dictionaryFile.c_str());
 		break;
 	case PROP_CAMERA_MATRIX:
 		if (p.camera.valid())

@@ -2,16 +2,23 @@
  *
  * gstfrappesettings.h: frappedetect's properties. The detector's take their
  * defaults from frappe::Config{} and their ranges from the library's
- * validation; the element's own (annotate, pose, ...) are defined here.
+ * validation; the element's own (annotate, pose, files, ...) are defined
+ * here, with what setting them checks and reads.
  */
 #pragma once
 
+#include <memory>
+#include <optional>
+#include <string>
+
 #include <gst/gst.h>
 
+#include <frappe/camera.h>
 #include <frappe/config.h>
+#include <frappe/pipeline.h>
+#include <frappe/pose.h>
 
 #include "gstfrappeenums.h"
-#include "pose.h"
 
 namespace frappe::gst {
 
@@ -32,6 +39,9 @@ enum Property {
 	PROP_MARKER_SIZE,
 	PROP_CAMERA_MATRIX,
 	PROP_DISTORTION,
+	PROP_CALIBRATION_FILE,
+	PROP_MARKER_SIZES,
+	PROP_DICTIONARY_FILE,
 	PROP_STATS,
 };
 
@@ -39,7 +49,7 @@ enum Property {
 inline const frappe::Config kLibraryDefaults{};
 
 /* Everything the properties set. The element copies it under the object
- * lock at the start of each frame. */
+ * lock at the start of a frame when its generation changed. */
 struct Settings {
 	gint dictionary = gst_frappe_dictionary_index(kLibraryDefaults.dictionary.c_str());
 	GstFrappeMode mode = gst_frappe_mode_from_library(kLibraryDefaults.mode);
@@ -54,22 +64,58 @@ struct Settings {
 	gboolean pipelined = FALSE;
 	GstFrappeBackend backend = GST_FRAPPE_BACKEND_AUTO;
 	gdouble markerSize = 0.0; /* no pose */
-	Camera camera;
+	std::string markerSizesSpec;   /* marker-sizes, as set */
+	frappe::MarkerSizes sizes;     /* marker-sizes over the default marker-size */
+	frappe::Camera camera;         /* camera-matrix and distortion */
+	std::string calibrationFile;   /* calibration-file, "" for none */
+	std::optional<frappe::Camera> calibration; /* read from it: at start, or when set while running */
+	std::string dictionaryFile;    /* dictionary-file, "" for none */
+	std::shared_ptr<const frappe::Dictionary> customDictionary; /* read from it, as the calibration */
+
+	/* Bumped by every property set: the element copies the settings only
+	 * when it changed (no copy, no allocation per frame). */
+	guint generation = 0;
+	/* Bumped when the camera of the pose changes (camera-matrix,
+	 * distortion, calibration-file): the element fits it to the frame
+	 * size again. */
+	guint cameraGeneration = 0;
 
 	/* Whether a change between two settings needs a new Pipeline. */
 	bool samePipeline(const Settings &o) const;
 
 	/* The pipeline's configuration: one thread, or two when pipelined;
-	 * max-hamming clamped to what the dictionary allows. */
+	 * max-hamming clamped to what the dictionary allows; the custom
+	 * dictionary when dictionary-file is set. */
 	frappe::Config config() const;
+
+	/* The camera of the pose, at the calibration's size: the calibration
+	 * file's when one is set (it wins over camera-matrix and distortion),
+	 * else camera-matrix's when set; nullptr for none. */
+	const frappe::Camera *poseCamera() const;
 };
 
 /* Installs every property; PROP_STATS is the element's to answer. */
 void installProperties(GObjectClass *klass);
 
-/* Sets or gets a property of `s` (not PROP_STATS); false for an id that
- * is not a setting. `self` is for the warnings about ignored values. */
-bool setProperty(GObject *self, Settings &s, guint propId, const GValue *value);
+/* Sets a property of `props` (not PROP_STATS), taking `element`'s object
+ * lock around it; false for an id that is not a setting. A value that
+ * cannot be used is refused with a GST_ELEMENT_WARNING and the previous
+ * one kept. The files of calibration-file and dictionary-file are read
+ * (outside the lock) when `running` (read under the lock) is set, else at
+ * start by startSettings(). */
+bool setProperty(GstElement *element, Settings &props, const bool &running, guint propId, const GValue *value);
+/* Gets a property of `s` (not PROP_STATS); false for an unknown id. */
 bool getProperty(const Settings &s, guint propId, GValue *value);
+
+/* At start: reads the files that calibration-file and dictionary-file
+ * name into `props` and sets `running`. A file that cannot be used is a
+ * GST_ELEMENT_ERROR naming it, and false. */
+bool startSettings(GstElement *element, Settings &props, bool &running);
+
+/* Puts the front end `backend` names into the pipeline's detectors: an
+ * element error and false when it cannot be used, one warning (the first
+ * time: `warnedFallback`) when auto falls back to the CPU. */
+bool selectFrontEnd(GstElement *element, frappe::Pipeline &pipeline, GstFrappeBackend backend,
+		    bool &warnedFallback);
 
 } /* namespace frappe::gst */

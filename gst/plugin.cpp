@@ -5,10 +5,13 @@
 #include <gst/gst.h>
 
 #include "gstfrappedetect.h"
+#include "gstfrappejson.h"
 
 static gboolean plugin_init(GstPlugin *plugin)
 {
-	return GST_ELEMENT_REGISTER(frappedetect, plugin);
+	gboolean ok = GST_ELEMENT_REGISTER(frappedetect, plugin);
+	ok &= GST_ELEMENT_REGISTER(frappejson, plugin);
+	return ok;
 }
 
 /* "MIT/X11" is how GStreamer names the MIT licence: with any string outside

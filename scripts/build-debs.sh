@@ -3,7 +3,7 @@
 #
 #   libfrappe-core0      libfrappe-core.so.0
 #   libfrappe-dev        headers, .pc files, the CMake package, .so links, .gir
-#   gstreamer1.0-frappe  the frappedetect plugin, libgstfrappemeta-1.0.so.0 and
+#   gstreamer1.0-frappe  the plugin (frappedetect, frappejson), libgstfrappemeta-1.0.so.0 and
 #                        its typelib GstFrappe-1.0 (Python apps)
 #   frappe-tools         frappe-detect, frappe-render, vc4-dis, vc4-run, vc4-probe
 #
@@ -229,7 +229,7 @@ if [ -d "$work/pkg/gstreamer1.0-frappe" ]; then
 fi
 control libfrappe-dev libdevel "" "Frappe fiducial marker detector - development files" "${dev_fields[@]}"
 [ ! -d "$work/pkg/gstreamer1.0-frappe" ] ||
-	control gstreamer1.0-frappe video same "Frappe fiducial marker detector - GStreamer element frappedetect"
+	control gstreamer1.0-frappe video same "Frappe fiducial marker detector - GStreamer elements frappedetect, frappejson"
 [ ! -d "$work/pkg/frappe-tools" ] ||
 	control frappe-tools video foreign "Frappe fiducial marker detector - command-line tools"
 

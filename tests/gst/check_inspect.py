@@ -1,22 +1,31 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: MIT
-"""gst-inspect-1.0 frappedetect must exit 0, print no warnings or criticals,
-and list every property the issue asks for; the plugin's licence must be one
-GStreamer knows (else every registry scan warns of an unknown license)."""
+"""gst-inspect-1.0 frappedetect and frappejson must exit 0, print no warnings
+or criticals, and list every property and pad the issues ask for; the
+plugin's licence must be one GStreamer knows (else every registry scan warns
+of an unknown license)."""
 import subprocess
 import sys
 
 PROPERTIES = ["dictionary", "mode", "edge-threshold", "corner-threshold", "region-contrast", "max-hamming",
               "scaled-size", "max-scaled-frames", "annotate", "post-messages", "pipelined",
-              "backend", "marker-size", "camera-matrix", "distortion", "stats"]
+              "backend", "marker-size", "camera-matrix", "distortion", "calibration-file",
+              "marker-sizes", "dictionary-file", "stats"]
 # gst_plugin_check_license()'s list (GStreamer 1.22).
 KNOWN_LICENSES = ["LGPL", "GPL", "QPL", "GPL/QPL", "MPL", "BSD", "MIT/X11", "0BSD", "Proprietary",
                   "unknown"]
 
 
+def missing_formats(element, inspected):
+    missing = [f for f in ("GRAY8", "I420", "YV12", "NV12", "NV21") if f not in inspected]
+    if missing:
+        print(f"{element}: missing formats {missing}")
+    return missing
+
+
 def main():
     inspect = sys.argv[1]
-    for args in (["frappedetect"], ["frappe"]):
+    for args in (["frappedetect"], ["frappejson"], ["frappe"]):
         p = subprocess.run([inspect] + args, capture_output=True, text=True)
         if p.returncode != 0:
             print(f"{args}: exit {p.returncode}\n{p.stderr}")
@@ -40,11 +49,19 @@ def main():
     if licence == []:
         print("no License line in gst-inspect-1.0 frappe")
         return 1
-    for fmt in ("GRAY8", "I420", "YV12", "NV12", "NV21"):
-        if fmt not in out:
-            print("missing format " + fmt)
-            return 1
-    print("gst-inspect-1.0 frappedetect: clean")
+    if missing_formats("frappedetect", out):
+        return 1
+    # Both spellings of a dictionary: the library's name and the nick.
+    if "apriltag_36h11" not in out or "apriltag-36h11" not in out:
+        print("dictionary values should show the library's names and the nicks")
+        return 1
+    json = subprocess.run([inspect, "frappejson"], capture_output=True, text=True).stdout
+    if "application/x-json" not in json or "frappejson" not in plugin:
+        print("frappejson: no application/x-json src pad, or not in the plugin")
+        return 1
+    if missing_formats("frappejson", json):
+        return 1
+    print("gst-inspect-1.0 frappedetect, frappejson: clean")
     return 0
 
 

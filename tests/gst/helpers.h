@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include <glib/gstdio.h>
 #include <gst/check/gstharness.h>
 #include <gst/gst.h>
 #include <gst/video/video.h>
@@ -168,6 +169,179 @@ inline GstElement *detector(GstHarness *h)
 	gst_iterator_free(it);
 	return found; /* the bin holds the reference */
 }
+
+/// A harness around `launch` whose element has a bus of its own, for its
+/// warnings and errors.
+struct BusHarness {
+	/* The bus before the caps: warnings at negotiation reach it. */
+	BusHarness(const char *launch, const FrameSpec &spec) : h(gst_harness_new_parse(launch)), bus(gst_bus_new())
+	{
+		gst_element_set_bus(h->element, bus);
+		gst_harness_set_src_caps_str(h, capsString(spec).c_str());
+	}
+	~BusHarness()
+	{
+		gst_element_set_bus(h->element, nullptr);
+		gst_object_unref(bus);
+		gst_harness_teardown(h);
+	}
+	BusHarness(const BusHarness &) = delete;
+	BusHarness &operator=(const BusHarness &) = delete;
+	GstHarness *h;
+	GstBus *bus;
+};
+
+/// Every message on the bus, oldest first (gst_bus_pop_filtered would
+/// throw away the others).
+struct BusMessages {
+	explicit BusMessages(GstBus *bus)
+	{
+		while (GstMessage *m = gst_bus_pop(bus))
+			all.push_back(m);
+	}
+	~BusMessages()
+	{
+		for (GstMessage *m : all)
+			gst_message_unref(m);
+	}
+	BusMessages(const BusMessages &) = delete;
+	BusMessages &operator=(const BusMessages &) = delete;
+	std::vector<GstMessage *> of(GstMessageType type) const
+	{
+		std::vector<GstMessage *> out;
+		for (GstMessage *m : all)
+			if (GST_MESSAGE_TYPE(m) == type)
+				out.push_back(m);
+		return out;
+	}
+	std::vector<GstMessage *> all;
+};
+
+/// The text and domain of a WARNING or ERROR message.
+struct MessageError {
+	MessageError() = default;
+	explicit MessageError(GstMessage *m)
+	{
+		GError *err = nullptr;
+		gchar *dbg = nullptr;
+		if (GST_MESSAGE_TYPE(m) == GST_MESSAGE_ERROR)
+			gst_message_parse_error(m, &err, &dbg);
+		else
+			gst_message_parse_warning(m, &err, &dbg);
+		domain = err->domain;
+		code = err->code;
+		text = err->message;
+		debug = dbg ? dbg : "";
+		g_error_free(err);
+		g_free(dbg);
+	}
+	GQuark domain = 0;
+	gint code = 0;
+	std::string text, debug;
+};
+
+/// Exactly one warning on the bus since it was last read, no error: a
+/// GST_RESOURCE_ERROR_SETTINGS one whose text holds `words`.
+inline void expectOneSettingsWarning(GstBus *bus, const std::string &words)
+{
+	const BusMessages msgs(bus);
+	EXPECT_TRUE(msgs.of(GST_MESSAGE_ERROR).empty());
+	const auto warnings = msgs.of(GST_MESSAGE_WARNING);
+	ASSERT_EQ(warnings.size(), 1u);
+	const MessageError w(warnings[0]);
+	EXPECT_EQ(w.domain, GST_RESOURCE_ERROR);
+	EXPECT_EQ(w.code, GST_RESOURCE_ERROR_SETTINGS);
+	EXPECT_NE(w.text.find(words), std::string::npos) << w.text;
+}
+
+/// The element error that keeps the pipeline `launch`, whose frappedetect is
+/// named "d", from starting (state change to PAUSED fails).
+inline MessageError startError(const std::string &launch)
+{
+	GstElement *pipeline = gst_parse_launch(launch.c_str(), nullptr);
+	EXPECT_NE(pipeline, nullptr);
+	EXPECT_EQ(gst_element_set_state(pipeline, GST_STATE_PAUSED), GST_STATE_CHANGE_FAILURE);
+	GstBus *bus = gst_element_get_bus(pipeline);
+	GstMessage *msg = gst_bus_pop_filtered(bus, GST_MESSAGE_ERROR);
+	EXPECT_NE(msg, nullptr);
+	EXPECT_STREQ(msg ? GST_OBJECT_NAME(GST_MESSAGE_SRC(msg)) : "", "d");
+	const MessageError e = msg ? MessageError(msg) : MessageError();
+	if (msg)
+		gst_message_unref(msg);
+	gst_object_unref(bus);
+	gst_element_set_state(pipeline, GST_STATE_NULL);
+	gst_object_unref(pipeline);
+	return e;
+}
+
+/// A rotation matrix, row-major, of `angle` radians about the unit axis.
+inline std::array<double, 9> rotation(const std::array<double, 3> &axis, double angle)
+{
+	const double c = std::cos(angle), s = std::sin(angle), t = 1 - c;
+	const double x = axis[0], y = axis[1], z = axis[2];
+	return { t * x * x + c,     t * x * y - s * z, t * x * z + s * y, t * x * y + s * z, t * y * y + c,
+		 t * y * z - s * x, t * x * z - s * y, t * y * z + s * x, t * z * z + c };
+}
+
+/// The marker-to-camera rotation of a marker turned by `r` (row-major) from
+/// facing the camera: the aruco frame (z out of the marker, towards the
+/// camera) flipped by 180 degrees about x first.
+inline std::array<double, 9> facingCamera(const std::array<double, 9> &r)
+{
+	const double flip[9] = { 1, 0, 0, 0, -1, 0, 0, 0, -1 };
+	std::array<double, 9> m{};
+	for (int i = 0; i < 3; ++i)
+		for (int j = 0; j < 3; ++j)
+			m[3 * i + j] = r[3 * i] * flip[j] + r[3 * i + 1] * flip[3 + j] + r[3 * i + 2] * flip[6 + j];
+	return m;
+}
+
+/// A marker of side `side` (metres) at rotation `m` (marker to camera,
+/// row-major) and translation `t`, seen through a pinhole camera.
+inline Placed posedMarker(int id, double fx, double fy, double cx, double cy, double side,
+			  const std::array<double, 9> &m, const std::array<double, 3> &t)
+{
+	const double hs = side / 2;
+	const double obj[4][3] = { { -hs, hs, 0 }, { hs, hs, 0 }, { hs, -hs, 0 }, { -hs, -hs, 0 } };
+	Placed placed{ id, {} };
+	for (int k = 0; k < 4; ++k) {
+		double p[3];
+		for (int i = 0; i < 3; ++i)
+			p[i] = m[3 * i] * obj[k][0] + m[3 * i + 1] * obj[k][1] + m[3 * i + 2] * obj[k][2] + t[i];
+		placed.corners[static_cast<std::size_t>(k)] = { static_cast<float>(fx * p[0] / p[2] + cx),
+								static_cast<float>(fy * p[1] / p[2] + cy) };
+	}
+	return placed;
+}
+
+/// A directory of its own for the files a test writes; removed with them.
+struct TempDir {
+	TempDir()
+	{
+		gchar *dir = g_dir_make_tmp("frappe-gst-XXXXXX", nullptr);
+		EXPECT_NE(dir, nullptr);
+		path = dir ? dir : "";
+		g_free(dir);
+	}
+	~TempDir()
+	{
+		for (const std::string &f : files)
+			g_remove(f.c_str());
+		g_rmdir(path.c_str());
+	}
+	TempDir(const TempDir &) = delete;
+	TempDir &operator=(const TempDir &) = delete;
+	/// Writes `text` to the file `name` in the directory; its path.
+	std::string write(const std::string &name, const std::string &text)
+	{
+		const std::string file = path + "/" + name;
+		EXPECT_TRUE(g_file_set_contents(file.c_str(), text.data(), static_cast<gssize>(text.size()), nullptr));
+		files.push_back(file);
+		return file;
+	}
+	std::string path;
+	std::vector<std::string> files;
+};
 
 inline const frappe::Dictionary &dict(const char *name)
 {

@@ -402,35 +402,10 @@ TEST(Properties, DefaultsAndArrays)
 TEST(Pose, MatchesKnownCamera)
 {
 	const double fx = 600.0, fy = 600.0, cx = 319.5, cy = 239.5, side = 0.08;
-	const double tvec[3] = { 0.03, -0.02, 0.55 };
+	const std::array<double, 3> tvec{ 0.03, -0.02, 0.55 };
 	/* Rotation: 25 degrees about an axis tilted in x and y. */
-	const double ax[3] = { 0.6, 0.8, 0.0 }, angle = 25.0 * G_PI / 180.0;
-	double R[9];
-	{
-		const double c = std::cos(angle), s = std::sin(angle), t = 1 - c;
-		const double x = ax[0], y = ax[1], z = ax[2];
-		const double r[9] = { t * x * x + c,     t * x * y - s * z, t * x * z + s * y,
-				      t * x * y + s * z, t * y * y + c,     t * y * z - s * x,
-				      t * x * z - s * y, t * y * z + s * x, t * z * z + c };
-		std::copy(r, r + 9, R);
-	}
-	/* The marker faces the camera: rotate the aruco frame (z out of the
-	 * marker, towards the camera) by 180 degrees about x first. */
-	const double flip[9] = { 1, 0, 0, 0, -1, 0, 0, 0, -1 };
-	double M[9];
-	for (int i = 0; i < 3; ++i)
-		for (int j = 0; j < 3; ++j)
-			M[3 * i + j] = R[3 * i] * flip[j] + R[3 * i + 1] * flip[3 + j] + R[3 * i + 2] * flip[6 + j];
-	const double hs = side / 2;
-	const double obj[4][3] = { { -hs, hs, 0 }, { hs, hs, 0 }, { hs, -hs, 0 }, { -hs, -hs, 0 } };
-	Placed placed{ 5, {} };
-	for (int k = 0; k < 4; ++k) {
-		double p[3];
-		for (int i = 0; i < 3; ++i)
-			p[i] = M[3 * i] * obj[k][0] + M[3 * i + 1] * obj[k][1] + M[3 * i + 2] * obj[k][2] + tvec[i];
-		placed.corners[static_cast<std::size_t>(k)] = { static_cast<float>(fx * p[0] / p[2] + cx),
-								static_cast<float>(fy * p[1] / p[2] + cy) };
-	}
+	const std::array<double, 9> M = facingCamera(rotation({ 0.6, 0.8, 0.0 }, 25.0 * G_PI / 180.0));
+	const Placed placed = posedMarker(5, fx, fy, cx, cy, side, M, tvec);
 
 	FrameSpec spec{ GST_VIDEO_FORMAT_I420, 640, 480, 0 };
 	GstHarness *h = newHarness("frappedetect marker-size=0.08 annotate=true", spec);
@@ -452,15 +427,7 @@ TEST(Pose, MatchesKnownCamera)
 
 	/* The rotation: z of the marker points back at the camera. */
 	const double th = std::sqrt(m->rvec[0] * m->rvec[0] + m->rvec[1] * m->rvec[1] + m->rvec[2] * m->rvec[2]);
-	double Rm[9];
-	{
-		const double x = m->rvec[0] / th, y = m->rvec[1] / th, z = m->rvec[2] / th;
-		const double c = std::cos(th), s = std::sin(th), t = 1 - c;
-		const double r[9] = { t * x * x + c,     t * x * y - s * z, t * x * z + s * y,
-				      t * x * y + s * z, t * y * y + c,     t * y * z - s * x,
-				      t * x * z - s * y, t * y * z + s * x, t * z * z + c };
-		std::copy(r, r + 9, Rm);
-	}
+	const std::array<double, 9> Rm = rotation({ m->rvec[0] / th, m->rvec[1] / th, m->rvec[2] / th }, th);
 	for (int i = 0; i < 9; ++i)
 		EXPECT_NEAR(Rm[i], M[i], 0.03) << "R[" << i << "]";
 	gst_buffer_unref(out);

@@ -26,23 +26,6 @@ namespace {
 constexpr GstClockTime kFrame = GST_SECOND / 30;
 const char *const kWarning = "Video buffer does not hold the frame it describes; passed through without detection";
 
-struct Harness {
-	Harness(const char *launch, const FrameSpec &spec)
-		: h(gst_harness_new_parse(launch)), bus(gst_bus_new())
-	{
-		gst_harness_set_src_caps_str(h, capsString(spec).c_str());
-		gst_element_set_bus(h->element, bus);
-	}
-	~Harness()
-	{
-		gst_element_set_bus(h->element, nullptr);
-		gst_object_unref(bus);
-		gst_harness_teardown(h);
-	}
-	GstHarness *h;
-	GstBus *bus;
-};
-
 /* A buffer of `size` bytes (a ramp, so a copy or a write shows) with a
  * GstVideoMeta claiming the given layout. */
 GstBuffer *lyingBuffer(gsize size, GstVideoFormat format, guint width, guint height,
@@ -73,30 +56,6 @@ std::vector<std::uint8_t> bytesOf(GstBuffer *buf)
 	return out;
 }
 
-/* Every message on the bus, oldest first (gst_bus_pop_filtered would
- * throw away the others). */
-struct BusMessages {
-	explicit BusMessages(GstBus *bus)
-	{
-		while (GstMessage *m = gst_bus_pop(bus))
-			all.push_back(m);
-	}
-	~BusMessages()
-	{
-		for (GstMessage *m : all)
-			gst_message_unref(m);
-	}
-	std::vector<GstMessage *> of(GstMessageType type) const
-	{
-		std::vector<GstMessage *> out;
-		for (GstMessage *m : all)
-			if (GST_MESSAGE_TYPE(m) == type)
-				out.push_back(m);
-		return out;
-	}
-	std::vector<GstMessage *> all;
-};
-
 /* The element's warning about a lying buffer, its debug text naming `detail`. */
 void expectLieWarning(GstMessage *msg, const std::string &detail)
 {
@@ -115,7 +74,7 @@ void expectLieWarning(GstMessage *msg, const std::string &detail)
  * after one warning naming `detail` and no frappedetect message. */
 void expectPassedThrough(const char *launch, const FrameSpec &caps, GstBuffer *lying, const std::string &detail)
 {
-	Harness t(launch, caps);
+	BusHarness t(launch, caps);
 	const auto before = bytesOf(lying);
 	gst_buffer_ref(lying);
 	ASSERT_EQ(gst_harness_push(t.h, lying), GST_FLOW_OK);
@@ -193,7 +152,7 @@ TEST(Lying, BufferWithoutMemory)
  * without a warning, and does not use up the one for an empty buffer. */
 TEST(Lying, EmptyGapBufferIsNoLie)
 {
-	Harness t("frappedetect", kGray64);
+	BusHarness t("frappedetect", kGray64);
 	GstBuffer *gap = gst_buffer_new();
 	GST_BUFFER_FLAG_SET(gap, GST_BUFFER_FLAG_GAP);
 	GST_BUFFER_PTS(gap) = 0;
@@ -237,7 +196,7 @@ TEST(Lying, ChromaPlanesCountOnlyWhenAnnotating)
 				   { 0, GST_VIDEO_INFO_PLANE_OFFSET(&info, 1), size - 10 }, { 640, 320, 320 });
 	};
 	{
-		Harness t("frappedetect", kI420);
+		BusHarness t("frappedetect", kI420);
 		GstBuffer *out = gst_harness_push_and_pull(t.h, buffer());
 		ASSERT_NE(out, nullptr);
 		gst_buffer_unref(out);
@@ -251,7 +210,7 @@ TEST(Lying, ChromaPlanesCountOnlyWhenAnnotating)
 /* One warning per kind of lie, not one per frame; every buffer still out. */
 TEST(Lying, OneWarningPerKind)
 {
-	Harness t("frappedetect", kGray64);
+	BusHarness t("frappedetect", kGray64);
 	for (int i = 0; i < 5; ++i)
 		ASSERT_EQ(gst_harness_push(t.h, lyingBuffer(4096, GST_VIDEO_FORMAT_GRAY8, 64, 64, { 0 }, { 256 },
 							    static_cast<GstClockTime>(i) * kFrame)),
@@ -271,7 +230,7 @@ TEST(Lying, OneWarningPerKind)
 TEST(Lying, PipelinedKeepsOrder)
 {
 	const FrameSpec spec{ GST_VIDEO_FORMAT_GRAY8, 640, 480, 0 };
-	Harness t("frappedetect pipelined=true", spec);
+	BusHarness t("frappedetect pipelined=true", spec);
 	auto good = [&](int i) {
 		return makeFrame(spec, { square(i, 100.0f, 80.0f, 150.0f) }, dict("aruco_mip_36h12"),
 				 static_cast<GstClockTime>(i) * kFrame, kFrame);
@@ -314,7 +273,7 @@ TEST(Lying, PipelinedKeepsOrder)
 TEST(Lying, CapsBeyondMaxPixelsAreRefused)
 {
 	const FrameSpec huge{ GST_VIDEO_FORMAT_GRAY8, 8192, 8193, 0 };
-	Harness t("frappedetect", huge);
+	BusHarness t("frappedetect", huge);
 	EXPECT_EQ(gst_harness_push(t.h, gst_buffer_new_allocate(nullptr, 64, nullptr)), GST_FLOW_NOT_NEGOTIATED);
 	EXPECT_EQ(gst_harness_buffers_received(t.h), 0u);
 	GstMessage *msg = gst_bus_pop_filtered(t.bus, GST_MESSAGE_ERROR);
@@ -333,7 +292,7 @@ TEST(Lying, CapsBeyondMaxPixelsAreRefused)
 TEST(Qos, LateBufferDroppedUnlessQosIsOff)
 {
 	for (const bool qos : { true, false }) {
-		Harness t(qos ? "frappedetect" : "frappedetect qos=false", kGray64);
+		BusHarness t(qos ? "frappedetect" : "frappedetect qos=false", kGray64);
 		EXPECT_EQ(gst_harness_push(t.h, makeFrame(kGray64, {}, dict("aruco_mip_36h12"), 0)), GST_FLOW_OK);
 		/* Downstream reports the frame at 1 s rendered 100 ms late. */
 		ASSERT_TRUE(gst_harness_push_upstream_event(
