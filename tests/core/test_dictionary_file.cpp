@@ -22,7 +22,7 @@ using namespace frappe::test;
 
 namespace {
 
-const std::string kSource = FRAPPE_SOURCE_DIR;
+const std::string kSource = FRAPPE_SOURCE_ROOT;
 
 void expectSame(const Dictionary &got, const Dictionary &want)
 {
