@@ -3,7 +3,7 @@
 //
 //   frappe-detect photo.jpg [--annotate out.png]      people
 //   frappe-detect --list L --out D.jsonl --repeat N   benchmarks (DETECTOR-CONTRACT.md)
-//   frappe-detect -                                   an image on stdin
+//   frappe-detect --calibration C --marker-size M -   robots: pose, an image on stdin
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
@@ -25,6 +25,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "annotate.h"
+#include "cli_pose.h"
 #include "cli_text.h"
 #include "image_check.h"
 #include "frappe/frappe.h"
@@ -76,6 +77,14 @@ const char kUsage[] =
 	"      --version           print the version\n"
 	"  -h, --help              this text\n"
 	"\n"
+	"pose (each marker's rvec, tvec in metres and reprojection error; OpenCV's frames):\n"
+	"      --calibration FILE  camera calibration: ROS camera_info YAML or OpenCV YAML/XML;\n"
+	"                          scaled to images of another size with the same aspect\n"
+	"      --camera FX,FY,CX,CY  a pinhole camera without distortion, instead\n"
+	"      --marker-size M     the markers' side in metres (the black border's outside)\n"
+	"      --marker-sizes SPEC  sides of some ids, \"0:0.05,7:0.1\"; the others\n"
+	"                          --marker-size's, or no pose\n"
+	"\n"
 	"Images are read one at a time and refused, with an error line, when larger\n"
 	"than 2^26 pixels (read from the header, before decoding) or cut short.\n"
 	"Exit status: 0, 1 when an image failed, 2 for bad options or files of options.\n";
@@ -86,6 +95,9 @@ struct Options {
 	std::string list, out, annotate, backend = "auto";
 	int repeat = 1;
 	bool json = false, stats = false;
+	/* Pose: a camera and the sizes, or neither. */
+	std::optional<frappe::Camera> camera;
+	frappe::MarkerSizes sizes;
 };
 
 [[noreturn]] void usageError(const std::string &msg)
@@ -150,10 +162,41 @@ void useDictionary(Options &o, const std::string &name)
 	}
 }
 
+/* The pose options, checked together once all are read. */
+void usePose(Options &o, const std::string &calibration, const std::string &camera, double size,
+	     const std::string &sizes)
+{
+	if (!calibration.empty() && !camera.empty())
+		usageError("--calibration and --camera: give one camera");
+	if (!calibration.empty()) {
+		try {
+			o.camera = frappe::readCalibration(calibration);
+		} catch (const std::exception &e) {
+			usageError(std::string("--calibration: ") + e.what());
+		}
+	} else if (!camera.empty()) {
+		frappe::Camera c;
+		std::string error;
+		if (!frappe::cli::parseCameraSpec(camera, c, error))
+			usageError("--camera " + error);
+		o.camera = c;
+	}
+	try {
+		o.sizes = frappe::MarkerSizes::parse(sizes, size);
+	} catch (const std::exception &e) {
+		usageError(std::string("--marker-sizes: ") + e.what());
+	}
+	if (o.camera && !o.sizes.any())
+		usageError("a camera without marker sizes: add --marker-size M (metres) or --marker-sizes");
+	if (!o.camera && o.sizes.any())
+		usageError("marker sizes without a camera: add --calibration FILE or --camera fx,fy,cx,cy");
+}
+
 Options parse(int argc, char **argv)
 {
 	Options o;
-
+	std::string calibration, camera, sizes;
+	double size = 0.0;
 	for (int i = 1; i < argc; ++i) {
 		const std::string a = argv[i];
 		auto value = [&]() -> std::string {
@@ -175,6 +218,20 @@ Options parse(int argc, char **argv)
 			std::exit(0);
 		} else if (a == "-d" || a == "--dictionary") {
 			useDictionary(o, value());
+		} else if (a == "--calibration") {
+			calibration = value();
+			if (calibration.empty())
+				usageError("--calibration needs a file");
+		} else if (a == "--camera") {
+			camera = value();
+			if (camera.empty())
+				usageError("--camera needs fx,fy,cx,cy");
+		} else if (a == "--marker-size") {
+			size = parseNumber<double>(a, value());
+			if (!(size > 0.0 && std::isfinite(size)))
+				usageError("--marker-size must be a side in metres above 0, got " + std::string(argv[i]));
+		} else if (a == "--marker-sizes") {
+			sizes = value();
 		} else if (a == "--mode") {
 			const std::string m = value();
 			if (m == "normal")
@@ -219,6 +276,7 @@ Options parse(int argc, char **argv)
 			o.images.push_back(a);
 		}
 	}
+	usePose(o, calibration, camera, size, sizes);
 	if (!o.list.empty())
 		readList(o.list, o.images);
 	if (o.images.empty())
@@ -256,6 +314,8 @@ std::string jsonLine(const std::string &image, const std::vector<Marker> &marker
 		}
 		std::snprintf(buf, sizeof(buf), "%.3f", m.margin);
 		o << "], \"hamming\": " << m.hamming << ", \"margin\": " << buf;
+		if (extras.poses && (*extras.poses)[i])
+			o << frappe::cli::poseJson(*(*extras.poses)[i]);
 		o << "}";
 	}
 	std::snprintf(buf, sizeof(buf), "%.4f", ms);
@@ -520,8 +580,26 @@ private:
 		}
 	}
 
+	/* The markers' poses, with the camera fitted to the image's size. */
+	void addPoses(Frame &f)
+	{
+		if (!opt_.camera || !f.error.empty())
+			return;
+		std::string note, error;
+		const frappe::Camera *camera = fitter_->fit(f.gray.cols, f.gray.rows, note, error);
+		if (!note.empty())
+			std::cerr << "frappe-detect: " << note << "\n";
+		if (!camera) {
+			f.error = (f.path == "-" ? "standard input" : f.path) + ": " + error;
+			std::cerr << "frappe-detect: " << f.error << "\n";
+			return;
+		}
+		f.poses = frappe::cli::markerPoses(f.markers, opt_.sizes, *camera);
+	}
+
 	void write(Frame &f)
 	{
+		addPoses(f);
 		++total_;
 		if (!f.error.empty())
 			++failed_;
@@ -551,6 +629,8 @@ private:
 				for (const auto &p : m.corners)
 					std::printf(" (%.2f, %.2f)", p.x, p.y);
 				std::printf("\n");
+				if (!f.poses.empty() && f.poses[i])
+					std::printf("           %s\n", frappe::cli::poseText(*f.poses[i]).c_str());
 			}
 			if (opt_.stats) {
 				std::printf("  stages:");
@@ -594,6 +674,8 @@ private:
 	}
 
 	const Options &opt_;
+	std::optional<frappe::cli::CameraFitter> fitter_ =
+		opt_.camera ? std::optional<frappe::cli::CameraFitter>(*opt_.camera) : std::nullopt;
 	frappe::Pipeline &pipeline_;
 	std::FILE *out_;
 	const bool serial_, many_;

@@ -1,10 +1,13 @@
 #!/usr/bin/env python3
 """frappe-detect's options of issue 13: --json --stats lines that stay JSON,
-the untimed warm-up, an image on standard input, --dictionary FILE.
+the untimed warm-up, an image on standard input, --dictionary FILE, and
+pose (--camera, --calibration, --marker-size, --marker-sizes) on the sample
+image against the geometry it was rendered with.
 
 usage: test_cli_options.py FRAPPE_DETECT FRAPPE_RENDER
 """
 import json
+import math
 import os
 import subprocess
 import sys
@@ -114,6 +117,95 @@ def dictionary_files(exe, render, sample, expected, tmp):
           'neither a name nor a file: exit 2, the names listed')
 
 
+def diagonal_centre(c):
+    """Where the quad's diagonals cross: the projection of the square's centre."""
+    (x0, y0), (x1, y1), (x2, y2), (x3, y3) = c
+    d1x, d1y, d2x, d2y = x2 - x0, y2 - y0, x3 - x1, y3 - y1
+    t = ((x1 - x0) * d2y - (y1 - y0) * d2x) / (d1x * d2y - d1y * d2x)
+    return x0 + t * d1x, y0 + t * d1y
+
+
+def rendering_camera(corners):
+    """frappe-render --scene draws each marker with perspectiveSquare: a
+    pinhole camera on the square's axis, 4 sides away, of focal length 4 x
+    the side in pixels, its centre where the square's centre projects;
+    tilted about the square's x axis, rolled about the optical axis. The top
+    and bottom edges lie at depths 4 -+ sin(tilt) / 2 sides, so their
+    lengths give the tilt and then the side. The marker's centre is at (0, 0,
+    4 sides) in that camera."""
+    cx, cy = diagonal_centre(corners)
+    top, bottom = math.dist(corners[0], corners[1]), math.dist(corners[3], corners[2])
+    s = 8 * (top - bottom) / (top + bottom)
+    side = top * (4 - 0.5 * s) / 4
+    return 4 * side, cx, cy
+
+
+def pose(exe, sample, expected, tmp):
+    size = 0.05
+    for truth in expected['markers']:
+        f, cx, cy = rendering_camera(truth['corners'])
+        r = run(exe, '--json', '--camera', '%.6f,%.6f,%.6f,%.6f' % (f, f, cx, cy), '--marker-size', str(size), sample)
+        m = next(m for m in json_lines(r)[0]['markers'] if m['id'] == truth['id'])
+        t = m['tvec']
+        off = math.dist(t, (0, 0, 4 * size))
+        check(r.returncode == 0 and off < 0.01 * 4 * size and m['pose_error'] < 0.5,
+              'id %d: tvec %s within 1%% of (0, 0, %.2f) m in its rendering camera; reprojection %.3f px'
+              % (truth['id'], ['%.4f' % v for v in t], 4 * size, m['pose_error']))
+        check(len(m['rvec']) == 3, 'rvec given')
+
+    # One camera for all: the id 17's; --marker-sizes gives 10 cm to id 17.
+    truth = next(t for t in expected['markers'] if t['id'] == 17)
+    f, cx, cy = rendering_camera(truth['corners'])
+    camera = '%.6f,%.6f,%.6f,%.6f' % (f, f, cx, cy)
+    r = run(exe, '--json', '--camera', camera, '--marker-sizes', '17:0.1', sample)
+    markers = json_lines(r)[0]['markers']
+    with_pose = [m['id'] for m in markers if 'tvec' in m]
+    check(with_pose == [17], 'only the ids with a size get a pose (%s)' % with_pose)
+    m17 = next(m for m in markers if m['id'] == 17)
+    check(abs(m17['tvec'][2] - 0.4) < 0.004, '--marker-sizes 17:0.1: twice as far (%.4f m)' % m17['tvec'][2])
+    r = run(exe, '--camera', camera, '--marker-size', '0.05', sample)
+    check(r.returncode == 0 and 'distance 0.2' in text(r.stdout), 'the text output gives the distance')
+
+    # A calibration of twice the size is scaled, with a note; another
+    # aspect ratio is an error line.
+    def ros(path, w, h, fx, cx_, cy_):
+        with open(path, 'w') as out:
+            out.write('image_width: %d\nimage_height: %d\ncamera_name: test\ncamera_matrix:\n  rows: 3\n  cols: 3\n'
+                      '  data: [%.6f, 0, %.6f, 0, %.6f, %.6f, 0, 0, 1]\ndistortion_model: plumb_bob\n'
+                      'distortion_coefficients:\n  rows: 1\n  cols: 5\n  data: [0, 0, 0, 0, 0]\n'
+                      % (w, h, fx, cx_, fx, cy_))
+    double = os.path.join(tmp, 'double.yaml')
+    ros(double, 1280, 960, 2 * f, (cx + 0.5) * 2 - 0.5, (cy + 0.5) * 2 - 0.5)
+    r = run(exe, '--json', '--calibration', double, '--marker-size', '0.05', sample)
+    m17 = next(m for m in json_lines(r)[0]['markers'] if m['id'] == 17)
+    check(r.returncode == 0 and math.dist(m17['tvec'], (0, 0, 0.2)) < 0.002,
+          '--calibration for 1280 x 960 scaled to 640 x 480: the same pose')
+    check('scaled to the image\'s 640 x 480' in text(r.stderr), 'the scaling noted on stderr')
+    wide = os.path.join(tmp, 'wide.yaml')
+    ros(wide, 1280, 720, f, cx, cy)
+    r = run(exe, '--json', '--calibration', wide, '--marker-size', '0.05', sample)
+    line = json_lines(r)[0]
+    check(r.returncode == 1 and 'another aspect ratio' in line.get('error', ''),
+          'a calibration of another aspect ratio: an error line, exit 1')
+
+    # Bad pose options: exit 2, saying what.
+    garbage = os.path.join(tmp, 'garbage.yaml')
+    with open(garbage, 'w') as out:
+        out.write('hello: world\n')
+    for args, what in ((['--calibration', garbage, '--marker-size', '0.05'], garbage),
+                       (['--calibration', os.path.join(tmp, 'none.yaml'), '--marker-size', '0.05'], 'none.yaml'),
+                       (['--camera', camera, '--marker-sizes', '17:0.1,x'], '--marker-sizes'),
+                       (['--camera', camera, '--marker-sizes', '17:-1'], '--marker-sizes'),
+                       (['--camera', '700,700,320', '--marker-size', '0.05'], '--camera'),
+                       (['--camera', camera, '--marker-size', '0'], '--marker-size'),
+                       (['--camera', camera], 'without marker sizes'),
+                       (['--marker-size', '0.05'], 'without a camera'),
+                       (['--camera', camera, '--calibration', double, '--marker-size', '0.05'], 'give one')):
+        r = run(exe, *args, sample)
+        check(r.returncode == 2 and what in text(r.stderr) and 'terminate' not in text(r.stderr),
+              '%s: exit 2, "%s"' % (' '.join(args), what))
+
+
 def main():
     exe, render = sys.argv[1], sys.argv[2]
     sample = os.path.join(SAMPLES, 'markers-36h12.png')
@@ -124,6 +216,7 @@ def main():
         stats_and_warm_up(exe, sample, scene)
         standard_input(exe, sample)
         dictionary_files(exe, render, sample, expected, tmp)
+        pose(exe, sample, expected, tmp)
     return 0
 
 
