@@ -3,8 +3,10 @@
 //
 //   frappe-detect photo.jpg [--annotate out.png]      people
 //   frappe-detect --list L --out D.jsonl --repeat N   benchmarks (DETECTOR-CONTRACT.md)
+//   frappe-detect --calibration C --marker-size M -   robots: pose, an image on stdin
 #include <algorithm>
 #include <cerrno>
+#include <cmath>
 #include <cstring>
 #include <deque>
 #include <chrono>
@@ -15,6 +17,7 @@
 #include <iostream>
 #include <limits>
 #include <new>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -22,6 +25,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "annotate.h"
+#include "cli_pose.h"
 #include "cli_text.h"
 #include "image_check.h"
 #include "frappe/frappe.h"
@@ -34,13 +38,15 @@ using frappe::Detector;
 using frappe::Marker;
 
 const char kUsage[] =
-	"usage: frappe-detect [options] IMAGE...\n"
+	"usage: frappe-detect [options] IMAGE...   (- reads one image from standard input)\n"
 	"       frappe-detect [options] --list LIST.txt --out DETS.jsonl [--repeat N]\n"
 	"\n"
 	"Finds square fiducial markers (ArUco, AprilTag) in 8-bit images.\n"
 	"\n"
 	"options:\n"
-	"  -d, --dictionary NAME   marker family (default aruco_mip_36h12); see --dictionaries\n"
+	"  -d, --dictionary NAME|FILE  marker family (default aruco_mip_36h12), see\n"
+	"                          --dictionaries; else a file of your own (the text format of\n"
+	"                          frappe-core/dictionaries, or OpenCV's aruco YAML/XML)\n"
 	"      --mode MODE         normal (default) or ascale (adaptive scaling over a sequence)\n"
 	"      --threads T         images detected at once, each on a thread of its own:\n"
 	"                          1 (default), 0 = one per core; time_ms is then each\n"
@@ -58,18 +64,30 @@ const char kUsage[] =
 	"                          kernels on an emulator: slow, bit-exact) (default auto)\n"
 	"  -a, --annotate PATH     write the image with the markers drawn (a folder for several images)\n"
 	"      --json              print one JSON line per image instead of text\n"
-	"      --stats             print per-stage timings\n"
+	"      --stats             per-stage timings: a line of text, or with --json a \"stats\"\n"
+	"                          object in each image's line; the first image's also gives\n"
+	"                          the untimed warm-up detection run before it (warm_up_ms)\n"
 	"      --list FILE         images to process, one path per line (a regular file of\n"
 	"                          at most 64 MiB and 1000000 images)\n"
 	"      --out FILE          JSON lines output, one per listed image, in order; a\n"
 	"                          name's bytes that are not UTF-8 are written \\u00XX\n"
-	"      --repeat N          time each image over N runs, report the median (default 1)\n"
+	"      --repeat N          time each image over N runs, report the median (default 1);\n"
+	"                          one untimed warm-up detection runs first either way\n"
 	"      --dictionaries      list the built-in dictionaries\n"
 	"      --version           print the version\n"
+	"  -h, --help              this text\n"
+	"\n"
+	"pose (each marker's rvec, tvec in metres and reprojection error; OpenCV's frames):\n"
+	"      --calibration FILE  camera calibration: ROS camera_info YAML or OpenCV YAML/XML;\n"
+	"                          scaled to images of another size with the same aspect\n"
+	"      --camera FX,FY,CX,CY  a pinhole camera without distortion, instead\n"
+	"      --marker-size M     the markers' side in metres (the black border's outside)\n"
+	"      --marker-sizes SPEC  sides of some ids, \"0:0.05,7:0.1\"; the others\n"
+	"                          --marker-size's, or no pose\n"
 	"\n"
 	"Images are read one at a time and refused, with an error line, when larger\n"
 	"than 2^26 pixels (read from the header, before decoding) or cut short.\n"
-	"  -h, --help              this text\n";
+	"Exit status: 0, 1 when an image failed, 2 for bad options or files of options.\n";
 
 struct Options {
 	Config config;
@@ -77,6 +95,9 @@ struct Options {
 	std::string list, out, annotate, backend = "auto";
 	int repeat = 1;
 	bool json = false, stats = false;
+	/* Pose: a camera and the sizes, or neither. */
+	std::optional<frappe::Camera> camera;
+	frappe::MarkerSizes sizes;
 };
 
 [[noreturn]] void usageError(const std::string &msg)
@@ -122,9 +143,60 @@ void readList(const std::string &list, std::vector<std::string> &images)
 	}
 }
 
+/* A built-in name first ("4x4_50" is the built-in even beside a file of
+ * that name; ./4x4_50 is the file), else a path to a file of one's own. */
+void useDictionary(Options &o, const std::string &name)
+{
+	if (frappe::findDictionary(name)) {
+		o.config.dictionary = name;
+		return;
+	}
+	std::error_code ec;
+	if (!std::filesystem::exists(name, ec))
+		usageError("unknown dictionary '" + name + "': neither a built-in name (" + frappe::dictionaryNames() +
+			   ") nor a file");
+	try {
+		o.config.custom_dictionary = frappe::loadDictionary(name);
+	} catch (const std::exception &e) {
+		usageError(std::string("--dictionary: ") + e.what());
+	}
+}
+
+/* The pose options, checked together once all are read. */
+void usePose(Options &o, const std::string &calibration, const std::string &camera, double size,
+	     const std::string &sizes)
+{
+	if (!calibration.empty() && !camera.empty())
+		usageError("--calibration and --camera: give one camera");
+	if (!calibration.empty()) {
+		try {
+			o.camera = frappe::readCalibration(calibration);
+		} catch (const std::exception &e) {
+			usageError(std::string("--calibration: ") + e.what());
+		}
+	} else if (!camera.empty()) {
+		frappe::Camera c;
+		std::string error;
+		if (!frappe::cli::parseCameraSpec(camera, c, error))
+			usageError("--camera " + error);
+		o.camera = c;
+	}
+	try {
+		o.sizes = frappe::MarkerSizes::parse(sizes, size);
+	} catch (const std::exception &e) {
+		usageError(std::string("--marker-sizes: ") + e.what());
+	}
+	if (o.camera && !o.sizes.any())
+		usageError("a camera without marker sizes: add --marker-size M (metres) or --marker-sizes");
+	if (!o.camera && o.sizes.any())
+		usageError("marker sizes without a camera: add --calibration FILE or --camera fx,fy,cx,cy");
+}
+
 Options parse(int argc, char **argv)
 {
 	Options o;
+	std::string calibration, camera, sizes;
+	double size = 0.0;
 	for (int i = 1; i < argc; ++i) {
 		const std::string a = argv[i];
 		auto value = [&]() -> std::string {
@@ -145,7 +217,21 @@ Options parse(int argc, char **argv)
 					  << d.defaultMaxHamming() << ", " << d.weakMaxHamming() << " with weak cells)\n";
 			std::exit(0);
 		} else if (a == "-d" || a == "--dictionary") {
-			o.config.dictionary = value();
+			useDictionary(o, value());
+		} else if (a == "--calibration") {
+			calibration = value();
+			if (calibration.empty())
+				usageError("--calibration needs a file");
+		} else if (a == "--camera") {
+			camera = value();
+			if (camera.empty())
+				usageError("--camera needs fx,fy,cx,cy");
+		} else if (a == "--marker-size") {
+			size = parseNumber<double>(a, value());
+			if (!(size > 0.0 && std::isfinite(size)))
+				usageError("--marker-size must be a side in metres above 0, got " + std::string(argv[i]));
+		} else if (a == "--marker-sizes") {
+			sizes = value();
 		} else if (a == "--mode") {
 			const std::string m = value();
 			if (m == "normal")
@@ -190,17 +276,26 @@ Options parse(int argc, char **argv)
 			o.images.push_back(a);
 		}
 	}
+	usePose(o, calibration, camera, size, sizes);
 	if (!o.list.empty())
 		readList(o.list, o.images);
 	if (o.images.empty())
 		usageError("no images given");
+	if (std::count(o.images.begin(), o.images.end(), "-") > 1)
+		usageError("- (standard input) can be read once only");
 	return o;
 }
 
 using frappe::cli::jsonEscape;
 
+/* What a line may carry beyond the contract's fields. */
+struct LineExtras {
+	const std::vector<std::optional<frappe::Pose>> *poses = nullptr; /* one per marker */
+	std::string stats; /* `"stats": {...}`, or empty */
+};
+
 std::string jsonLine(const std::string &image, const std::vector<Marker> &markers, double ms,
-		     const std::string &error)
+		     const std::string &error, const LineExtras &extras = {})
 {
 	std::ostringstream o;
 	o << "{\"image\": \"" << jsonEscape(image) << "\"";
@@ -218,10 +313,37 @@ std::string jsonLine(const std::string &image, const std::vector<Marker> &marker
 			o << buf;
 		}
 		std::snprintf(buf, sizeof(buf), "%.3f", m.margin);
-		o << "], \"hamming\": " << m.hamming << ", \"margin\": " << buf << "}";
+		o << "], \"hamming\": " << m.hamming << ", \"margin\": " << buf;
+		if (extras.poses && (*extras.poses)[i])
+			o << frappe::cli::poseJson(*(*extras.poses)[i]);
+		o << "}";
 	}
 	std::snprintf(buf, sizeof(buf), "%.4f", ms);
-	o << "], \"time_ms\": " << buf << "}";
+	o << "], \"time_ms\": " << buf;
+	if (!extras.stats.empty())
+		o << ", " << extras.stats;
+	o << "}";
+	return o.str();
+}
+
+/* The per-stage times as a JSON member; the warm-up's wall time when one
+ * ran before this image (below 0: none). */
+std::string statsJson(const frappe::StageTimes &times, double warmUpMs)
+{
+	std::ostringstream o;
+	char buf[32];
+	o << "\"stats\": {";
+	for (int s = 0; s < frappe::kStageCount; ++s) {
+		std::snprintf(buf, sizeof(buf), "%.4f", times.ms[s]);
+		o << (s ? ", " : "") << "\"" << frappe::stageName(static_cast<frappe::Stage>(s)) << "_ms\": " << buf;
+	}
+	std::snprintf(buf, sizeof(buf), "%.4f", times.total_ms);
+	o << ", \"total_ms\": " << buf;
+	if (warmUpMs >= 0.0) {
+		std::snprintf(buf, sizeof(buf), "%.4f", warmUpMs);
+		o << ", \"warm_up_ms\": " << buf;
+	}
+	o << "}";
 	return o.str();
 }
 
@@ -234,6 +356,8 @@ struct Frame {
 	std::vector<double> times_ms; /* one per repeat */
 	int in_flight = 0;            /* pushes whose result has not come back */
 	bool all_pushed = false;
+	double warm_up_ms = -1.0;     /* the untimed warm-up run on it, when one was */
+	std::vector<std::optional<frappe::Pose>> poses; /* one per marker, with a camera */
 };
 
 /* Reads, checks and decodes one image into f.gray, or sets f.error. The
@@ -242,6 +366,8 @@ struct Frame {
  * would return a partial image with a warning. */
 void loadImage(Frame &f, long long maxPixels)
 {
+	const bool fromStdin = f.path == "-";
+	const std::string name = fromStdin ? "standard input" : f.path;
 	/* Enough for any frame of maxPixels at 8 bytes a pixel (16-bit RGBA
 	 * stored raw) plus 16 MiB of metadata, 528 MiB by default; the bound on
 	 * formats we cannot read the size of. Under 2 GiB: cv::Mat's int size. */
@@ -249,19 +375,20 @@ void loadImage(Frame &f, long long maxPixels)
 		std::min<long long>(8 * maxPixels + (16 << 20), std::numeric_limits<std::int32_t>::max()));
 	std::vector<std::uint8_t> bytes;
 	try {
-		if (!frappe::cli::readFileBounded(f.path, fileLimit, bytes, f.error))
+		if (fromStdin ? !frappe::cli::readStreamBounded(0, name, fileLimit, bytes, f.error)
+			  : !frappe::cli::readFileBounded(f.path, fileLimit, bytes, f.error))
 			return;
 	} catch (const std::bad_alloc &) { /* a 32-bit Pi may not find the room */
-		f.error = "out of memory reading " + f.path;
+		f.error = "out of memory reading " + name;
 		return;
 	}
 	const frappe::cli::ImageHeader h = frappe::cli::inspectImage(bytes.data(), bytes.size());
 	if (!h.error.empty()) {
-		f.error = f.path + ": " + h.error;
+		f.error = name + ": " + h.error;
 		return;
 	}
 	if (h.format != frappe::cli::ImageFormat::Unknown && h.width > maxPixels / h.height) {
-		f.error = f.path + ": " + std::to_string(h.width) + " x " + std::to_string(h.height) + " " +
+		f.error = name + ": " + std::to_string(h.width) + " x " + std::to_string(h.height) + " " +
 			  frappe::cli::formatName(h.format) + ", more than the limit of " + std::to_string(maxPixels) +
 			  " pixels (Config::max_pixels); not decoded";
 		return;
@@ -270,20 +397,20 @@ void loadImage(Frame &f, long long maxPixels)
 		f.gray = cv::imdecode(cv::Mat(1, static_cast<int>(bytes.size()), CV_8UC1, bytes.data()), cv::IMREAD_GRAYSCALE);
 	} catch (const cv::Exception &e) {
 		f.gray.release();
-		f.error = "cannot decode " + f.path + " as an image (OpenCV: " + e.err + ")";
+		f.error = "cannot decode " + name + " as an image (OpenCV: " + e.err + ")";
 		return;
 	} catch (const std::bad_alloc &) {
-		f.error = "out of memory decoding " + f.path;
+		f.error = "out of memory decoding " + name;
 		return;
 	}
 	if (f.gray.empty()) {
-		f.error = "cannot decode " + f.path + " as an image";
+		f.error = "cannot decode " + name + " as an image";
 		return;
 	}
 	/* EXIF orientation may swap the sides, never the count. */
 	if (h.format != frappe::cli::ImageFormat::Unknown &&
 	    static_cast<long long>(f.gray.cols) * f.gray.rows != h.width * h.height) {
-		f.error = f.path + ": decoded " + std::to_string(f.gray.cols) + " x " + std::to_string(f.gray.rows) +
+		f.error = name + ": decoded " + std::to_string(f.gray.cols) + " x " + std::to_string(f.gray.rows) +
 			  ", the header says " + std::to_string(h.width) + " x " + std::to_string(h.height);
 		f.gray.release();
 	}
@@ -332,7 +459,9 @@ public:
 	{
 		using Clock = std::chrono::steady_clock;
 		const auto t0 = Clock::now();
-		bool warmed = opt_.repeat == 1; /* a warm-up only for timed repeats */
+		/* The first good image is detected once untimed: its time_ms would
+		 * otherwise include the buffers' growth and the threads' start. */
+		bool warmed = false;
 		for (const std::string &path : opt_.images) {
 			Frame &f = window_.emplace_back();
 			f.path = path;
@@ -340,7 +469,9 @@ public:
 			if (!f.error.empty())
 				std::cerr << "frappe-detect: " << f.error << "\n";
 			if (f.error.empty() && !warmed) {
+				const auto w0 = Clock::now();
 				warmUp(f);
+				f.warm_up_ms = std::chrono::duration<double, std::milli>(Clock::now() - w0).count();
 				warmed = true;
 			}
 			for (int r = 0; r < opt_.repeat && f.error.empty(); ++r)
@@ -449,38 +580,68 @@ private:
 		}
 	}
 
-	void write(const Frame &f)
+	/* The markers' poses, with the camera fitted to the image's size. */
+	void addPoses(Frame &f)
 	{
+		if (!opt_.camera || !f.error.empty())
+			return;
+		std::string note, error;
+		const frappe::Camera *camera = fitter_->fit(f.gray.cols, f.gray.rows, note, error);
+		if (!note.empty())
+			std::cerr << "frappe-detect: " << note << "\n";
+		if (!camera) {
+			f.error = (f.path == "-" ? "standard input" : f.path) + ": " + error;
+			std::cerr << "frappe-detect: " << f.error << "\n";
+			return;
+		}
+		f.poses = frappe::cli::markerPoses(f.markers, opt_.sizes, *camera);
+	}
+
+	void write(Frame &f)
+	{
+		addPoses(f);
 		++total_;
 		if (!f.error.empty())
 			++failed_;
 		const double ms = f.error.empty() && !f.times_ms.empty() ? median(f.times_ms) : 0.0;
+		LineExtras extras;
+		if (!f.poses.empty())
+			extras.poses = &f.poses;
 		if (out_) {
-			const std::string line = jsonLine(f.path, f.markers, ms, f.error) + "\n";
+			/* The contract's line, with the poses when asked for. */
+			const std::string line = jsonLine(f.path, f.markers, ms, f.error, extras) + "\n";
 			/* a line at a time: a run cut short keeps what it found */
 			if (std::fputs(line.c_str(), out_) < 0 || std::fflush(out_) != 0)
 				writeFailed_ = true;
 		}
 		if (opt_.json) {
-			std::cout << jsonLine(f.path, f.markers, ms, f.error) << "\n";
+			/* The stats inside the line: every line stays one JSON object. */
+			if (opt_.stats && f.error.empty())
+				extras.stats = statsJson(f.times, f.warm_up_ms);
+			std::cout << jsonLine(f.path, f.markers, ms, f.error, extras) << "\n";
 		} else if (f.error.empty() && opt_.out.empty()) {
 			std::printf("%s: %zu marker%s (%s) in %.2f ms\n", f.path.c_str(), f.markers.size(),
 				    f.markers.size() == 1 ? "" : "s",
 				    std::string(pipeline_.detector().dictionary().name).c_str(), ms);
-			for (const Marker &m : f.markers) {
+			for (std::size_t i = 0; i < f.markers.size(); ++i) {
+				const Marker &m = f.markers[i];
 				std::printf("  id %4d  hamming %d  margin %.2f  corners", m.id, m.hamming, m.margin);
 				for (const auto &p : m.corners)
 					std::printf(" (%.2f, %.2f)", p.x, p.y);
 				std::printf("\n");
+				if (!f.poses.empty() && f.poses[i])
+					std::printf("           %s\n", frappe::cli::poseText(*f.poses[i]).c_str());
 			}
-		}
-		if (opt_.stats && f.error.empty() && (opt_.json || opt_.out.empty())) {
-			std::printf("  stages:");
-			for (int s = 0; s < frappe::kStageCount; ++s)
-				std::printf(" %s %.3f ms",
-					    std::string(frappe::stageName(static_cast<frappe::Stage>(s))).c_str(),
-					    f.times.ms[s]);
-			std::printf("\n");
+			if (opt_.stats) {
+				std::printf("  stages:");
+				for (int s = 0; s < frappe::kStageCount; ++s)
+					std::printf(" %s %.3f ms",
+						    std::string(frappe::stageName(static_cast<frappe::Stage>(s))).c_str(),
+						    f.times.ms[s]);
+				std::printf("\n");
+				if (f.warm_up_ms >= 0.0)
+					std::printf("  warm-up before it, untimed: %.3f ms\n", f.warm_up_ms);
+			}
 		}
 		std::fflush(stdout);
 		if (!opt_.annotate.empty() && f.error.empty())
@@ -496,7 +657,9 @@ private:
 			annotateDirMade_ = true;
 		}
 		const std::string path =
-			many_ ? (fs::path(opt_.annotate) / fs::path(f.path).filename()).replace_extension(".png").string()
+			many_ ? (fs::path(opt_.annotate) / fs::path(f.path == "-" ? "stdin" : f.path).filename())
+					.replace_extension(".png")
+					.string()
 			      : opt_.annotate;
 		bool ok = false;
 		try {
@@ -511,6 +674,8 @@ private:
 	}
 
 	const Options &opt_;
+	std::optional<frappe::cli::CameraFitter> fitter_ =
+		opt_.camera ? std::optional<frappe::cli::CameraFitter>(*opt_.camera) : std::nullopt;
 	frappe::Pipeline &pipeline_;
 	std::FILE *out_;
 	const bool serial_, many_;

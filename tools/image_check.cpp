@@ -244,6 +244,42 @@ const char *formatName(ImageFormat format)
 	}
 }
 
+namespace {
+
+/* Reads fd to its end into `bytes`, never more than max bytes: false with
+ * `error` on a read error. `truncated` says whether more was there. */
+bool readUpTo(int fd, const std::string &name, std::size_t max, std::vector<std::uint8_t> &bytes, bool &truncated,
+	      std::string &error)
+{
+	std::size_t got = 0;
+	truncated = false;
+	for (;;) {
+		if (got == bytes.size()) {
+			if (got > max) {
+				truncated = true;
+				break;
+			}
+			/* Grow geometrically, to one byte past the limit at most. */
+			bytes.resize(std::min(max + 1, std::max<std::size_t>(64 << 10, 2 * got)));
+		}
+		const ssize_t r = ::read(fd, bytes.data() + got, bytes.size() - got);
+		if (r < 0 && errno == EINTR)
+			continue;
+		if (r < 0) {
+			error = "cannot read " + name + ": " + std::strerror(errno);
+			bytes.clear();
+			return false;
+		}
+		if (r == 0)
+			break;
+		got += static_cast<std::size_t>(r);
+	}
+	bytes.resize(got);
+	return true;
+}
+
+} // namespace
+
 bool readFileBounded(const std::string &path, std::size_t limit, std::vector<std::uint8_t> &bytes, std::string &error)
 {
 	bytes.clear();
@@ -266,31 +302,37 @@ bool readFileBounded(const std::string &path, std::size_t limit, std::vector<std
 		error = path + " is " + std::to_string(st.st_size) + " bytes, more than the limit of " +
 			std::to_string(limit);
 	} else {
-		/* The file may grow while we read: never past limit + 1. */
-		bytes.resize(static_cast<std::size_t>(st.st_size) + 1);
-		std::size_t got = 0;
-		ok = true;
-		while (got < bytes.size()) {
-			const ssize_t r = ::read(fd, bytes.data() + got, bytes.size() - got);
-			if (r < 0 && errno == EINTR)
-				continue;
-			if (r < 0) {
-				error = "cannot read " + path + ": " + std::strerror(errno);
-				ok = false;
-				break;
-			}
-			if (r == 0)
-				break;
-			got += static_cast<std::size_t>(r);
-		}
-		if (ok && got > static_cast<std::size_t>(st.st_size)) {
+		/* The file may grow while we read: never past its size + 1. */
+		bytes.reserve(static_cast<std::size_t>(st.st_size) + 1);
+		bool grew = false;
+		ok = readUpTo(fd, path, static_cast<std::size_t>(st.st_size), bytes, grew, error);
+		if (ok && grew) {
 			error = path + " grew while being read";
+			bytes.clear();
 			ok = false;
 		}
-		bytes.resize(ok ? got : 0);
 	}
 	::close(fd);
 	return ok;
+}
+
+bool readStreamBounded(int fd, const std::string &name, std::size_t limit, std::vector<std::uint8_t> &bytes,
+		       std::string &error)
+{
+	bytes.clear();
+	bool over = false;
+	if (!readUpTo(fd, name, limit, bytes, over, error))
+		return false;
+	if (over) {
+		error = name + " holds more than the limit of " + std::to_string(limit) + " bytes";
+		bytes.clear();
+		return false;
+	}
+	if (bytes.empty()) {
+		error = name + " is empty";
+		return false;
+	}
+	return true;
 }
 
 } // namespace frappe::cli

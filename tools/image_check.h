@@ -38,4 +38,10 @@ const char *formatName(ImageFormat format);
 bool readFileBounded(const std::string &path, std::size_t limit, std::vector<std::uint8_t> &bytes,
 		     std::string &error);
 
+/// Reads a stream (standard input: fd 0) to its end, at most `limit`
+/// bytes; false with `error` naming it ("standard input is empty", "...
+/// holds more than the limit of N bytes", a read error).
+bool readStreamBounded(int fd, const std::string &name, std::size_t limit, std::vector<std::uint8_t> &bytes,
+		       std::string &error);
+
 } // namespace frappe::cli

@@ -410,10 +410,9 @@ std::shared_ptr<const Dictionary> parse(std::string_view text, std::string_view 
 			src.fail(c.line, "a code with bits beyond the " + std::to_string(cells) + " cells of a " +
 						 std::to_string(p.side) + "x" + std::to_string(p.side) + " marker");
 	}
-	if (p.name.empty()) {
-		checkName(src, 1, fallbackName);
-		p.name = std::string(fallbackName);
-	}
+	/* A file's stem may be anything: cut, not refused. */
+	if (p.name.empty())
+		p.name = fallbackName.empty() ? "custom" : std::string(fallbackName.substr(0, kMaxNameBytes));
 
 	auto owned = std::make_shared<OwnedDictionary>();
 	owned->name = std::move(p.name);

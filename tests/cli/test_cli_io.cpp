@@ -3,12 +3,14 @@
 // and its JSON strings and numbers (tools/cli_text.h), on bytes made here.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <cstdio>
 #include <fstream>
 #include <string>
 #include <vector>
 
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include "cli_text.h"
@@ -214,6 +216,47 @@ TEST(ReadFileBounded, RefusesWhatIsNotARegularFileOrTooBig)
 	EXPECT_NE(error.find("cannot open"), std::string::npos) << error;
 	std::remove(file.c_str());
 	rmdir(dir);
+}
+
+/* Standard input as a pipe: read whole, refused when empty or beyond the
+ * limit, however the writer splits it. */
+TEST(ReadStreamBounded, WholeEmptyOrOverTheLimit)
+{
+	auto through = [](const std::string &data, std::size_t limit, Bytes &b, std::string &error) {
+		int fds[2];
+		EXPECT_EQ(pipe(fds), 0);
+		/* Written by a child process: a pipe holds only 64 KiB. */
+		const pid_t child = fork();
+		if (child == 0) {
+			close(fds[0]);
+			std::size_t at = 0;
+			while (at < data.size()) {
+				const ssize_t w = write(fds[1], data.data() + at, std::min<std::size_t>(1000, data.size() - at));
+				if (w <= 0)
+					break;
+				at += static_cast<std::size_t>(w);
+			}
+			_exit(0);
+		}
+		close(fds[1]);
+		const bool ok = readStreamBounded(fds[0], "standard input", limit, b, error);
+		close(fds[0]);
+		int status = 0;
+		waitpid(child, &status, 0);
+		return ok;
+	};
+	Bytes b;
+	std::string error;
+	std::string big(200000, 'x');
+	big[123456] = 'y';
+	ASSERT_TRUE(through(big, 200000, b, error)) << error;
+	ASSERT_EQ(b.size(), 200000u);
+	EXPECT_EQ(b[123456], 'y');
+	EXPECT_FALSE(through(big, 199999, b, error));
+	EXPECT_EQ(error, "standard input holds more than the limit of 199999 bytes");
+	EXPECT_TRUE(b.empty());
+	EXPECT_FALSE(through("", 100, b, error));
+	EXPECT_EQ(error, "standard input is empty");
 }
 
 TEST(JsonEscape, ValidUtf8IsKept)

@@ -99,6 +99,11 @@ TEST(DictionaryFile, TextWithoutHeaderCrlfAndSymmetricCode)
 	const auto e = parseDictionary("# dictionary: named\n0x0a8\n", "fallback");
 	EXPECT_EQ(e->name, "named");
 	EXPECT_EQ(e->min_hamming, 2);
+
+	/* A name from the caller is cut, never refused; YAML's name key wins. */
+	EXPECT_EQ(parseDictionary("0x0a8\n", "")->name, "custom");
+	EXPECT_EQ(parseDictionary("0x0a8\n", std::string(300, 'n'))->name, std::string(128, 'n'));
+	EXPECT_EQ(parseDictionary("nmarkers: 1\nname: yml\nmarkersize: 3\nmarker_0: '010101000'\n", "x")->name, "yml");
 }
 
 /* The detector reads a dictionary of the user's own, of the smallest and

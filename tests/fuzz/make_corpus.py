@@ -84,6 +84,25 @@ def main():
         with open(os.path.join(out, 'config-%d' % i), 'wb') as f:
             f.write(body)
 
+    # Dictionary files as a user writes them: the text format with and
+    # without its header, OpenCV's YAML and XML.
+    out = os.path.join(HERE, 'corpus', 'dictionary')
+    os.makedirs(out, exist_ok=True)
+    codes = [code('4x4_50', i) for i in range(5)]
+    seeds = {
+        'text-header': '# dictionary: mine\n# marker_side_bits: 4\n# codes: 5\n' +
+                       ''.join('0x%04x\n' % c for c in codes),
+        'text-bare': '\r\n'.join('0x%04x' % c for c in codes),
+        'opencv-yml': '%%YAML:1.0\n---\nnmarkers: 5\nmarkersize: 4\nmaxCorrectionBits: 1\n' +
+                      ''.join('marker_%d: "%s"\n' % (i, format(c, '016b')) for i, c in enumerate(codes)),
+        'opencv-xml': '<?xml version="1.0"?>\n<opencv_storage>\n<nmarkers>5</nmarkers>\n<markersize>4</markersize>\n' +
+                      ''.join('<marker_%d>"%s"</marker_%d>\n' % (i, format(c, '016b'), i) for i, c in enumerate(codes)) +
+                      '</opencv_storage>\n',
+    }
+    for name, text in seeds.items():
+        with open(os.path.join(out, name), 'w', newline='') as f:
+            f.write(text)
+
 
 if __name__ == '__main__':
     main()

@@ -77,11 +77,11 @@ FRAPPE_EXPORT std::uint64_t rotateCode(std::uint64_t code, int bits);
 ///   nmarkers, marker_0 .. marker_{N-1} as strings of n*n '0'/'1'
 ///   characters, row-major, 1 = white (the same bits), in any order.
 /// CRLF line ends and a UTF-8 byte-order mark are accepted; lines are at
-/// most 4096 bytes. The dictionary is named after the file (its stem)
-/// unless a `# dictionary:` header or a `name` key gives one (1 to 128
-/// bytes). Its min_hamming is computed over the codes and their rotations;
-/// a code that is its own rotation is accepted, making it 0 as for
-/// aruco_original (such a marker's orientation is ambiguous).
+/// most 4096 bytes. The dictionary is named after the file (its stem, cut
+/// to 128 bytes) unless a `# dictionary:` header or a `name` key gives one
+/// (1 to 128 bytes). Its min_hamming is computed over the codes and their
+/// rotations; a code that is its own rotation is accepted, making it 0 as
+/// for aruco_original (such a marker's orientation is ambiguous).
 /// opencv_max_correction is the file's maxCorrectionBits (or `#
 /// opencv_*_max_correction_bits` header), or 0.
 /// Throws std::runtime_error when the file cannot be read (missing, not a
