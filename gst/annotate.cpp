@@ -50,6 +50,12 @@ Pen outlinePen(double side)
 	return pen;
 }
 
+/* How far a pen's ink and halo reach from the centre line. */
+double reach(const Pen &pen)
+{
+	return pen.width / 2.0 + pen.halo;
+}
+
 /* Draws the strokes of all `paths` halos first, then inks: they meet, and
  * no halo may cut into a neighbour's ink. */
 void strokeTogether(Canvas &canvas, std::span<const Path> paths, std::span<const Pen> pens)
@@ -84,7 +90,7 @@ void drawAxes(Canvas &canvas, const Pose &pose, double size, const Camera &camer
 } // namespace
 
 Label placeLabel(const std::array<Point2f, 4> &corners, std::string_view text, int frameWidth, int frameHeight,
-		 Yuv ink)
+		 Yuv ink, std::span<const Marker> avoid)
 {
 	const double side = meanSide(corners);
 	const double minHeight = std::max(12.0, frameHeight / 40.0);
@@ -96,32 +102,53 @@ Label placeLabel(const std::array<Point2f, 4> &corners, std::string_view text, i
 	l.pen = textPen(l.height, ink);
 
 	/* Ink and halo around the cells; the gap keeps them off the outline's. */
-	const Pen outline = outlinePen(side);
-	const double margin = l.pen.width / 2.0 + l.pen.halo;
-	const double gap = margin + outline.width / 2.0 + outline.halo + 1.0;
+	const double margin = reach(l.pen);
+	const double gap = margin + reach(outlinePen(side)) + 1.0;
 	const Box b = cornerBox(corners);
-	const double cx = (b.x0 + b.x1) / 2.0, cy = (b.y0 + b.y1) / 2.0;
 	const double W = frameWidth, H = frameHeight;
 
-	auto fitsY = [&](double top) { return top - margin >= 0.0 && top + l.height + margin <= H - 1.0; };
-	auto fitsX = [&](double left) { return left - margin >= 0.0 && left + l.width + margin <= W - 1.0; };
-	const double above = b.y0 - gap - l.height, below = b.y1 + gap;
-	const double right = b.x1 + gap, left = b.x0 - gap - l.width;
-	l.left = cx - l.width / 2.0;
-	l.top = cy - l.height / 2.0;
-	if (fitsY(above))
-		l.top = above;
-	else if (fitsY(below))
-		l.top = below;
-	else if (fitsX(right))
-		l.left = right;
-	else if (fitsX(left))
-		l.left = left;
-	else
-		l.top = above;
-	/* Inside the frame, as far as it is wide and tall enough. */
-	l.left = std::max(margin, std::min(l.left, W - 1.0 - margin - l.width));
-	l.top = std::max(margin, std::min(l.top, H - 1.0 - margin - l.height));
+	/* Above, below, right, left of the marker. */
+	const double cx = (b.x0 + b.x1 - l.width) / 2.0, cy = (b.y0 + b.y1 - l.height) / 2.0;
+	const std::array<std::array<double, 2>, 4> spots{ {
+		{ cx, b.y0 - gap - l.height },
+		{ cx, b.y1 + gap },
+		{ b.x1 + gap, cy },
+		{ b.x0 - gap - l.width, cy },
+	} };
+	auto inside = [&](double left, double top) {
+		return left - margin >= 0.0 && left + l.width + margin <= W - 1.0 && top - margin >= 0.0 &&
+		       top + l.height + margin <= H - 1.0;
+	};
+	auto clear = [&](double left, double top) {
+		for (const Marker &m : avoid) {
+			const Box o = cornerBox(m.corners);
+			const double r = reach(outlinePen(meanSide(m.corners))) + margin;
+			if (left < o.x1 + r && left + l.width > o.x0 - r && top < o.y1 + r && top + l.height > o.y0 - r)
+				return false;
+		}
+		return true;
+	};
+	auto clamped = [&](std::array<double, 2> p) {
+		p[0] = std::max(margin, std::min(p[0], W - 1.0 - margin - l.width));
+		p[1] = std::max(margin, std::min(p[1], H - 1.0 - margin - l.height));
+		return p;
+	};
+	/* The first spot inside the frame and clear of every marker, else the
+	 * first inside the frame, else above as far as the frame allows. A
+	 * spot moves along its side into the frame, never across it. */
+	std::optional<std::array<double, 2>> chosen;
+	for (int pass = 0; pass < 2 && !chosen; ++pass) {
+		for (std::size_t k = 0; k < spots.size() && !chosen; ++k) {
+			const std::size_t across = k < 2 ? 1 : 0;
+			std::array<double, 2> p = clamped(spots[k]);
+			p[across] = spots[k][across];
+			if (inside(p[0], p[1]) && (pass == 1 || clear(p[0], p[1])))
+				chosen = p;
+		}
+	}
+	const std::array<double, 2> p = chosen ? *chosen : clamped(spots[0]);
+	l.left = p[0];
+	l.top = p[1];
 	return l;
 }
 
@@ -161,7 +188,7 @@ void annotateMarkers(GstVideoFrame *frame, const Result &result, const std::vect
 		const auto end = std::to_chars(text, text + sizeof(text), m.id).ptr;
 		const std::string_view id(text, static_cast<std::size_t>(end - text));
 		const Label l = placeLabel(m.corners, id, canvas.width(), canvas.height(),
-					   canvas.colour() ? colours::label : colours::white);
+					   canvas.colour() ? colours::label : colours::white, result.markers);
 		Path path;
 		addText(path, id, l.left, l.top, l.height);
 		canvas.stroke(path, l.pen);

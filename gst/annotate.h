@@ -9,6 +9,7 @@
 
 #include <array>
 #include <optional>
+#include <span>
 #include <string_view>
 #include <vector>
 
@@ -45,10 +46,12 @@ struct Label {
 /// frame `frameWidth` x `frameHeight`: a cap height of 0.3 marker sides,
 /// between max(12, frame height / 40) and frame height / 8 pixels; centred
 /// above the marker's bounding box, clear of its outline, else below it,
-/// else right or left of it; moved inside the frame. Only a marker too big
-/// for all four leaves its label on it.
+/// else right or left of it, moved along that side to be inside the frame;
+/// the first such place clear of the markers in `avoid` (their bounding
+/// boxes and outlines), else the first inside the frame. Only a marker too
+/// big for all four leaves its label on it.
 Label placeLabel(const std::array<Point2f, 4> &corners, std::string_view text, int frameWidth, int frameHeight,
-		 Yuv ink);
+		 Yuv ink, std::span<const Marker> avoid = {});
 
 /// Draws the frame's markers: outlines, first corners, ids and, where
 /// `poses` has one and `sizes` a positive side for the id, the axes (x red,

@@ -284,6 +284,28 @@ TEST(Overlay, LabelsClampedInsideFrame)
 	EXPECT_EQ(f.paddingWrites(), 0);
 }
 
+/* A label that would cover a neighbour goes to the next side that is
+ * clear: the lower marker's below it, not over the upper one. */
+TEST(Overlay, LabelsAvoidOtherMarkers)
+{
+	const std::vector<Placed> scene = { square(2, 200, 120, 100), square(1, 200, 250, 100) };
+	Frame f(GST_VIDEO_FORMAT_I420, scene);
+	const gst::Label alone = gst::placeLabel(scene[1].corners, "1", 640, 480, gst::colours::label);
+	EXPECT_LT(alone.top, 250.0) << "above, when nothing is in the way";
+	const gst::Label upper = gst::placeLabel(scene[0].corners, "2", 640, 480, gst::colours::label,
+						 f.result.markers);
+	const gst::Label lower = gst::placeLabel(scene[1].corners, "1", 640, 480, gst::colours::label,
+						 f.result.markers);
+	EXPECT_LT(upper.top + upper.height, 120.0) << "above";
+	EXPECT_GT(lower.top, 350.0) << "below";
+
+	/* Drawn so: the upper marker's quiet zone and code are untouched. */
+	f.annotate();
+	for (int y = 128; y < 213; ++y)
+		for (int x = 208; x < 293; ++x)
+			ASSERT_FALSE(f.changed(x, y)) << x << "," << y;
+}
+
 /* Glyph bitmaps, cell box plus overhang, averaged onto a 12x20 grid. */
 std::vector<double> glyphGrid(char ch, double height)
 {
