@@ -22,7 +22,14 @@ double clamp01(double v)
 
 std::uint8_t mix(std::uint8_t from, std::uint8_t to, double a)
 {
-	return static_cast<std::uint8_t>(std::lround(from + (to - from) * a));
+	/* Rounded to nearest; from + (to - from) * a stays in [0, 255]. */
+	return static_cast<std::uint8_t>(from + (to - from) * a + 0.5);
+}
+
+/* Where the drawn layers end, from the centre line. */
+double outerEdge(const Pen &pen, unsigned layers)
+{
+	return pen.width / 2.0 + ((layers & Canvas::Halo) ? std::max(pen.halo, 0.0) : 0.0);
 }
 
 double segmentDistance(double px, double py, double x0, double y0, double x1, double y1)
@@ -31,7 +38,8 @@ double segmentDistance(double px, double py, double x0, double y0, double x1, do
 	const double len2 = dx * dx + dy * dy;
 	double t = len2 > 0.0 ? ((px - x0) * dx + (py - y0) * dy) / len2 : 0.0;
 	t = std::clamp(t, 0.0, 1.0);
-	return std::hypot(px - (x0 + t * dx), py - (y0 + t * dy));
+	const double ex = px - (x0 + t * dx), ey = py - (y0 + t * dy);
+	return std::sqrt(ex * ex + ey * ey);
 }
 
 } // namespace
@@ -66,9 +74,11 @@ double Stroke::distance(double x, double y) const
 	double rel = std::atan2(dy, dx) - a0;
 	rel -= std::floor(rel / kTwoPi) * kTwoPi;
 	if (rel <= a1 - a0)
-		return std::abs(std::hypot(dx, dy) - r);
-	const double d0 = std::hypot(x - (x0 + r * std::cos(a0)), y - (y0 + r * std::sin(a0)));
-	const double d1 = std::hypot(x - (x0 + r * std::cos(a1)), y - (y0 + r * std::sin(a1)));
+		return std::abs(std::sqrt(dx * dx + dy * dy) - r);
+	const double d0 = segmentDistance(x, y, x0 + r * std::cos(a0), y0 + r * std::sin(a0), x0 + r * std::cos(a0),
+					  y0 + r * std::sin(a0));
+	const double d1 = segmentDistance(x, y, x0 + r * std::cos(a1), y0 + r * std::sin(a1), x0 + r * std::cos(a1),
+					  y0 + r * std::sin(a1));
 	return std::min(d0, d1);
 }
 
@@ -153,21 +163,16 @@ void Canvas::stroke(const Path &path, const Pen &pen, unsigned layers)
 	const auto strokes = path.strokes();
 	if (strokes.empty())
 		return;
-	const double inner = pen.width / 2.0;
-	const double outer = inner + ((layers & Halo) ? std::max(pen.halo, 0.0) : 0.0);
 	/* Past `reach` from the centre line a pixel is untouched. */
-	const double reach = outer + 0.5;
+	const double reach = outerEdge(pen, layers) + 0.5;
 
-	double bx0 = std::numeric_limits<double>::infinity(), by0 = bx0;
-	double bx1 = -bx0, by1 = -bx0;
+	double by0 = std::numeric_limits<double>::infinity(), by1 = -by0;
 	for (const Stroke &s : strokes) {
 		double a, b, c, d;
 		s.bounds(a, b, c, d);
 		if (!std::isfinite(a) || !std::isfinite(b) || !std::isfinite(c) || !std::isfinite(d))
 			return;
-		bx0 = std::min(bx0, a);
 		by0 = std::min(by0, b);
-		bx1 = std::max(bx1, c);
 		by1 = std::max(by1, d);
 	}
 	/* Whole chroma blocks, so each chroma sample sees all its pixels. */
@@ -176,51 +181,63 @@ void Canvas::stroke(const Path &path, const Pen &pen, unsigned layers)
 	const int yStart = static_cast<int>(top) / subY_ * subY_;
 	const int yEnd = static_cast<int>(bottom);
 
-	struct Active {
-		const Stroke *stroke;
-		double lo, hi;
-	};
 	std::array<Active, Path::kCapacity> active;
+	/* Runs of chroma blocks a row of blocks needs, disjoint. */
+	std::array<std::array<int, 2>, Path::kCapacity> runs;
 	for (int by = yStart; by <= yEnd; by += subY_) {
 		/* The strokes that reach these rows, and where across. */
 		std::size_t n = 0;
-		double rowLo = std::numeric_limits<double>::infinity(), rowHi = -rowLo;
 		for (const Stroke &s : strokes) {
 			double lo, hi;
 			if (!s.xSpan(by - reach, by + subY_ - 1 + reach, lo, hi))
 				continue;
-			active[n++] = { &s, lo - reach, hi + reach };
-			rowLo = std::min(rowLo, lo - reach);
-			rowHi = std::max(rowHi, hi + reach);
+			lo = std::clamp(std::floor(lo - reach), 0.0, static_cast<double>(width_));
+			hi = std::clamp(std::ceil(hi + reach), -1.0, static_cast<double>(width_ - 1));
+			if (lo <= hi)
+				active[n++] = { &s, lo, hi };
 		}
-		if (!n)
-			continue;
-		const double left = std::clamp(std::floor(rowLo), 0.0, static_cast<double>(width_));
-		const double right = std::clamp(std::ceil(rowHi), -1.0, static_cast<double>(width_ - 1));
-		for (int bx = static_cast<int>(left) / subX_ * subX_; bx <= static_cast<int>(right); bx += subX_) {
-			double haloSum = 0.0, inkSum = 0.0;
-			int count = 0;
-			for (int y = by; y < by + subY_ && y < height_; ++y) {
-				for (int x = bx; x < bx + subX_ && x < width_; ++x) {
-					double d = std::numeric_limits<double>::infinity();
-					for (std::size_t i = 0; i < n; ++i)
-						if (x >= active[i].lo && x <= active[i].hi)
-							d = std::min(d, active[i].stroke->distance(x, y));
-					const double h = (layers & Halo) ? clamp01(outer - d + 0.5) : 0.0;
-					const double k = (layers & Ink) ? clamp01(inner - d + 0.5) : 0.0;
-					++count;
-					if (h <= 0.0 && k <= 0.0)
-						continue;
-					std::uint8_t &p = y_[static_cast<std::ptrdiff_t>(y) * yStride_ + x];
-					p = mix(mix(p, kHalo.y, h), pen.ink.y, k);
-					haloSum += h;
-					inkSum += k;
-				}
-			}
-			if (u_ && (haloSum > 0.0 || inkSum > 0.0))
-				blendChroma(bx, by, haloSum / count, inkSum / count, pen.ink);
+		/* Only the blocks near a stroke: not the inside of an outline. */
+		std::sort(active.begin(), active.begin() + static_cast<std::ptrdiff_t>(n),
+			  [](const Active &a, const Active &b) { return a.lo < b.lo; });
+		std::size_t nRuns = 0;
+		for (std::size_t i = 0; i < n; ++i) {
+			const int b0 = static_cast<int>(active[i].lo) / subX_, b1 = static_cast<int>(active[i].hi) / subX_;
+			if (nRuns && b0 <= runs[nRuns - 1][1] + 1)
+				runs[nRuns - 1][1] = std::max(runs[nRuns - 1][1], b1);
+			else
+				runs[nRuns++] = { b0, b1 };
+		}
+		for (std::size_t r = 0; r < nRuns; ++r)
+			for (int bx = runs[r][0] * subX_; bx <= runs[r][1] * subX_; bx += subX_)
+				blendBlock(bx, by, { active.data(), n }, pen, layers);
+	}
+}
+
+void Canvas::blendBlock(int bx, int by, std::span<const Active> active, const Pen &pen, unsigned layers)
+{
+	const double inner = pen.width / 2.0;
+	const double outer = outerEdge(pen, layers);
+	double haloSum = 0.0, inkSum = 0.0;
+	int count = 0;
+	for (int y = by; y < by + subY_ && y < height_; ++y) {
+		for (int x = bx; x < bx + subX_ && x < width_; ++x) {
+			double d = std::numeric_limits<double>::infinity();
+			for (const Active &a : active)
+				if (x >= a.lo && x <= a.hi)
+					d = std::min(d, a.stroke->distance(x, y));
+			const double h = (layers & Halo) ? clamp01(outer - d + 0.5) : 0.0;
+			const double k = (layers & Ink) ? clamp01(inner - d + 0.5) : 0.0;
+			++count;
+			if (h <= 0.0 && k <= 0.0)
+				continue;
+			std::uint8_t &p = y_[static_cast<std::ptrdiff_t>(y) * yStride_ + x];
+			p = mix(mix(p, kHalo.y, h), pen.ink.y, k);
+			haloSum += h;
+			inkSum += k;
 		}
 	}
+	if (u_ && (haloSum > 0.0 || inkSum > 0.0))
+		blendChroma(bx, by, haloSum / count, inkSum / count, pen.ink);
 }
 
 } // namespace frappe::gst

@@ -88,6 +88,14 @@ public:
 	void stroke(const Path &path, const Pen &pen, unsigned layers = Both);
 
 private:
+	/// A stroke that reaches a row of blocks, between columns lo and hi.
+	struct Active {
+		const Stroke *stroke;
+		double lo, hi;
+	};
+	/// Blends one chroma block's pixels (subX_ x subY_ from (bx, by)) and
+	/// its chroma sample.
+	void blendBlock(int bx, int by, std::span<const Active> active, const Pen &pen, unsigned layers);
 	void blendChroma(int x, int y, double halo, double ink, Yuv c);
 
 	std::uint8_t *y_ = nullptr;

@@ -347,13 +347,15 @@ std::vector<double> sampleGlyph(const GstVideoFrame &frame, double left, double 
 /* A glyph drawn alone, white ink on black. */
 std::vector<double> glyphGrid(char ch, double height)
 {
-	const int size = static_cast<int>(height * 2) + 20;
+	/* Room for the overhang sampled and the bilinear neighbours. */
+	const double origin = std::ceil(0.1 * height) + 4.0;
+	const int size = static_cast<int>(height + 2 * origin);
 	Frame f(GST_VIDEO_FORMAT_GRAY8, {}, size, size, 0);
 	gst::Path path;
-	EXPECT_TRUE(gst::addText(path, std::string(1, ch), 8.0, 8.0, height));
+	EXPECT_TRUE(gst::addText(path, std::string(1, ch), origin, origin, height));
 	gst::Canvas canvas(&f.frame);
 	canvas.stroke(path, gst::textPen(height, gst::colours::white), gst::Canvas::Ink);
-	return sampleGlyph(f.frame, 8.0, 8.0, height);
+	return sampleGlyph(f.frame, origin, origin, height);
 }
 
 double correlation(const std::vector<double> &a, const std::vector<double> &b)
