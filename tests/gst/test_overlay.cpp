@@ -284,6 +284,29 @@ TEST(Overlay, LabelsClampedInsideFrame)
 	EXPECT_EQ(f.paddingWrites(), 0);
 }
 
+/* A frame smaller than a label, and corners far outside it, are drawn
+ * clipped: nothing written past the planes. */
+TEST(Overlay, TinyFrameAndFarCorners)
+{
+	for (GstVideoFormat format : { GST_VIDEO_FORMAT_GRAY8, GST_VIDEO_FORMAT_NV12 }) {
+		Frame f(format, {}, 10, 6);
+		Marker m;
+		m.id = 1234567;
+		m.corners = { Point2f{ -3e6f, -2e6f }, { 4e6f, -1e6f }, { 3e6f, 5e6f }, { -1e6f, 2e6f } };
+		f.result.markers.push_back(m);
+		m.id = 8;
+		m.corners = { Point2f{ 2, 1 }, { 8, 1 }, { 8, 5 }, { 2, 5 } };
+		f.result.markers.push_back(m);
+		f.annotate();
+		EXPECT_EQ(f.paddingWrites(), 0);
+		int changed = 0;
+		for (int y = 0; y < 6; ++y)
+			for (int x = 0; x < 10; ++x)
+				changed += f.changed(x, y);
+		EXPECT_GT(changed, 0);
+	}
+}
+
 /* A label that would cover a neighbour goes to the next side that is
  * clear: the lower marker's below it, not over the upper one. */
 TEST(Overlay, LabelsAvoidOtherMarkers)
