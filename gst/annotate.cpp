@@ -5,173 +5,193 @@
 #include "annotate.h"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
-#include <string>
+
+#include "overlay_font.h"
 
 namespace frappe::gst {
 
 namespace {
 
-/* 3x5 digits, one row per byte, bit 2 = left column. */
-constexpr std::array<std::array<std::uint8_t, 5>, 10> kDigits{ {
-	{ 7, 5, 5, 5, 7 }, /* 0 */
-	{ 2, 6, 2, 2, 7 }, /* 1 */
-	{ 7, 1, 7, 4, 7 }, /* 2 */
-	{ 7, 1, 3, 1, 7 }, /* 3 */
-	{ 5, 5, 7, 1, 1 }, /* 4 */
-	{ 7, 4, 7, 1, 7 }, /* 5 */
-	{ 7, 4, 7, 5, 7 }, /* 6 */
-	{ 7, 1, 2, 2, 2 }, /* 7 */
-	{ 7, 5, 7, 5, 7 }, /* 8 */
-	{ 7, 5, 7, 1, 7 }, /* 9 */
-} };
+struct Box {
+	double x0, y0, x1, y1;
+};
+
+Box cornerBox(const std::array<Point2f, 4> &corners)
+{
+	Box b{ corners[0].x, corners[0].y, corners[0].x, corners[0].y };
+	for (const Point2f &c : corners) {
+		b.x0 = std::min<double>(b.x0, c.x);
+		b.y0 = std::min<double>(b.y0, c.y);
+		b.x1 = std::max<double>(b.x1, c.x);
+		b.y1 = std::max<double>(b.y1, c.y);
+	}
+	return b;
+}
+
+double meanSide(const std::array<Point2f, 4> &corners)
+{
+	double side = 0.0;
+	for (std::size_t k = 0; k < 4; ++k) {
+		const Point2f a = corners[k], b = corners[(k + 1) & 3];
+		side += std::hypot(a.x - b.x, a.y - b.y) / 4.0;
+	}
+	return side;
+}
+
+/* The outline's pen: thicker on bigger markers, as before. */
+Pen outlinePen(double side)
+{
+	Pen pen;
+	pen.width = std::max(1.5, side / 32.0);
+	pen.halo = std::max(1.0, pen.width / 2.0);
+	pen.ink = colours::outline;
+	return pen;
+}
+
+/* How far a pen's ink and halo reach from the centre line. */
+double reach(const Pen &pen)
+{
+	return pen.width / 2.0 + pen.halo;
+}
+
+/* Draws the strokes of all `paths` halos first, then inks: they meet, and
+ * no halo may cut into a neighbour's ink. */
+void strokeTogether(Canvas &canvas, std::span<const Path> paths, std::span<const Pen> pens)
+{
+	for (std::size_t i = 0; i < paths.size(); ++i)
+		canvas.stroke(paths[i], pens[i], Canvas::Halo);
+	for (std::size_t i = 0; i < paths.size(); ++i)
+		canvas.stroke(paths[i], pens[i], Canvas::Ink);
+}
+
+void drawAxes(Canvas &canvas, const Pose &pose, double size, const Camera &camera, double side)
+{
+	const double h = size / 2.0;
+	const std::array<std::array<double, 3>, 4> points{ { { 0, 0, 0 }, { h, 0, 0 }, { 0, h, 0 }, { 0, 0, h } } };
+	const std::vector<Point2f> p = projectPoints(points, pose, camera);
+	if (p.size() != 4 || !std::isfinite(p[0].x) || !std::isfinite(p[0].y))
+		return;
+	const std::array<Yuv, 3> inks{ colours::axisX, colours::axisY, colours::axisZ };
+	std::array<Path, 3> paths;
+	std::array<Pen, 3> pens;
+	for (std::size_t a = 0; a < 3; ++a) {
+		pens[a].width = std::max(2.0, side / 20.0);
+		pens[a].halo = std::max(1.0, pens[a].width / 3.0);
+		pens[a].ink = inks[a];
+		/* An end behind the camera: no axis. */
+		if (std::isfinite(p[a + 1].x) && std::isfinite(p[a + 1].y))
+			paths[a].add(Stroke::segment(p[0].x, p[0].y, p[a + 1].x, p[a + 1].y));
+	}
+	strokeTogether(canvas, paths, pens);
+}
 
 } // namespace
 
-Canvas::Canvas(GstVideoFrame *frame)
+Label placeLabel(const std::array<Point2f, 4> &corners, std::string_view text, int frameWidth, int frameHeight,
+		 Yuv ink, std::span<const Marker> avoid)
 {
-	width_ = GST_VIDEO_FRAME_COMP_WIDTH(frame, 0);
-	height_ = GST_VIDEO_FRAME_COMP_HEIGHT(frame, 0);
-	y_ = static_cast<std::uint8_t *>(GST_VIDEO_FRAME_COMP_DATA(frame, 0));
-	yStride_ = GST_VIDEO_FRAME_COMP_STRIDE(frame, 0);
-	if (GST_VIDEO_FRAME_N_COMPONENTS(frame) >= 3) {
-		u_ = static_cast<std::uint8_t *>(GST_VIDEO_FRAME_COMP_DATA(frame, 1));
-		v_ = static_cast<std::uint8_t *>(GST_VIDEO_FRAME_COMP_DATA(frame, 2));
-		uvStride_ = GST_VIDEO_FRAME_COMP_STRIDE(frame, 1);
-		uvPixelStride_ = GST_VIDEO_FRAME_COMP_PSTRIDE(frame, 1);
-	}
-}
+	const double side = meanSide(corners);
+	const double minHeight = std::max(12.0, frameHeight / 40.0);
+	const double maxHeight = std::max(minHeight, frameHeight / 8.0);
 
-void Canvas::plot(int x, int y, Yuv c)
-{
-	if (x < 0 || y < 0 || x >= width_ || y >= height_)
-		return;
-	y_[static_cast<std::ptrdiff_t>(y) * yStride_ + x] = c.y;
-	if (u_) {
-		/* All chroma formats accepted here are subsampled 2x2. */
-		const std::ptrdiff_t o = static_cast<std::ptrdiff_t>(y / 2) * uvStride_ + (x / 2) * uvPixelStride_;
-		u_[o] = c.u;
-		v_[o] = c.v;
-	}
-}
+	Label l;
+	l.height = std::clamp(0.3 * side, minHeight, maxHeight);
+	l.width = textWidth(text, l.height);
+	l.pen = textPen(l.height, ink);
 
-void Canvas::fillRect(int x0, int y0, int x1, int y1, Yuv c)
-{
-	x0 = std::max(x0, 0);
-	y0 = std::max(y0, 0);
-	x1 = std::min(x1, width_ - 1);
-	y1 = std::min(y1, height_ - 1);
-	for (int y = y0; y <= y1; ++y)
-		for (int x = x0; x <= x1; ++x)
-			plot(x, y, c);
-}
+	/* Ink and halo around the cells; the gap keeps them off the outline's. */
+	const double margin = reach(l.pen);
+	const double gap = margin + reach(outlinePen(side)) + 1.0;
+	const Box b = cornerBox(corners);
+	const double W = frameWidth, H = frameHeight;
 
-void Canvas::line(double x0, double y0, double x1, double y1, int thickness, Yuv c)
-{
-	if (!std::isfinite(x0) || !std::isfinite(y0) || !std::isfinite(x1) || !std::isfinite(y1))
-		return;
-	/* Keep absurd projections (points behind the camera) from looping for
-	 * ever: clamp to a generous box around the frame. */
-	const double lim = 4.0 * std::max(width_, height_) + 64.0;
-	x0 = std::clamp(x0, -lim, lim);
-	y0 = std::clamp(y0, -lim, lim);
-	x1 = std::clamp(x1, -lim, lim);
-	y1 = std::clamp(y1, -lim, lim);
-
-	const double dx = x1 - x0, dy = y1 - y0;
-	const int steps = std::max(1, static_cast<int>(std::ceil(std::max(std::abs(dx), std::abs(dy)))));
-	const int lo = -(thickness - 1) / 2, hi = thickness / 2;
-	for (int i = 0; i <= steps; ++i) {
-		const int x = static_cast<int>(std::lround(x0 + dx * i / steps));
-		const int y = static_cast<int>(std::lround(y0 + dy * i / steps));
-		if (x + hi < 0 || y + hi < 0 || x + lo >= width_ || y + lo >= height_)
-			continue;
-		fillRect(x + lo, y + lo, x + hi, y + hi, c);
-	}
-}
-
-void Canvas::haloLine(double x0, double y0, double x1, double y1, int thickness, Yuv c)
-{
-	line(x0, y0, x1, y1, thickness + 2, colours::black);
-	line(x0, y0, x1, y1, thickness, c);
-}
-
-void Canvas::number(int value, double cx, double cy, int cell)
-{
-	const std::string text = std::to_string(value);
-	cell = std::max(cell, 1);
-	const int n = static_cast<int>(text.size());
-	const int w = (4 * n - 1) * cell, h = 5 * cell;
-	const int left = static_cast<int>(std::lround(cx)) - w / 2;
-	const int top = static_cast<int>(std::lround(cy)) - h / 2;
-	fillRect(left - cell, top - cell, left + w + cell - 1, top + h + cell - 1, colours::black);
-	for (int i = 0; i < n; ++i) {
-		const char ch = text[static_cast<std::size_t>(i)];
-		if (ch < '0' || ch > '9') {
-			/* A minus sign. */
-			fillRect(left + 4 * i * cell, top + 2 * cell, left + (4 * i + 3) * cell - 1,
-				 top + 3 * cell - 1, colours::white);
-			continue;
+	/* Above, below, right, left of the marker. */
+	const double cx = (b.x0 + b.x1 - l.width) / 2.0, cy = (b.y0 + b.y1 - l.height) / 2.0;
+	const std::array<std::array<double, 2>, 4> spots{ {
+		{ cx, b.y0 - gap - l.height },
+		{ cx, b.y1 + gap },
+		{ b.x1 + gap, cy },
+		{ b.x0 - gap - l.width, cy },
+	} };
+	auto inside = [&](double left, double top) {
+		return left - margin >= 0.0 && left + l.width + margin <= W - 1.0 && top - margin >= 0.0 &&
+		       top + l.height + margin <= H - 1.0;
+	};
+	auto clear = [&](double left, double top) {
+		for (const Marker &m : avoid) {
+			const Box o = cornerBox(m.corners);
+			const double r = reach(outlinePen(meanSide(m.corners))) + margin;
+			if (left < o.x1 + r && left + l.width > o.x0 - r && top < o.y1 + r && top + l.height > o.y0 - r)
+				return false;
 		}
-		const auto &glyph = kDigits[static_cast<std::size_t>(ch - '0')];
-		for (int r = 0; r < 5; ++r)
-			for (int col = 0; col < 3; ++col)
-				if (glyph[static_cast<std::size_t>(r)] & (4 >> col))
-					fillRect(left + (4 * i + col) * cell, top + r * cell,
-						 left + (4 * i + col + 1) * cell - 1, top + (r + 1) * cell - 1,
-						 colours::white);
+		return true;
+	};
+	auto clamped = [&](std::array<double, 2> p) {
+		p[0] = std::max(margin, std::min(p[0], W - 1.0 - margin - l.width));
+		p[1] = std::max(margin, std::min(p[1], H - 1.0 - margin - l.height));
+		return p;
+	};
+	/* The first spot inside the frame and clear of every marker, else the
+	 * first inside the frame, else above as far as the frame allows. A
+	 * spot moves along its side into the frame, never across it. */
+	std::optional<std::array<double, 2>> chosen;
+	for (int pass = 0; pass < 2 && !chosen; ++pass) {
+		for (std::size_t k = 0; k < spots.size() && !chosen; ++k) {
+			const std::size_t across = k < 2 ? 1 : 0;
+			std::array<double, 2> p = clamped(spots[k]);
+			p[across] = spots[k][across];
+			if (inside(p[0], p[1]) && (pass == 1 || clear(p[0], p[1])))
+				chosen = p;
+		}
 	}
+	const std::array<double, 2> p = chosen ? *chosen : clamped(spots[0]);
+	l.left = p[0];
+	l.top = p[1];
+	return l;
 }
 
-void annotateMarkers(GstVideoFrame *frame, const Result &result,
-		     const std::vector<std::optional<frappe::Pose>> &poses, const frappe::MarkerSizes &sizes,
-		     const frappe::Camera &camera)
+void annotateMarkers(GstVideoFrame *frame, const Result &result, const std::vector<std::optional<Pose>> &poses,
+		     const MarkerSizes &sizes, const Camera &camera)
 {
 	Canvas canvas(frame);
 	for (std::size_t i = 0; i < result.markers.size(); ++i) {
 		const Marker &m = result.markers[i];
-		double side = 0.0;
-		for (int k = 0; k < 4; ++k) {
-			const auto a = m.corners[static_cast<std::size_t>(k)];
-			const auto b = m.corners[static_cast<std::size_t>((k + 1) & 3)];
-			side += std::hypot(a.x - b.x, a.y - b.y) / 4.0;
-		}
-		const int thickness = std::max(1, static_cast<int>(side / 32.0));
-		for (int k = 0; k < 4; ++k) {
-			const auto a = m.corners[static_cast<std::size_t>(k)];
-			const auto b = m.corners[static_cast<std::size_t>((k + 1) & 3)];
-			canvas.haloLine(a.x, a.y, b.x, b.y, thickness, colours::outline);
-		}
-		/* The first corner (top-left in the marker's orientation). */
-		const int r = std::max(2, static_cast<int>(side / 24.0));
-		const int cx = static_cast<int>(std::lround(m.corners[0].x));
-		const int cy = static_cast<int>(std::lround(m.corners[0].y));
-		canvas.fillRect(cx - r - 1, cy - r - 1, cx + r + 1, cy + r + 1, colours::black);
-		canvas.fillRect(cx - r, cy - r, cx + r, cy + r, colours::firstCorner);
+		const double side = meanSide(m.corners);
 
-		if (poses[i]) {
-			const double h = sizes(m.id) / 2.0;
-			const std::array<std::array<double, 3>, 4> axes{
-				{ { 0, 0, 0 }, { h, 0, 0 }, { 0, h, 0 }, { 0, 0, h } }
-			};
-			const auto p = frappe::projectPoints(axes, *poses[i], camera);
-			if (p.size() == 4) {
-				canvas.haloLine(p[0].x, p[0].y, p[1].x, p[1].y, thickness, colours::axisX);
-				canvas.haloLine(p[0].x, p[0].y, p[2].x, p[2].y, thickness, colours::axisY);
-				canvas.haloLine(p[0].x, p[0].y, p[3].x, p[3].y, thickness, colours::axisZ);
-			}
+		/* The four sides as one shape: round joins, one halo. */
+		Path outline;
+		for (std::size_t k = 0; k < 4; ++k) {
+			const Point2f a = m.corners[k], b = m.corners[(k + 1) & 3];
+			outline.add(Stroke::segment(a.x, a.y, b.x, b.y));
 		}
+		canvas.stroke(outline, outlinePen(side));
 
-		/* The id between the centre and the first corner: the quadrant of
-		 * the marker frame (-x, +y) that the axes leave free. */
-		double mx = 0.0, my = 0.0;
-		for (const auto &c : m.corners) {
-			mx += c.x / 4.0;
-			my += c.y / 4.0;
-		}
-		mx = (mx * 3.0 + m.corners[0].x * 2.0) / 5.0;
-		my = (my * 3.0 + m.corners[0].y * 2.0) / 5.0;
-		canvas.number(m.id, mx, my, std::max(1, static_cast<int>(side / 24.0)));
+		/* The first corner (top-left in the marker's orientation): a dot
+		 * on the border, clear of the code cells. */
+		Path dot;
+		dot.add(Stroke::segment(m.corners[0].x, m.corners[0].y, m.corners[0].x, m.corners[0].y));
+		Pen dotPen;
+		dotPen.width = std::max(4.0, side / 12.0);
+		dotPen.halo = 1.0;
+		dotPen.ink = colours::firstCorner;
+		canvas.stroke(dot, dotPen);
+
+		if (i < poses.size() && poses[i] && sizes(m.id) > 0.0)
+			drawAxes(canvas, *poses[i], sizes(m.id), camera, side);
+	}
+
+	/* Labels last: over the axes of any neighbour. */
+	for (const Marker &m : result.markers) {
+		char text[16];
+		const auto end = std::to_chars(text, text + sizeof(text), m.id).ptr;
+		const std::string_view id(text, static_cast<std::size_t>(end - text));
+		const Label l = placeLabel(m.corners, id, canvas.width(), canvas.height(),
+					   canvas.colour() ? colours::label : colours::white, result.markers);
+		Path path;
+		addText(path, id, l.left, l.top, l.height);
+		canvas.stroke(path, l.pen);
 	}
 }
 

@@ -1,14 +1,16 @@
 /* SPDX-License-Identifier: MIT
  *
- * annotate.h: drawing marker outlines, ids and pose axes straight into the
- * planes of a mapped 8-bit YUV/GRAY frame, so the drawing survives any
- * encoder. No OpenCV, a tiny built-in digit font.
+ * annotate.h: what frappedetect's annotate property draws into a frame:
+ * each marker's outline and first corner, its id in an outlined stroke
+ * font beside it (never over its code), and its pose axes, straight into
+ * the Y (and U/V) planes so the drawing survives any encoder.
  */
 #pragma once
 
 #include <array>
-#include <cstdint>
 #include <optional>
+#include <span>
+#include <string_view>
 #include <vector>
 
 #include <gst/video/video.h>
@@ -17,60 +19,45 @@
 #include <frappe/detector.h>
 #include <frappe/pose.h>
 
+#include "canvas.h"
+
 namespace frappe::gst {
 
-/// A colour as 8-bit Y, U, V (U and V are ignored on GRAY8).
-struct Yuv {
-	std::uint8_t y, u, v;
-};
-
-/// Draws into the luma plane and, when present, the chroma planes of a frame
-/// mapped for writing (GRAY8, I420, YV12, NV12, NV21).
-class Canvas {
-public:
-	explicit Canvas(GstVideoFrame *frame);
-
-	int width() const { return width_; }
-	int height() const { return height_; }
-
-	void plot(int x, int y, Yuv c);
-	void fillRect(int x0, int y0, int x1, int y1, Yuv c);
-	/// A line of the given thickness (pixels), clipped to the frame.
-	void line(double x0, double y0, double x1, double y1, int thickness, Yuv c);
-	/// A line with a dark halo one pixel wide on each side, visible on any
-	/// background.
-	void haloLine(double x0, double y0, double x1, double y1, int thickness, Yuv c);
-	/// Decimal digits of `value` centred on (cx, cy), `cell` pixels per font
-	/// cell (the font is 3x5 cells), white on a black box.
-	void number(int value, double cx, double cy, int cell);
-
-private:
-	std::uint8_t *y_ = nullptr;
-	int yStride_ = 0;
-	std::uint8_t *u_ = nullptr;
-	std::uint8_t *v_ = nullptr;
-	int uvStride_ = 0;
-	int uvPixelStride_ = 1; ///< 1 for planar, 2 for NV12/NV21
-	int width_ = 0;
-	int height_ = 0;
-};
-
-/// Colours used by frappedetect.
+/// Colours used by frappedetect (BT.601 video range).
 namespace colours {
-constexpr Yuv outline{ 235, 44, 21 };   // bright green
+constexpr Yuv outline{ 235, 44, 21 };     // bright green
 constexpr Yuv firstCorner{ 82, 90, 240 }; // red
-constexpr Yuv black{ 16, 128, 128 };
-constexpr Yuv white{ 235, 128, 128 };
-constexpr Yuv axisX{ 82, 90, 240 };   // red
-constexpr Yuv axisY{ 145, 54, 34 };   // green
-constexpr Yuv axisZ{ 41, 240, 110 };  // blue
+constexpr Yuv label{ 210, 16, 146 };      // yellow
+constexpr Yuv white{ 235, 128, 128 };     // labels on GRAY8
+constexpr Yuv axisX{ 82, 90, 240 };       // red
+constexpr Yuv axisY{ 145, 54, 34 };       // green
+constexpr Yuv axisZ{ 41, 240, 110 };      // blue
 } // namespace colours
 
-/// What frappedetect's annotate property draws for a frame's markers:
-/// outlines, first corners, ids and, where `poses` has one, the axes of a
-/// marker of its side in `sizes` (metres).
-void annotateMarkers(GstVideoFrame *frame, const Result &result,
-		     const std::vector<std::optional<frappe::Pose>> &poses, const frappe::MarkerSizes &sizes,
-		     const frappe::Camera &camera);
+/// A label's place: its glyph cells (overlay_font.h) from (left, top),
+/// `width` x `height` pixels, and the pen; the ink and halo reach
+/// pen.width / 2 + pen.halo further.
+struct Label {
+	double left = 0.0, top = 0.0, width = 0.0, height = 0.0;
+	Pen pen;
+};
+
+/// Where annotateMarkers() writes `text` for the marker at `corners` in a
+/// frame `frameWidth` x `frameHeight`: a cap height of 0.3 marker sides,
+/// between max(12, frame height / 40) and frame height / 8 pixels; centred
+/// above the marker's bounding box, clear of its outline, else below it,
+/// else right or left of it, moved along that side to be inside the frame;
+/// the first such place clear of the markers in `avoid` (their bounding
+/// boxes and outlines), else the first inside the frame. Only a marker too
+/// big for all four leaves its label on it.
+Label placeLabel(const std::array<Point2f, 4> &corners, std::string_view text, int frameWidth, int frameHeight,
+		 Yuv ink, std::span<const Marker> avoid = {});
+
+/// Draws the frame's markers: outlines, first corners, ids and, where
+/// `poses` has one and `sizes` a positive side for the id, the axes (x red,
+/// y green, z blue, half a side long) projected through `camera`. Ids are
+/// yellow on colour formats, white on GRAY8, outlined in black.
+void annotateMarkers(GstVideoFrame *frame, const Result &result, const std::vector<std::optional<Pose>> &poses,
+		     const MarkerSizes &sizes, const Camera &camera);
 
 } // namespace frappe::gst
