@@ -70,8 +70,9 @@ void drawAxes(Canvas &canvas, const Pose &pose, double size, const Camera &camer
 {
 	const double h = size / 2.0;
 	const std::array<std::array<double, 3>, 4> points{ { { 0, 0, 0 }, { h, 0, 0 }, { 0, h, 0 }, { 0, 0, h } } };
-	const std::vector<Point2f> p = projectPoints(points, pose, camera);
-	if (p.size() != 4 || !std::isfinite(p[0].x) || !std::isfinite(p[0].y))
+	std::array<Point2f, 4> p;
+	projectPoints(points, pose, camera, p);
+	if (!std::isfinite(p[0].x) || !std::isfinite(p[0].y))
 		return;
 	const std::array<Yuv, 3> inks{ colours::axisX, colours::axisY, colours::axisZ };
 	std::array<Path, 3> paths;

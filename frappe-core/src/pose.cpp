@@ -306,23 +306,31 @@ std::optional<MarkerPose> estimatePose(const std::array<Point2f, 4> &corners, do
 	return result;
 }
 
-std::vector<Point2f> projectPoints(std::span<const std::array<double, 3>> points, const Pose &pose,
-				  const Camera &camera)
+void projectPoints(std::span<const std::array<double, 3>> points, const Pose &pose, const Camera &camera,
+		   std::span<Point2f> out)
 {
+	if (out.size() != points.size())
+		throw std::invalid_argument("frappe::projectPoints: " + std::to_string(points.size()) + " points but room for " +
+					    std::to_string(out.size()));
 	camera.validate();
 	const Lens lens(camera);
 	const Matrix3d R = detail::rotationMatrix(Vector3d(pose.rvec[0], pose.rvec[1], pose.rvec[2]));
 	const Vector3d t(pose.tvec[0], pose.tvec[1], pose.tvec[2]);
-	std::vector<Point2f> out;
-	out.reserve(points.size());
-	for (const auto &m : points) {
+	for (std::size_t i = 0; i < points.size(); ++i) {
+		const auto &m = points[i];
 		double u, v;
 		if (project(R * Vector3d(m[0], m[1], m[2]) + t, lens, u, v))
-			out.push_back({ static_cast<float>(u), static_cast<float>(v) });
+			out[i] = { static_cast<float>(u), static_cast<float>(v) };
 		else
-			out.push_back({ std::numeric_limits<float>::quiet_NaN(),
-					std::numeric_limits<float>::quiet_NaN() });
+			out[i] = { std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::quiet_NaN() };
 	}
+}
+
+std::vector<Point2f> projectPoints(std::span<const std::array<double, 3>> points, const Pose &pose,
+				  const Camera &camera)
+{
+	std::vector<Point2f> out(points.size());
+	projectPoints(points, pose, camera, out);
 	return out;
 }
 

@@ -368,6 +368,15 @@ TEST(Pose, ProjectPoints)
 	const std::array<std::array<double, 3>, 1> behind = { { { 0, 0, 1.0 } } };
 	const auto b = projectPoints(behind, pose, cam);
 	EXPECT_TRUE(std::isnan(b[0].x) && std::isnan(b[0].y));
+	/* Into caller's room, the same points; room of the wrong size throws. */
+	std::array<Point2f, 4> room;
+	projectPoints(pts, pose, cam, room);
+	for (int i = 0; i < 4; ++i) {
+		EXPECT_EQ(room[i].x, out[i].x);
+		EXPECT_EQ(room[i].y, out[i].y);
+	}
+	std::array<Point2f, 3> small;
+	EXPECT_THROW(projectPoints(pts, pose, cam, small), std::invalid_argument);
 }
 
 /* undistortPoints inverts the distortion: where the point would be seen by

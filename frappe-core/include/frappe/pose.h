@@ -58,6 +58,10 @@ FRAPPE_EXPORT std::optional<MarkerPose> estimatePose(const std::array<Point2f, 4
 /// std::invalid_argument for a camera that fails Camera::validate().
 FRAPPE_EXPORT std::vector<Point2f> projectPoints(std::span<const std::array<double, 3>> points, const Pose &pose,
 						 const Camera &camera);
+/// The same into `out`, which must have one element per point (else
+/// std::invalid_argument): no allocation, for drawing on every frame.
+FRAPPE_EXPORT void projectPoints(std::span<const std::array<double, 3>> points, const Pose &pose,
+				 const Camera &camera, std::span<Point2f> out);
 
 /// Undistorts pixel points: where each would be under the same camera
 /// matrix with no distortion (OpenCV's undistortPoints with P = K). A
