@@ -44,7 +44,7 @@ py::array imageArg(py::handle obj)
 			a = py::array::ensure(obj);
 		} catch (const py::error_already_set &) {
 		}
-		if (!a)
+		if (!a || a.dtype().kind() == 'O')
 			throw py::type_error("image must be a numpy array (2-D, uint8), not " +
 					     std::string(py::str(obj.get_type().attr("__name__"))));
 	}
@@ -54,7 +54,7 @@ py::array imageArg(py::handle obj)
 				      "e.g. cv2.cvtColor(image, cv2.COLOR_BGR2GRAY)");
 	if (a.ndim() != 2 && a.ndim() != 3)
 		throw py::value_error("image must be 2-D (height, width), got " + std::to_string(a.ndim()) +
-				      "-D with shape " + std::string(py::str(obj.attr("shape"))));
+				      "-D with shape " + std::string(py::str(a.attr("shape"))));
 	if (!a.dtype().is(py::dtype::of<std::uint8_t>()))
 		throw py::type_error("image must be uint8 (8-bit grey), not " + std::string(py::str(a.dtype())) +
 				     "; convert it first, e.g. image.astype(numpy.uint8)");

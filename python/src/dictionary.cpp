@@ -100,9 +100,9 @@ Raises ValueError for an unknown name.)doc");
 #ifdef FRAPPE_PYTHON_HAVE_LOAD_DICTIONARY
 	m.def(
 		"load_dictionary",
-		[](const std::string &path) {
+		[](py::handle path) {
 			try {
-				return DictionaryRef{ loadDictionary(path) };
+				return DictionaryRef{ loadDictionary(pathArg(path)) };
 			} catch (const std::invalid_argument &) {
 				throw;
 			} catch (const std::runtime_error &e) {

@@ -12,6 +12,12 @@ py::array_t<float> newFloatArray(py::ssize_t rows, py::ssize_t cols)
 	return py::array_t<float>({ rows, cols });
 }
 
+std::string pathArg(py::handle obj)
+{
+	/* os.fsdecode: str, bytes or os.PathLike, as open() takes. */
+	return py::module_::import("os").attr("fsdecode")(obj).cast<std::string>();
+}
+
 void raiseOSError(const std::exception &error)
 {
 	PyErr_SetString(PyExc_OSError, error.what());

@@ -6,6 +6,7 @@
 #include <array>
 #include <exception>
 #include <memory>
+#include <string>
 
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
@@ -46,6 +47,9 @@ std::array<Point2f, 4> cornersArg(py::handle obj);
 /// Raises OSError with `error`'s message: what the library's
 /// std::runtime_error means for a file (missing, unreadable, too large).
 [[noreturn]] void raiseOSError(const std::exception &error);
+
+/// A file name from a str or an os.PathLike (pathlib.Path).
+std::string pathArg(py::handle obj);
 
 /// A (rows, cols) float32 array of fresh memory owned by Python.
 py::array_t<float> newFloatArray(py::ssize_t rows, py::ssize_t cols);

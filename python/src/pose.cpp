@@ -200,9 +200,9 @@ calibrated at (0: unknown). Raises ValueError saying what is wrong.)doc")
 
 	m.def(
 		"read_calibration",
-		[](const std::string &path) {
+		[](py::handle path) {
 			try {
-				return readCalibration(path);
+				return readCalibration(pathArg(path));
 			} catch (const std::invalid_argument &) {
 				throw;
 			} catch (const std::runtime_error &e) {
