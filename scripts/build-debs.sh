@@ -2,8 +2,9 @@
 # Builds Frappe's Debian packages with plain dpkg-deb:
 #
 #   libfrappe-core0      libfrappe-core.so.0
-#   libfrappe-dev        headers, .pc files, the CMake package, .so links
-#   gstreamer1.0-frappe  the frappedetect plugin and libgstfrappemeta-1.0.so.0
+#   libfrappe-dev        headers, .pc files, the CMake package, .so links, .gir
+#   gstreamer1.0-frappe  the frappedetect plugin, libgstfrappemeta-1.0.so.0 and
+#                        its typelib GstFrappe-1.0 (Python apps)
 #   frappe-tools         frappe-detect, frappe-render, vc4-dis, vc4-run, vc4-probe
 #
 # Usage: scripts/build-debs.sh [--arch amd64|arm64] [--builddir DIR [--no-rebuild]] [OUTDIR]
@@ -119,9 +120,10 @@ take() {
 	done
 }
 take libfrappe-core0 "$lib/libfrappe-core.so.*"
-take gstreamer1.0-frappe "$lib/gstreamer-1.0/libgstfrappe.so" "$lib/libgstfrappemeta-1.0.so.*"
+take gstreamer1.0-frappe "$lib/gstreamer-1.0/libgstfrappe.so" "$lib/libgstfrappemeta-1.0.so.*" \
+	"$lib/girepository-1.0/GstFrappe-1.0.typelib"
 take libfrappe-dev usr/include/frappe usr/include/gstreamer-1.0 "$lib/libfrappe-core.so" \
-	"$lib/libgstfrappemeta-1.0.so" "$lib/pkgconfig" "$lib/cmake"
+	"$lib/libgstfrappemeta-1.0.so" "$lib/pkgconfig" "$lib/cmake" usr/share/gir-1.0
 take frappe-tools "usr/bin/*"
 # A file no package took is a new install() that needs a home here.
 left=$(find "$root" ! -type d)

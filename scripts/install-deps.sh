@@ -24,6 +24,9 @@ packages=(
 	# the GStreamer element and its examples
 	libgstreamer1.0-dev libgstreamer-plugins-base1.0-dev
 	gstreamer1.0-tools gstreamer1.0-plugins-base gstreamer1.0-plugins-good
+	# the typelib GstFrappe-1.0 of gstfrappemeta and its Python test
+	gobject-introspection libgirepository1.0-dev gir1.2-gstreamer-1.0 gir1.2-gst-plugins-base-1.0
+	python3-gi python3-gst-1.0
 	# the Raspberry Pis' CPUs, emulated: the core and vc4 suites cross-built
 	# for ARMv6 (scripts/arm/armv6-armel.ini) and aarch64
 	# (scripts/arm/armv8-arm64.ini), and the ARMv6 kernels' test (tests/armv6)

@@ -2,11 +2,14 @@
  *
  * gstfrappemeta.h: the per-marker metadata that frappedetect attaches to
  * the buffers it detects on, for applications (link with pkg-config
- * gstfrappemeta).
+ * gstfrappemeta). Bindings read it through gstfrappemarker.h (GObject
+ * introspection namespace GstFrappe, typelib GstFrappe-1.0).
  */
 #pragma once
 
 #include <gst/gst.h>
+
+#include "gstfrappemarker.h"
 
 G_BEGIN_DECLS
 
@@ -44,7 +47,8 @@ G_BEGIN_DECLS
  *
  * One marker found by frappedetect. A buffer carries one meta per marker;
  * iterate them with gst_buffer_iterate_meta_filtered() and
- * %GST_FRAPPE_MARKER_META_API_TYPE.
+ * %GST_FRAPPE_MARKER_META_API_TYPE (bindings, which cannot cast a #GstMeta,
+ * call gst_frappe_buffer_get_markers() instead).
  *
  * Camera frame: OpenCV's (x right, y down, z forward, in metres). Marker
  * frame: OpenCV aruco's (origin at the marker centre, x right, y up, z out
@@ -71,20 +75,35 @@ typedef struct {
 	gfloat margin;
 } GstFrappeMarkerMeta;
 
+/**
+ * gst_frappe_marker_meta_api_get_type:
+ *
+ * Returns: the API type of #GstFrappeMarkerMeta, to find the metas of a
+ * buffer with
+ */
 GType gst_frappe_marker_meta_api_get_type(void);
+
+/**
+ * gst_frappe_marker_meta_get_info:
+ *
+ * Returns: (transfer none): the registration of #GstFrappeMarkerMeta
+ */
 const GstMetaInfo *gst_frappe_marker_meta_get_info(void);
 
 /**
  * gst_buffer_add_frappe_marker_meta:
  * @buffer: a writable #GstBuffer
  * @id: marker id
- * @dictionary: dictionary name (interned internally)
- * @corners: 8 floats, x0, y0, ..., x3, y3
+ * @dictionary: (nullable): dictionary name (interned internally)
+ * @corners: (array fixed-size=8): 8 floats, x0, y0, ..., x3, y3
  * @hamming: corrected bits
  *
- * Returns: (transfer none): the new meta, without pose (set has_pose, rvec,
- * tvec and reprojection_error afterwards when known) and with a margin of 0
- * (set margin afterwards).
+ * Adds a marker meta to @buffer (what frappedetect does), without pose
+ * (set has_pose, rvec, tvec and the reprojection errors afterwards when
+ * known) and with a margin of 0 (set margin afterwards).
+ *
+ * Returns: (transfer none) (nullable): the new meta, %NULL (and a
+ * critical) when @buffer is not a buffer or @corners is %NULL
  */
 GstFrappeMarkerMeta *gst_buffer_add_frappe_marker_meta(GstBuffer *buffer, gint id,
 						       const gchar *dictionary,
@@ -92,6 +111,8 @@ GstFrappeMarkerMeta *gst_buffer_add_frappe_marker_meta(GstBuffer *buffer, gint i
 
 /**
  * gst_buffer_get_frappe_marker_meta:
+ * @b: a #GstBuffer
+ *
  * Returns: (transfer none) (nullable): the first marker meta of @buffer.
  */
 #define gst_buffer_get_frappe_marker_meta(b) \
@@ -99,11 +120,18 @@ GstFrappeMarkerMeta *gst_buffer_add_frappe_marker_meta(GstBuffer *buffer, gint i
 
 /**
  * gst_buffer_get_n_frappe_marker_metas:
+ * @buffer: a #GstBuffer
+ *
  * Returns: how many marker metas @buffer carries.
  */
 guint gst_buffer_get_n_frappe_marker_metas(GstBuffer *buffer);
 
-/** The roi_type of the GstVideoRegionOfInterestMeta frappedetect adds per marker. */
+/**
+ * GST_FRAPPE_ROI_TYPE:
+ *
+ * The roi_type of the GstVideoRegionOfInterestMeta frappedetect adds per
+ * marker.
+ */
 #define GST_FRAPPE_ROI_TYPE "fiducial"
 
 G_END_DECLS
