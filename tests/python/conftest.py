@@ -120,6 +120,17 @@ def render_scene(dictionary="aruco_mip_36h12", scene=SCENE, shape=(480, 640), ba
     return image, truth
 
 
+def check_file_errors(load, tmp_path, bad_text):
+    """`load` raises OSError naming a missing file, ValueError naming a file
+    of `bad_text`."""
+    with pytest.raises(OSError, match="missing.txt"):
+        load(tmp_path / "missing.txt")
+    bad = tmp_path / "bad.txt"
+    bad.write_text(bad_text)
+    with pytest.raises(ValueError, match="bad.txt"):
+        load(bad)
+
+
 @pytest.fixture(scope="session")
 def scene():
     return render_scene()

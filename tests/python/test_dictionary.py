@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 
 import frappe
+from conftest import check_file_errors
 
 
 def test_names_and_lookup():
@@ -72,9 +73,4 @@ def test_load_dictionary_round_trip(tmp_path):
         # The built-in family finds it under its own id.
         assert [m.id for m in frappe.Detector("4x4_50").detect(canvas)] == [25]
     assert frappe.load_dictionary(text).name == "mine"
-    with pytest.raises(OSError, match="nothing.txt"):
-        frappe.load_dictionary(tmp_path / "nothing.txt")
-    bad = tmp_path / "bad.txt"
-    bad.write_text("0x1\n0xzz\n")
-    with pytest.raises(ValueError, match="bad.txt"):
-        frappe.load_dictionary(bad)
+    check_file_errors(frappe.load_dictionary, tmp_path, "0x1\n0xzz\n")

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import frappe
-from conftest import K640, SCENE, marker_corners, rotation
+from conftest import K640, SCENE, check_file_errors, marker_corners, rotation
 
 pytestmark = pytest.mark.skipif(not hasattr(frappe, "estimate_pose"),
                                 reason="frappe-core has no estimatePose yet")
@@ -136,9 +136,4 @@ distortion_coefficients:
     a = frappe.estimate_pose(corners, 0.05, cam)
     b = frappe.estimate_pose(corners, 0.05, cam.matrix, cam.distortion)
     np.testing.assert_array_equal(a.tvec, b.tvec)
-    with pytest.raises(OSError, match="missing.yaml"):
-        frappe.read_calibration(tmp_path / "missing.yaml")
-    bad = tmp_path / "bad.yaml"
-    bad.write_text("hello: world\n")
-    with pytest.raises(ValueError, match="bad.yaml"):
-        frappe.read_calibration(bad)
+    check_file_errors(frappe.read_calibration, tmp_path, "hello: world\n")
