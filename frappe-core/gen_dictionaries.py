@@ -29,7 +29,9 @@ def parse(path):
             sys.exit(f'{path}: code {c:#x} wider than {bits * bits} bits')
     return dict(name=name, bits=bits, codes=codes,
                 dmin=int(header['min_hamming_distance']),
-                opencv=int(header.get('opencv_4.6_max_correction_bits', '0')))
+                # opencv_4.6_... or, for aruco_mip_36h12, opencv_4.8_...
+                opencv=int(next((v for k, v in header.items()
+                                 if k.startswith('opencv') and k.endswith('max_correction_bits')), '0')))
 
 
 def main():

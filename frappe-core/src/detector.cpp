@@ -29,6 +29,19 @@ void validate(const Config &c, const Dictionary &d)
 		fail("edge_threshold must be in (0, 4], got " + std::to_string(c.edge_threshold));
 	if (!(c.corner_threshold >= 0.0f && c.corner_threshold <= 100.0f))
 		fail("corner_threshold must be in [0, 100], got " + std::to_string(c.corner_threshold));
+	if (c.custom_dictionary) {
+		/* One made by hand rather than by loadDictionary(): what the
+		 * decoder and the sample grid rely on. */
+		if (d.bits < 3 || d.bits > 8)
+			fail("custom_dictionary: bits must be 3..8, got " + std::to_string(d.bits));
+		if (d.codes.empty())
+			fail("custom_dictionary: no codes");
+		const int cells = d.bits * d.bits;
+		for (std::uint64_t code : d.codes) {
+			if (cells < 64 && code >> cells)
+				fail("custom_dictionary: a code with bits beyond the " + std::to_string(cells) + " cells");
+		}
+	}
 	if (c.max_hamming < -1 || c.max_hamming > d.bits * d.bits / 2)
 		fail("max_hamming must be -1 (dictionary default) or 0.." + std::to_string(d.bits * d.bits / 2) +
 		     " for " + std::string(d.name) + ", got " + std::to_string(c.max_hamming));
@@ -174,12 +187,14 @@ void Detector::Impl::trace(Slot &slot)
 
 Detector::Detector(const Config &config) : impl_(std::make_unique<Impl>())
 {
-	const Dictionary *d = findDictionary(config.dictionary);
+	/* A dictionary of the user's own wins over the name. */
+	const Dictionary *d = config.custom_dictionary ? config.custom_dictionary.get() : findDictionary(config.dictionary);
 	if (!d)
 		throw std::invalid_argument("frappe::Config: unknown dictionary '" + config.dictionary +
-					    "'; known: " + dictionaryNames());
+					    "'; known: " + dictionaryNames() + ", or a file (loadDictionary())");
 	validate(config, *d);
 	impl_->config = config;
+	impl_->customDictionary = config.custom_dictionary;
 	impl_->dict = d;
 	impl_->codes = std::make_unique<detail::CodeBook>(*d);
 	impl_->maxHamming = config.max_hamming >= 0 ? config.max_hamming : d->defaultMaxHamming();

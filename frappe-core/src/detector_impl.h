@@ -41,6 +41,9 @@ constexpr int kMaxReadBlock = 8;
 struct FRAPPE_HIDDEN Detector::Impl {
 	Config config;
 	const Dictionary *dict = nullptr;
+	/* Config::custom_dictionary, held here whatever becomes of the
+	 * config: dict and codes point into it. */
+	std::shared_ptr<const Dictionary> customDictionary;
 	std::unique_ptr<detail::CodeBook> codes;
 	int maxHamming = 0;
 	detail::DecodePolicy policy;

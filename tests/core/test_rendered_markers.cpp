@@ -19,7 +19,7 @@ using namespace frappe::test;
 
 namespace {
 
-struct Pose {
+struct ScenePose {
 	float side;  ///< pixels
 	float roll;  ///< degrees in the image plane
 	float tilt;  ///< degrees out of the plane
@@ -29,7 +29,7 @@ struct Pose {
 
 /* From small and sharp to large, tilted and blurred. Sides are in cells of
  * at least 3.5 px: below that no decoder reads a code reliably. */
-const Pose kPoses[] = {
+const ScenePose kPoses[] = {
 	{ 0, 0, 0, 0.0f, 2.0f },    /* side filled in: 3.5 px per cell */
 	{ 60, 17, 30, 0.6f, 3.0f },
 	{ 90, -40, 45, 0.8f, 3.0f },
@@ -61,7 +61,7 @@ TEST_P(RenderedMarkers, FoundWithExactIdAndSubPixelCorners)
 	Detector det(cfg);
 	std::mt19937 rng(7 + GetParam());
 	int poseIndex = 0;
-	for (Pose pose : kPoses) {
+	for (ScenePose pose : kPoses) {
 		if (pose.side == 0)
 			pose.side = 3.5f * (dict.bits + 2);
 		const int id = (poseIndex * 37 + 11) % dict.size();

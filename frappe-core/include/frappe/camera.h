@@ -46,7 +46,8 @@ struct FRAPPE_EXPORT Camera {
 	/// scaled by the ratio of widths, fy, cy by the ratio of heights (the
 	/// pixel-centre convention kept: c' = (c + 0.5) * r - 0.5); distortion
 	/// unchanged (it is in normalised coordinates). Unchanged when the
-	/// calibration size is unknown or equal.
+	/// calibration size is unknown or equal. Does not check fits(); throws
+	/// std::invalid_argument for a frame size that is not positive.
 	Camera scaledTo(int frame_width, int frame_height) const;
 };
 

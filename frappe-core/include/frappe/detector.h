@@ -105,6 +105,8 @@ public:
 	void reset();
 
 	const Config &config() const;
+	/// Config::custom_dictionary when set (kept alive by the Detector),
+	/// else the built-in named by Config::dictionary.
 	const Dictionary &dictionary() const;
 	int maxHamming() const;
 	FrontEndParams frontEndParams() const;

@@ -65,28 +65,39 @@ FRAPPE_EXPORT std::string dictionaryNames(std::string_view separator = ", ");
 FRAPPE_EXPORT std::uint64_t rotateCode(std::uint64_t code, int bits);
 
 /// Reads a dictionary of the user's own from a file, in either of two
-/// formats (told by the content):
+/// formats, told by the content (the text format when the first line that
+/// is neither blank nor a `#` comment starts with `0x`):
 /// - the built-in dictionaries' text format (frappe-core/dictionaries/
-///   README.md): `#` comments, one 0x-hex codeword a line, id = line
-///   index; the side n is taken from a `# marker_side_bits: n` header, else
-///   from the codes' hex digits (ceil(n*n/4));
+///   README.md): `#` comments, one 0x-hex codeword a line (a `#` comment
+///   may follow it), id = codeword index; the side n is taken from a `#
+///   marker_side_bits: n` header, else from the codes' hex digits, which
+///   must then all be ceil(n*n/4) (3, 4, 7, 9, 13 or 16 for n = 3..8);
 /// - OpenCV's aruco YAML (what cv::aruco::Dictionary::writeDictionary
-///   writes): markersize, nmarkers, marker_0 .. marker_{N-1} as strings of
-///   n*n '0'/'1' characters, row-major, 1 = white (the same bits).
-/// The dictionary is named after the file (its stem) unless a `#
-/// dictionary:` header or a `name` key gives one. Its min_hamming is
-/// computed over the codes and their rotations; opencv_max_correction is
-/// the file's maxCorrectionBits, or 0.
+///   writes), or the same keys as its FileStorage XML: markersize,
+///   nmarkers, marker_0 .. marker_{N-1} as strings of n*n '0'/'1'
+///   characters, row-major, 1 = white (the same bits), in any order.
+/// CRLF line ends and a UTF-8 byte-order mark are accepted; lines are at
+/// most 4096 bytes. The dictionary is named after the file (its stem)
+/// unless a `# dictionary:` header or a `name` key gives one (1 to 128
+/// bytes). Its min_hamming is computed over the codes and their rotations;
+/// a code that is its own rotation is accepted, making it 0 as for
+/// aruco_original (such a marker's orientation is ambiguous).
+/// opencv_max_correction is the file's maxCorrectionBits (or `#
+/// opencv_*_max_correction_bits` header), or 0.
 /// Throws std::runtime_error when the file cannot be read (missing, not a
 /// regular file, over 64 MiB) and std::invalid_argument, naming the file
-/// and line, when its content is not a dictionary: no codes, more than
-/// 65536, a side outside 3..8, a code with bits beyond n*n, a codeword
-/// that does not parse, a count that disagrees with nmarkers, two ids with
-/// the same code in some rotation.
+/// and line ("frappe::loadDictionary: FILE:LINE: what"), when its content
+/// is not a dictionary: no codes, more than 4096 (every pair is compared
+/// in 4 rotations: a fraction of a second on a PC at 4096), a side outside
+/// 3..8 (what a 64-bit code and the detector's sample grid hold), a code
+/// with bits beyond n*n, a codeword that does not parse, a count that
+/// disagrees with nmarkers or a `# codes:` header, an unknown or repeated
+/// key, a control character, two ids with the same code in some rotation.
 FRAPPE_EXPORT std::shared_ptr<const Dictionary> loadDictionary(const std::string &path);
 
 /// The same from a file's text; `name` is the dictionary's unless the text
-/// names one, and names it in messages.
+/// names one, and names the text in messages
+/// ("frappe::parseDictionary: NAME:LINE: what").
 FRAPPE_EXPORT std::shared_ptr<const Dictionary> parseDictionary(std::string_view text, std::string_view name);
 
 } // namespace frappe

@@ -34,7 +34,7 @@ struct Pose {
 /// afar or face on is ambiguous: two poses, mirror images about the line of
 /// sight, project it almost alike. IPPE finds both in closed form; the one
 /// that reprojects better is refined by a few Gauss-Newton steps.
-struct MarkerPose {
+struct FRAPPE_EXPORT MarkerPose {
 	Pose pose;        ///< the better solution, refined
 	Pose alternative; ///< the other (unrefined); alternative.error is infinity when there was none
 	/// How far apart the two are in evidence: alternative.error /
@@ -54,12 +54,16 @@ FRAPPE_EXPORT std::optional<MarkerPose> estimatePose(const std::array<Point2f, 4
 
 /// Projects points of the marker frame into the image (distortion applied),
 /// e.g. the axes to draw. A point at or behind the camera's plane
-/// (z <= 0 in the camera frame) comes out as NaN.
+/// (z <= 0 in the camera frame) comes out as NaN. Throws
+/// std::invalid_argument for a camera that fails Camera::validate().
 FRAPPE_EXPORT std::vector<Point2f> projectPoints(std::span<const std::array<double, 3>> points, const Pose &pose,
 						 const Camera &camera);
 
 /// Undistorts pixel points: where each would be under the same camera
-/// matrix with no distortion (OpenCV's undistortPoints with P = K).
+/// matrix with no distortion (OpenCV's undistortPoints with P = K). A
+/// point the distortion model cannot invert (beyond where it folds over,
+/// far outside the calibrated field) comes out as NaN. Throws
+/// std::invalid_argument for a camera that fails Camera::validate().
 FRAPPE_EXPORT std::vector<Point2f> undistortPoints(std::span<const Point2f> points, const Camera &camera);
 
 /// The side of each marker id, metres: one default and exceptions, written
