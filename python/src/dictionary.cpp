@@ -97,7 +97,6 @@ The built-in dictionary `name`: a name from dictionaries(), case-insensitive,
 or a common alias ('DICT_6X6_250', 'DICT_APRILTAG_36h11', 'tag36h11').
 Raises ValueError for an unknown name.)doc");
 
-#ifdef FRAPPE_PYTHON_HAVE_LOAD_DICTIONARY
 	m.def(
 		"load_dictionary",
 		[](py::handle path) {
@@ -114,7 +113,6 @@ A dictionary of your own from a file: frappe's text format (one 0x-hex code a
 line) or OpenCV's aruco YAML (what cv2.aruco.Dictionary.writeDictionary
 writes). Raises OSError when the file cannot be read and ValueError, naming
 the file and line, when it is not a dictionary.)doc");
-#endif
 }
 
 } // namespace frappe::python

@@ -37,7 +37,5 @@ PYBIND11_MODULE(_frappe, m)
 	bindMarker(m);
 	bindRender(m);
 	bindDetector(m);
-#ifdef FRAPPE_PYTHON_HAVE_POSE
 	bindPose(m);
-#endif
 }

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 import frappe
-from conftest import check_file_errors
+from conftest import ROOT, check_file_errors, render_scene
 
 
 def test_names_and_lookup():
@@ -49,7 +49,6 @@ def test_render_and_detect_every_family():
         assert [m.id for m in found] == [marker_id], name
 
 
-@pytest.mark.skipif(not hasattr(frappe, "load_dictionary"), reason="frappe-core has no loadDictionary yet")
 def test_load_dictionary_round_trip(tmp_path):
     base = frappe.get_dictionary("4x4_50")
     # Five of 4x4_50's codes in frappe's text format, and in OpenCV's YAML.
@@ -74,3 +73,21 @@ def test_load_dictionary_round_trip(tmp_path):
         assert [m.id for m in frappe.Detector("4x4_50").detect(canvas)] == [25]
     assert frappe.load_dictionary(text).name == "mine"
     check_file_errors(frappe.load_dictionary, tmp_path, "0x1\n0xzz\n")
+
+
+def test_load_built_in_file():
+    """A built-in family's source file loads as the same codes, and a
+    detector with it finds what the built-in one does."""
+    path = ROOT / "frappe-core" / "dictionaries" / "4x4_50.txt"
+    loaded, base = frappe.load_dictionary(path), frappe.get_dictionary("4x4_50")
+    assert (loaded.name, loaded.bits, loaded.size, loaded.builtin) == ("4x4_50", 4, 50, False)
+    assert loaded.codes.tolist() == base.codes.tolist()
+    assert loaded.min_hamming == base.min_hamming == 4
+    assert loaded != base
+    image, truth = render_scene(loaded, [(i, (10 * k, -15 * k, 30 * k), (-0.15 + 0.1 * k, 0.0, 0.5))
+                                         for k, i in enumerate((0, 17, 33, 49))])
+    found = frappe.Detector(loaded).detect(image)
+    assert sorted(m.id for m in found) == [0, 17, 33, 49]
+    for m in found:
+        np.testing.assert_allclose(m.corners, truth[m.id], atol=0.1)
+    assert [m.id for m in found] == [m.id for m in frappe.Detector(base).detect(image)]

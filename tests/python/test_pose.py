@@ -6,11 +6,7 @@ import numpy as np
 import pytest
 
 import frappe
-from conftest import K640, SCENE, check_file_errors, marker_corners, rotation
-
-pytestmark = pytest.mark.skipif(not hasattr(frappe, "estimate_pose"),
-                                reason="frappe-core has no estimatePose yet")
-
+from conftest import K640, ROOT, SCENE, check_file_errors, marker_corners, render_scene, rotation
 
 def rotation_angle(Ra, Rb):
     """The angle, degrees, of the rotation between two rotation matrices."""
@@ -18,28 +14,51 @@ def rotation_angle(Ra, Rb):
     return np.degrees(np.arccos(np.clip(c, -1, 1)))
 
 
-def rodrigues(R):
-    """A rotation vector from a matrix (independent of the module's own)."""
-    angle = np.arccos(np.clip((np.trace(R) - 1) / 2, -1, 1))
-    axis = np.array([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]]) / (2 * np.sin(angle))
-    return axis * angle
+def rodrigues(rvec):
+    """The rotation matrix of a rotation vector (independent of the module's own)."""
+    angle = np.linalg.norm(rvec)
+    x, y, z = rvec / angle
+    k = np.array([[0, -z, y], [z, 0, -x], [-y, x, 0]])
+    return np.eye(3) + np.sin(angle) * k + (1 - np.cos(angle)) * (k @ k)
 
 
-def test_pose_of_rendered_markers(scene):
-    image, _ = scene
+# Markers 50 px wide (0.06 m at 0.72 m): face on off the pixel grid, rolled,
+# tilted; the hardest cases for rotation the issue's bar covers.
+SMALL = [
+    (5, (0, 0, 0), (0.013, 0.021, 0.72)),
+    (6, (0, 0, 30), (-0.15, 0.05, 0.72)),
+    (7, (10, 0, 0), (0.15, 0.1, 0.7)),
+]
+
+
+def blur_and_noise(image):
+    """A camera's softness and sensor noise: a 5-tap blur, noise of sigma 3."""
+    f = image.astype(float)
+    f = (f + np.roll(f, 1, 0) + np.roll(f, -1, 0) + np.roll(f, 1, 1) + np.roll(f, -1, 1)) / 5
+    noise = np.random.default_rng(1).normal(0, 3, f.shape)
+    return np.clip(f + noise, 0, 255).astype(np.uint8)
+
+
+@pytest.mark.parametrize("blurred", [False, True], ids=["sharp", "blurred"])
+@pytest.mark.parametrize("scene_", [SCENE, SMALL], ids=["scene", "50px"])
+def test_pose_of_rendered_markers(scene_, blurred):
+    image, _ = render_scene(scene=scene_)
+    if blurred:
+        image = blur_and_noise(image)
     found = {m.id: m for m in frappe.Detector().detect(image)}
-    assert sorted(found) == sorted(i for i, _, _ in SCENE)
-    for marker_id, angles, t in SCENE:
+    assert sorted(found) == sorted(i for i, _, _ in scene_)
+    for marker_id, angles, t in scene_:
         R = rotation(*angles)
         pose = frappe.estimate_pose(found[marker_id], 0.06, K640)
         assert pose is not None
-        # Corners within a few hundredths of a pixel: millimetres, a degree.
-        assert np.abs(pose.tvec - t).max() < 0.004, (marker_id, pose.tvec, t)
-        assert rotation_angle(pose.rotation_matrix, R) < 1.5, marker_id
-        assert pose.error < 0.3
+        # The issue's bar for markers of 50 px or more: 1 % of the
+        # distance, half a degree (measured: 0.1 %, 0.4 degree at worst).
+        assert np.linalg.norm(pose.tvec - t) < 0.01 * np.linalg.norm(t), (marker_id, pose.tvec, t)
+        assert rotation_angle(pose.rotation_matrix, R) < 0.5, marker_id
+        assert pose.error < 0.1 and pose.ambiguity > 10
         assert pose.tvec.dtype == np.float64 and pose.rvec.shape == (3,)
         # rotation_matrix is rvec's, transform both.
-        np.testing.assert_allclose(rodrigues(pose.rotation_matrix), pose.rvec, atol=1e-9)
+        np.testing.assert_allclose(rodrigues(pose.rvec), pose.rotation_matrix, atol=1e-9)
         np.testing.assert_allclose(pose.transform[:3, :3], pose.rotation_matrix)
         np.testing.assert_allclose(pose.transform[:3, 3], pose.tvec)
         assert pose.transform[3].tolist() == [0, 0, 0, 1]
@@ -137,3 +156,31 @@ distortion_coefficients:
     b = frappe.estimate_pose(corners, 0.05, cam.matrix, cam.distortion)
     np.testing.assert_array_equal(a.tvec, b.tvec)
     check_file_errors(frappe.read_calibration, tmp_path, "hello: world\n")
+
+
+def test_sample_calibrations(tmp_path):
+    """The sample video's camera (examples/data) in ROS and OpenCV YAML, and
+    the same written as OpenCV XML, read alike."""
+    data = ROOT / "examples" / "data"
+    xml = tmp_path / "camera.xml"
+    xml.write_text("""<?xml version="1.0"?>
+<opencv_storage>
+<image_width>640</image_width>
+<image_height>480</image_height>
+<camera_matrix type_id="opencv-matrix"><rows>3</rows><cols>3</cols><dt>d</dt>
+  <data>700. 0. 319.5 0. 700. 239.5 0. 0. 1.</data></camera_matrix>
+<distortion_coefficients type_id="opencv-matrix"><rows>5</rows><cols>1</cols><dt>d</dt>
+  <data>0. 0. 0. 0. 0.</data></distortion_coefficients>
+</opencv_storage>
+""")
+    K700 = [[700, 0, 319.5], [0, 700, 239.5], [0, 0, 1]]
+    R, t = rotation(25, -15, 40), np.array([0.05, -0.03, 0.5])
+    corners = marker_corners(K700, R, t, 0.05)
+    for path in (data / "camera-700.yaml", str(data / "camera-700-opencv.yml"), xml):
+        cam = frappe.read_calibration(path)
+        assert (cam.width, cam.height) == (640, 480), path
+        np.testing.assert_array_equal(cam.matrix, K700)
+        assert cam.distortion.tolist() == [0.0] * 5
+        pose = frappe.estimate_pose(corners, 0.05, cam)
+        np.testing.assert_allclose(pose.tvec, t, atol=1e-5)
+        assert rotation_angle(pose.rotation_matrix, R) < 0.01
