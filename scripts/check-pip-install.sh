@@ -2,8 +2,8 @@
 # Checks the Python package as a new user gets it: pip install . into a
 # fresh virtual environment (with the system's meson-python, pybind11 and
 # numpy, --no-build-isolation: no network needed), then, from outside the
-# source tree, imports frappe and detects a rendered marker. Prints the time
-# taken; about 3 minutes of compiling on two cores.
+# source tree, imports frappe, detects a rendered marker and estimates its
+# pose. Prints the time taken; about 4 minutes of compiling on two cores.
 #   scripts/check-pip-install.sh [PYTHON]     (default /usr/bin/python3)
 set -euo pipefail
 
@@ -24,7 +24,7 @@ start=$(date +%s)
 }
 
 cd "$work"
-"$work/venv/bin/python" - <<'PY'
+FRAPPE_SRC=$src "$work/venv/bin/python" - <<'PY'
 import numpy as np
 import frappe
 
@@ -37,6 +37,12 @@ assert [m.id for m in found] == [42], found
 # The border's outer corners: 12 px of quiet zone, pixel centres at integers.
 truth = np.array([[161.5, 111.5], [257.5, 111.5], [257.5, 207.5], [161.5, 207.5]])
 assert np.abs(found[0].corners - truth).max() < 0.5, found[0].corners
-print(f"check-pip-install: frappe {frappe.__version__} from {frappe.__file__}: {found[0]}")
+# Seen by a 600 px pinhole centred at (199.5, 149.5), a 96 px marker of
+# 9.6 cm is 0.6 m away, its centre (209.5, 159.5) 1 cm right and down.
+pose = frappe.estimate_pose(found[0], 0.096, frappe.Camera.pinhole(600, 600, 199.5, 149.5))
+assert np.abs(pose.tvec - [0.01, 0.01, 0.6]).max() < 1e-3, pose
+cam = frappe.read_calibration(__import__("os").environ["FRAPPE_SRC"] + "/examples/data/camera-700.yaml")
+assert (cam.fx, cam.width) == (700.0, 640), cam
+print(f"check-pip-install: frappe {frappe.__version__} from {frappe.__file__}: {found[0]}, {pose}")
 PY
 echo "check-pip-install: passed in $(($(date +%s) - start)) s"

@@ -1,7 +1,5 @@
 # SPDX-License-Identifier: MIT
 # Type stubs of the package frappe (the extension frappe._frappe).
-# estimate_pose, read_calibration, Camera, Pose, project_points,
-# undistort_points and load_dictionary exist when the library has them.
 
 from __future__ import annotations
 
@@ -128,6 +126,8 @@ class Camera:
 def read_calibration(path: Union[str, PathLike[str]]) -> Camera: ...
 
 class Pose:
+    """frappe::MarkerPose in one: rvec, tvec, error are its pose's;
+    alternative (None for none, and on the alternative itself), ambiguity."""
     @property
     def rvec(self) -> npt.NDArray[np.float64]: ...
     @property

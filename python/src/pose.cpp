@@ -219,7 +219,8 @@ the file and key when it is not a calibration.)doc");
 Where a marker is: the motion from the marker's frame to the camera's, as
 cv2.solvePnP gives it (x right, y down, z forward; the marker's origin at its
 centre, x right, y up, z towards the viewer). Units are those of the marker
-size given to estimate_pose().)doc")
+size given to estimate_pose(). The better of the two poses a square's corners
+allow, with the other as .alternative: C++'s frappe::MarkerPose in one.)doc")
 		.def_property_readonly("rvec", [](const PyPose &p) { return vector3(p.pose.rvec); },
 				       "Rotation vector (axis times angle, radians), (3,) float64, as cv2.Rodrigues.")
 		.def_property_readonly("tvec", [](const PyPose &p) { return vector3(p.pose.tvec); },
@@ -267,7 +268,7 @@ The pose of a square marker of side `marker_size` (> 0, in the unit you want
 tvec in) whose corners the camera saw at `corners` (a Marker, or (4, 2)
 pixels as the detector reports them: distorted, top-left first, clockwise).
 camera_matrix is a 3 x 3 array with dist_coeffs (0, 4, 5 or 8 values, None
-for none), or a frappe.Camera. IPPE with Gauss-Newton refinement; returns a
+for none), or a frappe.Camera. IPPE refined by Levenberg-Marquardt; returns a
 frappe.Pose, or None when the corners are degenerate (collinear, not finite).
 Raises ValueError for a size not positive or a bad camera.)doc");
 
