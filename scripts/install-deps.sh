@@ -15,6 +15,9 @@ packages=(
 	clang libclang-rt-14-dev
 	# the data tests' scorer (../shared/tools/eval.py) and scripts/quality.py
 	python3-numpy
+	# the Python module (python/: pip install --no-build-isolation ., its
+	# tests, scripts/check-pip-install.sh)
+	python3-dev pybind11-dev python3-mesonpy python3-pytest python3-venv python3-pip
 	# the CMake package (its version file comes from cmake's templates) and
 	# its test; dpkg-shlibdeps for scripts/build-debs.sh
 	cmake dpkg-dev
