@@ -33,7 +33,8 @@ struct Pose {
 /// Both poses a square's four corners allow. A planar square seen from
 /// afar or face on is ambiguous: two poses, mirror images about the line of
 /// sight, project it almost alike. IPPE finds both in closed form; the one
-/// that reprojects better is refined by a few Gauss-Newton steps.
+/// that reprojects better is refined by a few Levenberg-Marquardt
+/// steps (Gauss-Newton kept from diverging).
 struct FRAPPE_EXPORT MarkerPose {
 	Pose pose;        ///< the better solution, refined
 	Pose alternative; ///< the other (unrefined); alternative.error is infinity when there was none
