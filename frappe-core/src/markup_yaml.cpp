@@ -64,19 +64,26 @@ std::size_t quoteEnd(std::string_view s, std::size_t i)
 	return std::string_view::npos;
 }
 
+/* For loops that skip quoted text: when s[i] opens a quoted scalar, where
+ * it closes (npos when it does not), else i. */
+std::size_t pastQuote(std::string_view s, std::size_t i)
+{
+	if ((s[i] != '"' && s[i] != '\'') || !opensQuote(s, i))
+		return i;
+	const std::size_t end = quoteEnd(s, i);
+	return end == std::string_view::npos ? end : end - 1;
+}
+
 /* The line without its comment: # at its start or after a space, outside
  * quotes. */
 std::string_view stripComment(std::string_view s)
 {
 	for (std::size_t i = 0; i < s.size(); ++i) {
-		if ((s[i] == '"' || s[i] == '\'') && opensQuote(s, i)) {
-			const std::size_t end = quoteEnd(s, i);
-			if (end == std::string_view::npos)
-				return s;
-			i = end - 1;
-		} else if (s[i] == '#' && (i == 0 || isSpace(s[i - 1]))) {
+		i = pastQuote(s, i);
+		if (i == std::string_view::npos)
+			return s;
+		if (s[i] == '#' && (i == 0 || isSpace(s[i - 1])))
 			return s.substr(0, i);
-		}
 	}
 	return s;
 }
@@ -341,16 +348,13 @@ private:
 	{
 		int n = 0;
 		for (std::size_t i = 0; i < s.size(); ++i) {
-			if ((s[i] == '"' || s[i] == '\'') && opensQuote(s, i)) {
-				const std::size_t end = quoteEnd(s, i);
-				if (end == std::string_view::npos)
-					return n;
-				i = end - 1;
-			} else if (s[i] == '[' || s[i] == '{') {
+			i = pastQuote(s, i);
+			if (i == std::string_view::npos)
+				return n;
+			if (s[i] == '[' || s[i] == '{')
 				++n;
-			} else if (s[i] == ']' || s[i] == '}') {
+			else if (s[i] == ']' || s[i] == '}')
 				--n;
-			}
 		}
 		return n;
 	}

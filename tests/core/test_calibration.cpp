@@ -287,13 +287,19 @@ TEST(Calibration, RosCameraInfoMessage)
 	EXPECT_EQ(c.distortion, (std::vector<double>{ 0.35, -0.12, 0.0009, 0.0005, 0.02, 0.62, -0.06, 0.03 }));
 }
 
-TEST(Calibration, OpenCvYaml)
+/* The size and matrix of both OpenCV samples. */
+void expectOpenCvSample(const Camera &c)
 {
-	const Camera c = parseCalibration(kOpenCvYaml, "out_camera_data.yml");
 	EXPECT_EQ(c.width, 1280);
 	EXPECT_EQ(c.height, 720);
 	expectMatrix(c, { 9.1234567890123457e+02, 0, 6.4012345678901234e+02, 0, 9.1334567890123457e+02,
 			  3.6012345678901234e+02, 0, 0, 1 });
+}
+
+TEST(Calibration, OpenCvYaml)
+{
+	const Camera c = parseCalibration(kOpenCvYaml, "out_camera_data.yml");
+	expectOpenCvSample(c);
 	EXPECT_EQ(c.distortion, (std::vector<double>{ 1.2345678901234567e-01, -2.3456789012345678e-01, 1e-3,
 						      -2e-3, 9.8765432109876543e-02 }));
 }
@@ -301,10 +307,7 @@ TEST(Calibration, OpenCvYaml)
 TEST(Calibration, OpenCvXml)
 {
 	const Camera c = parseCalibration(kOpenCvXml, "out_camera_data.xml");
-	EXPECT_EQ(c.width, 1280);
-	EXPECT_EQ(c.height, 720);
-	expectMatrix(c, { 9.1234567890123457e+02, 0, 6.4012345678901234e+02, 0, 9.1334567890123457e+02,
-			  3.6012345678901234e+02, 0, 0, 1 });
+	expectOpenCvSample(c);
 	EXPECT_EQ(c.distortion, (std::vector<double>{ 0.12, -0.23, 1e-3, -2e-3, 9.8e-2, 0.15, -0.01, 3e-3 }));
 }
 
@@ -338,25 +341,26 @@ image_size: [320,   # width
   - 0
   - 1
 dist_coeffs:
+- 0.1
+- -0.05
+- 1e-3
+- +0.002
+- .01
+- 0.2
+- -0.03
+- 0.004
 - 0
-- 0
-- 0
-- 0
-- 0
-- 0
-- 0
-- 0
-- 0
-- 0
-- 0
-- 0
-- 0
-- 0
+- 0.
+- -0
+- 0e0
+- .0
+- 0.0
 )");
 	EXPECT_EQ(y.width, 320);
 	EXPECT_EQ(y.height, 240);
 	expectMatrix(y, { 300, 0, 160, 0, 305.5, 120, 0, 0, 1 });
-	EXPECT_EQ(y.distortion, std::vector<double>(8, 0.0)); /* 14 with the thin prism and tilt zero */
+	/* 14, the thin prism and tilt terms zero */
+	EXPECT_EQ(y.distortion, (std::vector<double>{ 0.1, -0.05, 0.001, 0.002, 0.01, 0.2, -0.03, 0.004 }));
 
 	const Camera z = parseCalibration("K: {rows: 3, cols: 3, data: [500, 0, 10, 0, 500, 20, 0, 0, 1]}\n"
 					  "D: []\n");

@@ -54,12 +54,17 @@ struct FRAPPE_EXPORT Camera {
 /// Reads a calibration file, whatever its kind (told by its content):
 /// - ROS camera_info YAML (camera_calibration's output): image_width,
 ///   image_height, camera_matrix {rows, cols, data}, distortion_model,
-///   distortion_coefficients {data};
+///   distortion_coefficients {data}; or a CameraInfo message as printed
+///   (width, height, K, D, distortion_model);
 /// - OpenCV FileStorage YAML (%YAML:1.0, !!opencv-matrix) or XML
 ///   (<opencv_storage>, type_id="opencv-matrix"), with the keys OpenCV's
 ///   samples and calibration tools write: camera_matrix or cameraMatrix or
 ///   K, distortion_coefficients or dist_coeffs or distCoeffs or D,
 ///   image_width / image_height or imageSize or image_size [w, h].
+/// The size is optional, the matrix and the distortion (possibly empty) are
+/// not. A distortion_model must be plumb_bob (5 coefficients) or
+/// rational_polynomial (8): equidistant (fisheye) is refused. OpenCV's 12
+/// or 14 coefficients are accepted when the terms beyond 8 are zero.
 /// Throws std::runtime_error when the file cannot be read (missing, not a
 /// regular file, over 1 MiB), std::invalid_argument when it is not a
 /// calibration (unknown kind, a missing key, a matrix of the wrong size, a
