@@ -34,39 +34,50 @@ Camera Camera::pinhole(double fx, double fy, double cx, double cy, int width, in
 	return c;
 }
 
+namespace {
+
+/* What is wrong with a camera, or "" when nothing is. valid() asks without
+ * throwing: a plugin may sit in a C program, where throwing for an unset
+ * camera on every caps change would be both slow and, under a preloaded
+ * AddressSanitizer, fatal. */
+std::string problem(const Camera &c)
+{
+	for (std::size_t i = 0; i < c.matrix.size(); ++i)
+		if (!std::isfinite(c.matrix[i]))
+			return "camera matrix entry " + std::to_string(i) + " is not finite";
+	if (!(c.matrix[0] > 0.0))
+		return "fx must be positive, got " + str(c.matrix[0]);
+	if (!(c.matrix[4] > 0.0))
+		return "fy must be positive, got " + str(c.matrix[4]);
+	if (c.matrix[3] != 0.0 || c.matrix[6] != 0.0 || c.matrix[7] != 0.0 || c.matrix[8] != 1.0)
+		return "camera matrix: the last row must be 0 0 1 and [1][0] 0, got [1][0] " + str(c.matrix[3]) +
+		       ", last row " + str(c.matrix[6]) + " " + str(c.matrix[7]) + " " + str(c.matrix[8]);
+	const std::size_t n = c.distortion.size();
+	if (n != 0 && n != 4 && n != 5 && n != 8)
+		return "distortion: " + std::to_string(n) + " coefficients, expected 0, 4, 5 or 8";
+	for (std::size_t i = 0; i < n; ++i)
+		if (!std::isfinite(c.distortion[i]))
+			return "distortion coefficient " + std::to_string(i) + " is not finite";
+	if (c.width < 0 || c.height < 0)
+		return "negative size " + std::to_string(c.width) + "x" + std::to_string(c.height);
+	if ((c.width == 0) != (c.height == 0))
+		return "size " + std::to_string(c.width) + "x" + std::to_string(c.height) +
+		       ": give both the width and the height, or neither";
+	return {};
+}
+
+} // namespace
+
 bool Camera::valid() const
 {
-	try {
-		validate();
-		return true;
-	} catch (const std::invalid_argument &) {
-		return false;
-	}
+	return problem(*this).empty();
 }
 
 void Camera::validate() const
 {
-	for (std::size_t i = 0; i < matrix.size(); ++i)
-		if (!std::isfinite(matrix[i]))
-			fail("camera matrix entry " + std::to_string(i) + " is not finite");
-	if (!(matrix[0] > 0.0))
-		fail("fx must be positive, got " + str(matrix[0]));
-	if (!(matrix[4] > 0.0))
-		fail("fy must be positive, got " + str(matrix[4]));
-	if (matrix[3] != 0.0 || matrix[6] != 0.0 || matrix[7] != 0.0 || matrix[8] != 1.0)
-		fail("camera matrix: the last row must be 0 0 1 and [1][0] 0, got [1][0] " + str(matrix[3]) +
-		     ", last row " + str(matrix[6]) + " " + str(matrix[7]) + " " + str(matrix[8]));
-	const std::size_t n = distortion.size();
-	if (n != 0 && n != 4 && n != 5 && n != 8)
-		fail("distortion: " + std::to_string(n) + " coefficients, expected 0, 4, 5 or 8");
-	for (std::size_t i = 0; i < n; ++i)
-		if (!std::isfinite(distortion[i]))
-			fail("distortion coefficient " + std::to_string(i) + " is not finite");
-	if (width < 0 || height < 0)
-		fail("negative size " + std::to_string(width) + "x" + std::to_string(height));
-	if ((width == 0) != (height == 0))
-		fail("size " + std::to_string(width) + "x" + std::to_string(height) +
-		     ": give both the width and the height, or neither");
+	const std::string p = problem(*this);
+	if (!p.empty())
+		fail(p);
 }
 
 bool Camera::fits(int frame_width, int frame_height) const
