@@ -60,7 +60,7 @@
  * warning and gives no pose. A file that cannot be used is an error at
  * start; set while playing, it is a warning and the previous file is kept
  * (a refused marker-sizes, camera-matrix or distortion: a warning too).
- * The pose (frappe::estimatePose: IPPE, refined by Gauss-Newton) is in
+ * The pose (frappe::estimatePose: IPPE, refined by Levenberg-Marquardt) is in
  * OpenCV's camera frame (x right, y down, z forward) for the marker frame
  * of OpenCV aruco: origin at the marker centre, x right, y up, z out of the
  * marker towards the camera.
