@@ -5,6 +5,7 @@
 
 #include "frappe/export.h"
 
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -84,6 +85,10 @@ public:
 	/// Whether run() fills out.regions too; otherwise the Detector adds
 	/// the CPU's region map.
 	virtual bool makesRegionMap() const { return false; }
+	/// Bytes of the last frame the front end copied into memory of its
+	/// own before reading them (0 when it read the frame in place, as the
+	/// CPU does), so that a zero-copy path can be checked and logged.
+	virtual std::size_t lastCopyBytes() const { return 0; }
 };
 
 /// The reference CPU front end. `threads` > 1 splits the frame into row

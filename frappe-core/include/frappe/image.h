@@ -15,6 +15,13 @@ struct ImageView {
 	int width = 0;
 	int height = 0;
 	int stride = 0; ///< bytes from one row to the next, >= width
+	/// When the pixels live in a dma-buf (a camera's or a GPU-visible
+	/// pool's buffer): its file descriptor, borrowed like the pixels, and
+	/// the byte offset of `data` in it; -1 for ordinary memory. A backend
+	/// that can read the dma-buf in place (the VC4's QPUs) imports it
+	/// instead of copying the frame; the CPU ignores both fields.
+	int dmabuf_fd = -1;
+	std::size_t dmabuf_offset = 0;
 
 	constexpr ImageView() = default;
 	constexpr ImageView(const std::uint8_t *d, int w, int h, int s)

@@ -3,6 +3,9 @@
 
 #include <stdexcept>
 
+#include <sys/mman.h>
+#include <unistd.h>
+
 #include "frontend/vc4_front_end.hpp"
 #include "frontend/vc4_warper.hpp"
 
@@ -44,6 +47,24 @@ BackendChoice selectFrontEnd(std::string_view name, int threads)
 					    std::string(kBackendNames));
 	}
 	return choice;
+}
+
+int allocateFrameMemory(std::string_view backend, std::size_t bytes, std::string &why)
+{
+	/* First cut, for both: a memfd. The real GPU's dma-heap comes with
+	 * the zero-copy path (issue 14). */
+	if (backend != "vc4" && backend != "vc4-emu") {
+		why = "no QPU frame memory for backend '" + std::string(backend) + "'";
+		return -1;
+	}
+	const int fd = memfd_create("frappe-frame", MFD_CLOEXEC);
+	if (fd < 0 || ftruncate(fd, static_cast<off_t>(bytes)) != 0) {
+		why = "memfd_create failed";
+		if (fd >= 0)
+			close(fd);
+		return -1;
+	}
+	return fd;
 }
 
 } // namespace frappe::vc4

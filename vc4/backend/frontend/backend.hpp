@@ -4,6 +4,7 @@
 // frappe::FrontEnd; what runs behind it stays in vc4/.
 #pragma once
 
+#include <cstddef>
 #include <memory>
 #include <string>
 #include <string_view>
@@ -32,5 +33,13 @@ inline constexpr std::string_view kBackendNames = "auto, cpu, vc4, vc4-emu";
 /// when the probe succeeds, else the CPU with `fallback` set. Throws
 /// std::invalid_argument for any other name.
 BackendChoice selectFrontEnd(std::string_view name, int threads);
+
+/// Frame memory the QPUs of `backend` ("vc4" or "vc4-emu") read in place: a
+/// dma-buf of at least `bytes`, for an upstream element to write camera frames
+/// into (the element offers a pool of them in the ALLOCATION query). "vc4":
+/// from the dma-heap the runtime uses; "vc4-emu": a memfd, as the emulator
+/// reads host memory. Returns the file descriptor (the caller owns it) or -1
+/// with `why` set in one sentence. Never throws.
+int allocateFrameMemory(std::string_view backend, std::size_t bytes, std::string &why);
 
 } // namespace frappe::vc4
