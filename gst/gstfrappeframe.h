@@ -15,7 +15,7 @@ struct MappedFrame {
 	GstBuffer *buffer = nullptr; /* writable, owned */
 	GstVideoFrame frame{};       /* mapped until finished or discarded */
 	bool writable = false;       /* mapped for annotation */
-	ImageView image;             /* the luma plane */
+	ImageView image;             /* the luma plane, and its dma-buf when it lies in one */
 
 	/* Maps `buffer` (taking it) read-only, or read-write to annotate;
 	 * false, and the buffer dropped, when it cannot be mapped. */
