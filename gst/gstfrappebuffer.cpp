@@ -119,9 +119,12 @@ void BufferLog::memory(GstElement *element, GstBuffer *buffer, const GstVideoInf
 	const bool dmabuf = mem && gst_is_dmabuf_memory(mem);
 	if (!loggedMemory_) {
 		loggedMemory_ = true;
+		/* Without a meta, mapping several memories merges them. */
+		const guint n = gst_buffer_get_video_meta(buffer) ? 1 : gst_buffer_n_memory(buffer);
 		if (dmabuf)
-			GST_DEBUG_OBJECT(element, "input is dmabuf memory (fd %d): mapped %s, not copied",
-					 gst_dmabuf_memory_get_fd(mem), annotate ? "read-write to annotate" : "read-only");
+			GST_DEBUG_OBJECT(element, "input is dmabuf memory (fd %d): mapped %s, %s",
+					 gst_dmabuf_memory_get_fd(mem), annotate ? "read-write to annotate" : "read-only",
+					 n > 1 ? "its memories merged into one (a copy)" : "not copied");
 		else
 			GST_DEBUG_OBJECT(element, "input is %s memory",
 					 mem && mem->allocator ? mem->allocator->mem_type : "unknown");
@@ -135,7 +138,7 @@ void BufferLog::memory(GstElement *element, GstBuffer *buffer, const GstVideoInf
 	}
 }
 
-void BufferLog::copied(GstElement *element, GstBuffer *buffer, const ImageView &image, std::size_t bytes,
+void BufferLog::copied(GstElement *element, const ImageView &image, bool dmabufInput, std::size_t bytes,
 		       bool poolOffered)
 {
 	if (bytes == 0 || std::exchange(loggedCopy_, true))
@@ -145,7 +148,7 @@ void BufferLog::copied(GstElement *element, GstBuffer *buffer, const ImageView &
 		why = "the luma rows in the dma-buf are not 4-byte aligned";
 	else if (image.dmabuf_fd >= 0)
 		why = "the backend did not read the dma-buf in place (its debug output says why)";
-	else if (gst_is_dmabuf_memory(gst_buffer_peek_memory(buffer, 0)))
+	else if (dmabufInput)
 		why = "the luma plane is not within one dma-buf memory";
 	else if (poolOffered)
 		why = "system memory: upstream did not take the offered pool of GPU-visible buffers";

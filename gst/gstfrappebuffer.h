@@ -56,11 +56,12 @@ public:
 	void memory(GstElement *element, GstBuffer *buffer, const GstVideoInfo *info, bool annotate);
 
 	/* One debug line, the first time the backend copied a frame (`bytes`
-	 * > 0) before reading it, saying why: system memory (upstream did not
+	 * > 0) of `image` (from dma-buf memory when `dmabufInput`) before
+	 * reading it, saying why: system memory (upstream did not
 	 * take the offered pool, or none was offered), a luma plane not in one
 	 * dma-buf memory, rows not 4-byte aligned in the dma-buf, or else the
 	 * backend's own reason. */
-	void copied(GstElement *element, GstBuffer *buffer, const ImageView &image, std::size_t bytes,
+	void copied(GstElement *element, const ImageView &image, bool dmabufInput, std::size_t bytes,
 		    bool poolOffered);
 
 private:

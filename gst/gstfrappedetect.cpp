@@ -278,7 +278,7 @@ static void finish(GstFrappeDetect *self, MappedFrame &f, const frappe::Result &
 		frappe::gst::annotateMarkers(&f.frame, result, priv->bestPoses, s.sizes, priv->camera.fitted());
 	}
 
-	priv->bufferLog.copied(GST_ELEMENT(self), f.buffer, f.image, result.copy_bytes, priv->poolOffered);
+	priv->bufferLog.copied(GST_ELEMENT(self), f.image, f.dmabufInput, result.copy_bytes, priv->poolOffered);
 	GstBuffer *buffer = f.release();
 
 	if (s.postMessages) {

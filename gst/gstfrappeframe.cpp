@@ -45,6 +45,9 @@ bool MappedFrame::map(GstBuffer *buf, const GstVideoInfo *info, bool forAnnotati
 	 * read-only for the metas; we own the buffer until it is pushed. */
 	const auto flags = static_cast<GstMapFlags>(static_cast<int>(writable ? GST_MAP_READWRITE : GST_MAP_READ) |
 						    static_cast<int>(GST_VIDEO_FRAME_MAP_FLAG_NO_REF));
+	/* Mapping a buffer of several memories without a meta merges them
+	 * into system memory (and replaces them). */
+	dmabufInput = gst_is_dmabuf_memory(gst_buffer_peek_memory(buffer, 0));
 	if (!gst_video_frame_map(&frame, const_cast<GstVideoInfo *>(info), buffer, flags)) {
 		gst_buffer_unref(buffer);
 		buffer = nullptr;
