@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: MIT
  *
- * frappe_backend.cpp: the front end a user names put into a detector.
+ * frappe_backend.cpp: the front end a user names put into a detector, and
+ * the frame memory its QPUs read in place.
  */
 #include "frappe_backend.h"
 
@@ -35,6 +36,17 @@ std::string selectBackend(Pipeline &pipeline, std::string_view name)
 	if (name == "vc4" || name == "vc4-emu")
 		throw BackendNotBuilt("backend " + std::string(name) + " needs vc4/, which this build lacks");
 	throw std::invalid_argument("unknown backend '" + std::string(name) + "' (auto, cpu, vc4, vc4-emu)");
+#endif
+}
+
+int allocateFrameMemory(std::string_view backend, std::size_t bytes, std::string &why)
+{
+#ifdef FRAPPE_HAVE_VC4
+	return vc4::allocateFrameMemory(backend, bytes, why);
+#else
+	(void)bytes;
+	why = "no frame memory for backend '" + std::string(backend) + "': this build has no vc4/";
+	return -1;
 #endif
 }
 

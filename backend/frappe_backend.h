@@ -1,11 +1,13 @@
 /* SPDX-License-Identifier: MIT
  *
  * frappe_backend.h: the front end a user names (the element's backend
- * property, the CLI's --backend) put into a detector. No GStreamer types,
- * so that any program can call it.
+ * property, the CLI's --backend) put into a detector, and the frame memory
+ * its QPUs read in place. No GStreamer types, so that any program can call
+ * it.
  */
 #pragma once
 
+#include <cstddef>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -33,5 +35,14 @@ public:
  * name, BackendNotBuilt, and std::runtime_error when the QPUs cannot be used.
  */
 std::string selectBackend(Pipeline &pipeline, std::string_view name);
+
+/*
+ * Frame memory the QPUs of `backend` ("vc4" or "vc4-emu") read in place: a
+ * dma-buf of at least `bytes`, for an upstream element to write frames into
+ * (the element's pool of GPU-visible buffers). Returns its file descriptor,
+ * which the caller owns, or -1 with `why` set in one sentence (any other
+ * backend, or a build without vc4/). Never throws.
+ */
+int allocateFrameMemory(std::string_view backend, std::size_t bytes, std::string &why);
 
 } /* namespace frappe */

@@ -4,8 +4,13 @@
 #include <algorithm>
 #include <cstdarg>
 #include <cstdint>
+#include <utility>
 
 #include <gst/allocators/gstdmabuf.h>
+
+#include <frappe/config.h>
+
+#include "gstfrappepool.h"
 
 GST_DEBUG_CATEGORY_EXTERN(gst_frappe_detect_debug);
 #define GST_CAT_DEFAULT gst_frappe_detect_debug
@@ -114,18 +119,57 @@ void BufferLog::memory(GstElement *element, GstBuffer *buffer, const GstVideoInf
 	const bool dmabuf = mem && gst_is_dmabuf_memory(mem);
 	if (!loggedMemory_) {
 		loggedMemory_ = true;
+		/* Without a meta, mapping several memories merges them. */
+		const guint n = gst_buffer_get_video_meta(buffer) ? 1 : gst_buffer_n_memory(buffer);
 		if (dmabuf)
-			GST_DEBUG_OBJECT(element, "input is dmabuf memory (fd %d): mapped %s, not copied",
-					 gst_dmabuf_memory_get_fd(mem), annotate ? "read-write to annotate" : "read-only");
+			GST_DEBUG_OBJECT(element, "input is dmabuf memory (fd %d): mapped %s, %s",
+					 gst_dmabuf_memory_get_fd(mem), annotate ? "read-write to annotate" : "read-only",
+					 n > 1 ? "its memories merged into one (a copy)" : "not copied");
 		else
 			GST_DEBUG_OBJECT(element, "input is %s memory",
 					 mem && mem->allocator ? mem->allocator->mem_type : "unknown");
 	}
-	if (dmabuf && !warnedStride_ && !gst_buffer_get_video_meta(buffer) && GST_VIDEO_INFO_WIDTH(info) % 64 != 0) {
+	/* Our own pool's buffers have the default layout without a meta. */
+	if (dmabuf && !warnedStride_ && !gst_buffer_get_video_meta(buffer) && GST_VIDEO_INFO_WIDTH(info) % 64 != 0 &&
+	    !isFramePool(buffer->pool)) {
 		warnedStride_ = true;
 		GST_WARNING_OBJECT(element, "dmabuf input %d pixels wide without GstVideoMeta: the "
 				   "producer's stride may differ from the default one", GST_VIDEO_INFO_WIDTH(info));
 	}
+}
+
+void BufferLog::copied(GstElement *element, const ImageView &image, bool dmabufInput, std::size_t bytes,
+		       bool poolOffered)
+{
+	if (bytes == 0 || std::exchange(loggedCopy_, true))
+		return;
+	const char *why;
+	if (image.dmabuf_fd >= 0 && (image.stride % 4 != 0 || image.dmabuf_offset % 4 != 0))
+		why = "the luma rows in the dma-buf are not 4-byte aligned";
+	else if (image.dmabuf_fd >= 0)
+		why = "the backend did not read the dma-buf in place (its debug output says why)";
+	else if (dmabufInput)
+		why = "the luma plane is not within one dma-buf memory";
+	else if (poolOffered)
+		why = "system memory: upstream did not take the offered pool of GPU-visible buffers";
+	else
+		why = "system memory: no pool was offered (no ALLOCATION query, or no frame memory)";
+	GST_DEBUG_OBJECT(element, "frame copied for the backend, %" G_GSIZE_FORMAT " bytes (luma stride %d, "
+			 "dma-buf fd %d offset %" G_GSIZE_FORMAT "): %s; later copies are not logged", bytes,
+			 image.stride, image.dmabuf_fd, image.dmabuf_offset, why);
+}
+
+bool acceptFrameSize(GstElement *element, const GstVideoInfo *info)
+{
+	const gint w = GST_VIDEO_INFO_WIDTH(info), h = GST_VIDEO_INFO_HEIGHT(info);
+	GST_DEBUG_OBJECT(element, "%s %dx%d", GST_VIDEO_INFO_NAME(info), w, h);
+	const long long maxPixels = frappe::Config{}.max_pixels;
+	if (static_cast<long long>(w) * h <= maxPixels)
+		return true;
+	GST_ELEMENT_ERROR(element, CORE, NEGOTIATION,
+			  ("Frames of %dx%d are larger than the detector accepts (%lld pixels)", w, h, maxPixels),
+			  (nullptr));
+	return false;
 }
 
 void askOneMoreBuffer(GstElement *element, GstQuery *query)

@@ -3,7 +3,8 @@
  * gstfrappebuffer.h: what the element checks and logs about an input
  * buffer before it maps it: whether its memory holds the frame its caps and
  * GstVideoMeta describe (a buffer that lies would make the detector read,
- * or annotation write, past its end), and which memory it is; and the one
+ * or annotation write, past its end), which memory it is and why the
+ * backend copied it; and the one
  * more buffer it asks of upstream's pools when it holds one (pipelined).
  */
 #pragma once
@@ -12,6 +13,8 @@
 #include <cstddef>
 
 #include <gst/video/video.h>
+
+#include <frappe/image.h>
 
 namespace frappe::gst {
 
@@ -52,11 +55,26 @@ public:
 	 * default stride a producer may not use. */
 	void memory(GstElement *element, GstBuffer *buffer, const GstVideoInfo *info, bool annotate);
 
+	/* One debug line, the first time the backend copied a frame (`bytes`
+	 * > 0) of `image` (from dma-buf memory when `dmabufInput`) before
+	 * reading it, saying why: system memory (upstream did not
+	 * take the offered pool, or none was offered), a luma plane not in one
+	 * dma-buf memory, rows not 4-byte aligned in the dma-buf, or else the
+	 * backend's own reason. */
+	void copied(GstElement *element, const ImageView &image, bool dmabufInput, std::size_t bytes,
+		    bool poolOffered);
+
 private:
 	std::array<bool, static_cast<std::size_t>(Lie::Count)> warnedLie_{};
 	bool loggedMemory_ = false;
 	bool warnedStride_ = false;
+	bool loggedCopy_ = false;
 };
+
+/* Whether frames of `info`'s size are within frappe::Config's max_pixels
+ * (the element leaves it at its default); a GST_ELEMENT_ERROR if not, at
+ * negotiation rather than at every buffer. */
+bool acceptFrameSize(GstElement *element, const GstVideoInfo *info);
 
 /* Raises every pool's minimum (and a lower maximum) in an ALLOCATION
  * query by one: the buffer held while pipelined. */

@@ -70,7 +70,11 @@
  * 1, 2 or 3 (it fails to start when they cannot be used, e.g. while the vc4
  * KMS driver owns the GPU); `vc4-emu`, the same QPU programs on an emulator,
  * bit-exact and slow, for testing anywhere; `auto` (the default), the QPUs
- * when the probe succeeds, else the CPU with one warning on a Pi.
+ * when the probe succeeds, else the CPU with one warning on a Pi. With the
+ * QPUs the element offers upstream a pool of GPU-visible dma-buf buffers
+ * (rows 64-byte aligned when a GstVideoMeta can say so) and the QPUs read a
+ * luma plane that lies in one dma-buf in place; other input is copied (the
+ * stats' `copied-bytes`, and one debug line saying why).
  *
  * With #GstFrappeDetect:pipelined, two frames are detected at once, each
  * whole frame on a detector of its own on one of two threads (a
@@ -136,6 +140,7 @@
 #include "gstfrappecamera.h"
 #include "gstfrappeenums.h"
 #include "gstfrappeoutput.h"
+#include "gstfrappepool.h"
 #include "gstfrappesettings.h"
 #include "gstfrappeframe.h"
 
@@ -168,6 +173,7 @@ struct FrappeDetectPrivate {
 	std::vector<GstBuffer *> output; /* finished, waiting for generate_output */
 	frappe::gst::BufferLog bufferLog;
 	bool warnedFallback = false, warnedDropped = false;
+	bool poolOffered = false; /* a GstFrappePool went upstream */
 	guint64 frames = 0;
 	frappe::gst::StatsWindow window;
 };
@@ -272,6 +278,7 @@ static void finish(GstFrappeDetect *self, MappedFrame &f, const frappe::Result &
 		frappe::gst::annotateMarkers(&f.frame, result, priv->bestPoses, s.sizes, priv->camera.fitted());
 	}
 
+	priv->bufferLog.copied(GST_ELEMENT(self), f.image, f.dmabufInput, result.copy_bytes, priv->poolOffered);
 	GstBuffer *buffer = f.release();
 
 	if (s.postMessages) {
@@ -548,20 +555,26 @@ static gboolean gst_frappe_detect_query(GstBaseTransform *trans, GstPadDirection
 	return ret;
 }
 
-/* Holding a buffer in pipelined mode takes one more from upstream's pool. */
+/* The QPUs' frame memory for upstream to write into; holding a buffer in
+ * pipelined mode takes one more from upstream's pool (or ours). */
 static gboolean gst_frappe_detect_propose_allocation(GstBaseTransform *trans, GstQuery *decide_query,
 						     GstQuery *query)
 {
 	GstFrappeDetect *self = GST_FRAPPE_DETECT(trans);
-	if (!GST_BASE_TRANSFORM_CLASS(parent_class)->propose_allocation(trans, decide_query, query))
-		return FALSE;
-
+	FrappeDetectPrivate *priv = self->priv;
+	gboolean ret = GST_BASE_TRANSFORM_CLASS(parent_class)->propose_allocation(trans, decide_query, query);
 	GST_OBJECT_LOCK(self);
-	const gboolean pipelined = self->priv->props.pipelined;
+	const GstFrappeBackend backend = priv->props.backend;
+	const gboolean pipelined = priv->props.pipelined;
 	GST_OBJECT_UNLOCK(self);
-	if (pipelined)
+	/* auto probes the QPUs here, once. */
+	const bool probed = backend == GST_FRAPPE_BACKEND_AUTO && ensure_pipeline(self);
+	const char *memory = frappe::gst::frameMemoryBackend(backend, probed ? priv->pipeline.get() : nullptr);
+	priv->poolOffered = memory && frappe::gst::offerFramePool(GST_ELEMENT(self), query, memory);
+	ret = ret || priv->poolOffered;
+	if (ret && pipelined)
 		frappe::gst::askOneMoreBuffer(GST_ELEMENT(self), query);
-	return TRUE;
+	return ret;
 }
 
 static gboolean gst_frappe_detect_start(GstBaseTransform *trans)
@@ -577,6 +590,7 @@ static gboolean gst_frappe_detect_start(GstBaseTransform *trans)
 	self->priv->window.reset();
 	self->priv->bufferLog.reset();
 	self->priv->warnedDropped = false;
+	self->priv->poolOffered = false;
 	return TRUE;
 }
 
@@ -592,23 +606,16 @@ static gboolean gst_frappe_detect_stop(GstBaseTransform *trans)
 	return TRUE;
 }
 
-/* Frames beyond max_pixels (the element leaves it at Config's default)
- * are refused here, once, rather than failing at every buffer; a buffer's
- * meta must then match these caps (checkBuffer). */
+/* Too large frames are refused here, once; a buffer's meta must then match
+ * these caps (checkBuffer). */
 static gboolean gst_frappe_detect_set_info(GstVideoFilter *filter, GstCaps *, GstVideoInfo *in_info,
 					   GstCaps *, GstVideoInfo *)
 {
-	const gint w = GST_VIDEO_INFO_WIDTH(in_info), h = GST_VIDEO_INFO_HEIGHT(in_info);
-	GST_DEBUG_OBJECT(filter, "%s %dx%d", GST_VIDEO_INFO_NAME(in_info), w, h);
-	const long long maxPixels = frappe::Config{}.max_pixels;
-	if (static_cast<long long>(w) * h > maxPixels) {
-		GST_ELEMENT_ERROR(filter, CORE, NEGOTIATION,
-				  ("Frames of %dx%d are larger than the detector accepts (%lld pixels)", w, h, maxPixels),
-				  (nullptr));
+	if (!frappe::gst::acceptFrameSize(GST_ELEMENT(filter), in_info))
 		return FALSE;
-	}
 	GstFrappeDetect *self = GST_FRAPPE_DETECT(filter);
-	self->priv->camera.fit(GST_ELEMENT(self), self->priv->active.poseCamera(), w, h);
+	self->priv->camera.fit(GST_ELEMENT(self), self->priv->active.poseCamera(), GST_VIDEO_INFO_WIDTH(in_info),
+			       GST_VIDEO_INFO_HEIGHT(in_info));
 	return TRUE;
 }
 

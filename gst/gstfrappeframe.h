@@ -15,7 +15,8 @@ struct MappedFrame {
 	GstBuffer *buffer = nullptr; /* writable, owned */
 	GstVideoFrame frame{};       /* mapped until finished or discarded */
 	bool writable = false;       /* mapped for annotation */
-	ImageView image;             /* the luma plane */
+	ImageView image;             /* the luma plane, and its dma-buf when it lies in one */
+	bool dmabufInput = false;    /* dma-buf memory before mapping merged several memories */
 
 	/* Maps `buffer` (taking it) read-only, or read-write to annotate;
 	 * false, and the buffer dropped, when it cannot be mapped. */

@@ -164,7 +164,8 @@ GstStructure *statsStructure(guint64 frames, const Result &result, double poseMs
 	}
 	gst_structure_set(s, "pose-ms", G_TYPE_DOUBLE, poseMs, "total-ms", G_TYPE_DOUBLE,
 			  result.times.total_ms + poseMs, "backend", G_TYPE_STRING, backend, "pipelined",
-			  G_TYPE_BOOLEAN, static_cast<gboolean>(pipelined), nullptr);
+			  G_TYPE_BOOLEAN, static_cast<gboolean>(pipelined), "copied-bytes", G_TYPE_UINT64,
+			  static_cast<guint64>(result.copy_bytes), nullptr);
 	return s;
 }
 

@@ -28,7 +28,8 @@ void attachMarkerMetas(GstBuffer *buffer, gint width, gint height, const Result 
 GstStructure *frameMessage(GstBuffer *buffer, const GstSegment &segment, const Result &result,
 			   const Poses &poses, const char *dictionary);
 
-/* The `stats` property's structure for the last frame. */
+/* The `stats` property's structure for the last frame; `copied-bytes`
+ * is what the backend copied of it before reading (0: read in place). */
 GstStructure *statsStructure(guint64 frames, const Result &result, double poseMs, const char *backend,
 			     bool pipelined);
 

@@ -275,7 +275,8 @@ void installProperties(GObjectClass *gobject_class)
 		gobject_class, PROP_STATS,
 		g_param_spec_boxed("stats", "Statistics",
 				   "Per-stage timings (ms) and counts of the last frame (candidates read, "
-				   "candidates-dropped over the cap)", GST_TYPE_STRUCTURE,
+				   "candidates-dropped over the cap, copied-bytes the backend copied before "
+				   "reading it)", GST_TYPE_STRUCTURE,
 				   static_cast<GParamFlags>(G_PARAM_READABLE | G_PARAM_STATIC_STRINGS)));
 }
 
@@ -481,6 +482,16 @@ bool selectFrontEnd(GstElement *element, frappe::Pipeline &pipeline, GstFrappeBa
 		return false;
 	}
 	return true;
+}
+
+const char *frameMemoryBackend(GstFrappeBackend backend, frappe::Pipeline *pipeline)
+{
+	if (backend == GST_FRAPPE_BACKEND_VC4 || backend == GST_FRAPPE_BACKEND_VC4_EMU)
+		return gst_frappe_backend_nick(backend);
+	if (backend == GST_FRAPPE_BACKEND_AUTO && pipeline &&
+	    g_str_equal(pipeline->detector().frontEnd().name(), "vc4"))
+		return "vc4";
+	return nullptr;
 }
 
 bool getProperty(const Settings &p, guint propId, GValue *value)

@@ -118,4 +118,9 @@ bool startSettings(GstElement *element, Settings &props, bool &running);
 bool selectFrontEnd(GstElement *element, frappe::Pipeline &pipeline, GstFrappeBackend backend,
 		    bool &warnedFallback);
 
+/* The backend whose QPUs read frames in place, for the pool offered
+ * upstream: vc4 or vc4-emu, or auto when `pipeline` (the one auto made, or
+ * nullptr) runs the QPUs; nullptr for the CPU. */
+const char *frameMemoryBackend(GstFrappeBackend backend, frappe::Pipeline *pipeline);
+
 } /* namespace frappe::gst */

@@ -250,6 +250,7 @@ void DetectorStages::frontEnd(Detector &detector, const ImageView &image, int sl
 		detail::regionMap(image, 1.0f, d.params.region_contrast, s.edges.regions, d.regionScratch);
 	}
 	s.result.scale = s.edges.scale;
+	s.result.copy_bytes = d.frontEnd->lastCopyBytes();
 }
 
 void DetectorStages::trace(Detector &detector, int slot)

@@ -3,6 +3,7 @@
 // detect() gives frame by frame; bad frames are refused without losing the
 // ones in flight; dropped frames leave nothing behind.
 #include <algorithm>
+#include <memory>
 #include <stdexcept>
 #include <thread>
 
@@ -152,6 +153,57 @@ TEST_P(PipelineModes, FlushWithNothingInFlight)
 	other.push(frames[1].view());
 }
 
+namespace {
+
+/* The CPU front end, saying it copied stride * height bytes of each frame:
+ * a value that differs per frame, so a Result carrying another frame's
+ * count shows. */
+class CountingFrontEnd : public FrontEnd
+{
+public:
+	const char *name() const override { return "counting"; }
+	void run(const ImageView &image, float scale, const FrontEndParams &params, EdgeMap &out) override
+	{
+		cpu_->run(image, scale, params, out);
+		last_ = static_cast<std::size_t>(image.stride) * static_cast<std::size_t>(image.height);
+	}
+	std::size_t lastCopyBytes() const override { return last_; }
+
+private:
+	std::unique_ptr<FrontEnd> cpu_ = makeCpuFrontEnd(1);
+	std::size_t last_ = 0;
+};
+
+} // namespace
+
+/* The GStreamer element reports each frame's copied bytes from its Result:
+ * in a pipeline the detector that ran a frame may be on the next one by the
+ * time its result comes out, so the count travels with the result. */
+TEST_P(PipelineModes, EachResultCarriesTheBytesItsFrontEndCopied)
+{
+	const std::vector<Image> frames = sequence(8);
+	Pipeline pipeline(configOf(GetParam()), GetParam().mode, GetParam().latencyAsked);
+	for (int i = 0; i < pipeline.detectorCount(); ++i)
+		pipeline.detector(i).setFrontEnd(std::make_unique<CountingFrontEnd>());
+	std::size_t next = 0;
+	auto check = [&](const Result *r) {
+		ASSERT_NE(r, nullptr);
+		/* Frame i is pushed i rows short. */
+		const std::size_t rows = static_cast<std::size_t>(frames[next].height) - next;
+		EXPECT_EQ(r->copy_bytes, static_cast<std::size_t>(frames[next].stride) * rows) << "frame " << next;
+		++next;
+	};
+	for (std::size_t i = 0; i < frames.size(); ++i) {
+		ImageView v = frames[i].view();
+		v.height -= static_cast<int>(i);
+		if (const Result *r = pipeline.push(v))
+			check(r);
+	}
+	while (const Result *r = pipeline.flush())
+		check(r);
+	EXPECT_EQ(next, frames.size());
+}
+
 INSTANTIATE_TEST_SUITE_P(All, PipelineModes,
 			 ::testing::Values(Setup{ Pipeline::Mode::Stages, 1, -1, 2, 1, "Stages" },
 					   Setup{ Pipeline::Mode::Frames, 1, -1, 0, 1, "FramesOneThread" },
@@ -214,3 +266,4 @@ TEST(Pipeline, FramesModeRefusesABadFrameAndKeepsTheOrder)
 	EXPECT_THROW(pipeline.push(ImageView(nullptr, 10, 10, 10)), std::invalid_argument);
 	pushTheRest(pipeline, frames, 2, 0);
 }
+

@@ -151,6 +151,38 @@ inline void expectMarkers(GstBuffer *buf, const std::vector<Placed> &placed, con
 	}
 }
 
+/// A marker as a meta gives it: id and corners, to compare exactly.
+struct Found {
+	int id;
+	std::array<float, 8> corners;
+	bool operator==(const Found &o) const { return id == o.id && corners == o.corners; }
+};
+
+/// A buffer's markers by id.
+inline std::vector<Found> foundMarkers(GstBuffer *buf)
+{
+	std::vector<Found> f;
+	for (const GstFrappeMarkerMeta *m : markerMetas(buf)) {
+		Found x{ m->id, {} };
+		std::copy(m->corners, m->corners + 8, x.corners.begin());
+		f.push_back(x);
+	}
+	std::sort(f.begin(), f.end(), [](const Found &a, const Found &b) { return a.id < b.id; });
+	return f;
+}
+
+/// Waits (30 s at most) for the pipeline's EOS, which must come before any error.
+inline void waitForEos(GstElement *pipeline)
+{
+	GstBus *bus = gst_element_get_bus(pipeline);
+	GstMessage *msg = gst_bus_timed_pop_filtered(bus, 30 * GST_SECOND,
+						     static_cast<GstMessageType>(GST_MESSAGE_EOS | GST_MESSAGE_ERROR));
+	ASSERT_NE(msg, nullptr);
+	EXPECT_EQ(GST_MESSAGE_TYPE(msg), GST_MESSAGE_EOS);
+	gst_message_unref(msg);
+	gst_object_unref(bus);
+}
+
 /// The frappedetect element of a harness (gst_harness_new_parse wraps it in a bin).
 inline GstElement *detector(GstHarness *h)
 {

@@ -33,11 +33,6 @@ std::vector<Placed> markersOf(int i)
 	return m;
 }
 
-struct Found {
-	int id;
-	std::array<float, 8> corners;
-};
-
 /* Runs n frames through `launch` and returns each output buffer's markers,
  * in output order, checking timestamps on the way. */
 std::vector<std::vector<Found>> runFrames(const std::string &launch, int n)
@@ -60,14 +55,7 @@ std::vector<std::vector<Found>> runFrames(const std::string &launch, int n)
 	EXPECT_EQ(outs.size(), static_cast<std::size_t>(n)) << launch;
 	for (std::size_t i = 0; i < outs.size(); ++i) {
 		EXPECT_EQ(GST_BUFFER_PTS(outs[i]), static_cast<GstClockTime>(i) * kFrame) << launch;
-		std::vector<Found> f;
-		for (const GstFrappeMarkerMeta *m : markerMetas(outs[i])) {
-			Found x{ m->id, {} };
-			std::copy(m->corners, m->corners + 8, x.corners.begin());
-			f.push_back(x);
-		}
-		std::sort(f.begin(), f.end(), [](const Found &a, const Found &b) { return a.id < b.id; });
-		frames.push_back(f);
+		frames.push_back(foundMarkers(outs[i]));
 		gst_buffer_unref(outs[i]);
 	}
 	gst_harness_teardown(h);

@@ -57,17 +57,6 @@ GstElement *runPipeline(const std::string &launch, int n)
 	return pipeline;
 }
 
-void waitForEos(GstElement *pipeline)
-{
-	GstBus *bus = gst_element_get_bus(pipeline);
-	GstMessage *msg = gst_bus_timed_pop_filtered(bus, 30 * GST_SECOND,
-						     static_cast<GstMessageType>(GST_MESSAGE_EOS | GST_MESSAGE_ERROR));
-	ASSERT_NE(msg, nullptr);
-	EXPECT_EQ(GST_MESSAGE_TYPE(msg), GST_MESSAGE_EOS);
-	gst_message_unref(msg);
-	gst_object_unref(bus);
-}
-
 } // namespace
 
 /* Metas made by hand: the line is exactly what they say, numbers in their

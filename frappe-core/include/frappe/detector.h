@@ -5,6 +5,7 @@
 #include "frappe/export.h"
 
 #include <array>
+#include <cstddef>
 #include <memory>
 #include <string_view>
 #include <vector>
@@ -58,6 +59,11 @@ struct Result {
 	/// grid). Markers among them are missed; a caller may report it as a
 	/// warning.
 	int candidates_dropped = 0;
+	/// Bytes of the frame its front end copied before reading it
+	/// (FrontEnd::lastCopyBytes() of the detector that ran it): 0 when
+	/// the frame was read in place. Carried here because in a Pipeline
+	/// that detector may already be running a later frame.
+	std::size_t copy_bytes = 0;
 };
 
 /// Finds markers of one dictionary in 8-bit luma images.
