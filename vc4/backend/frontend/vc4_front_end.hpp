@@ -39,6 +39,7 @@ struct PassCounts {
 };
 struct FrameCounts {
 	PassCounts pass[2];
+	PassCounts region[2]; // the region map's means and dark passes (tiles: 64x16 blocks of the map)
 };
 // False when `front_end` is not an emulated VC4 front end or has not run a QPU frame.
 bool lastFrameCounts(const frappe::FrontEnd &front_end, FrameCounts &out);

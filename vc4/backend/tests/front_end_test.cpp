@@ -56,15 +56,17 @@ Img scene(int width, int height, unsigned seed, int markers, int padding = 0)
 	return s;
 }
 
-size_t last_edges = 0, last_corners = 0;
+size_t last_edges = 0, last_corners = 0, last_dark = 0;
 
-FrontEndParams params(int64_t edge = 400, int64_t corner = 2000) { return {edge, corner}; }
+// Region contrast 41: Config's default 0.16, so every comparison covers the region map too.
+FrontEndParams params(int64_t edge = 400, int64_t corner = 2000, int region = 41) { return {edge, corner, region}; }
 
-void expectSame(const EdgeMap &got, const EdgeMap &want, const std::string &what)
+void expectSameMap(const TraceMap &got, const TraceMap &want, const std::string &what)
 {
 	ASSERT_EQ(got.width, want.width) << what;
 	ASSERT_EQ(got.height, want.height) << what;
 	ASSERT_EQ(got.scale, want.scale) << what;
+	ASSERT_EQ(got.pixels.size(), want.pixels.size()) << what;
 	size_t bad = 0, first = 0;
 	for (size_t i = 0; i < want.pixels.size(); ++i)
 		if (got.pixels[i] != want.pixels[i] && bad++ == 0)
@@ -72,6 +74,12 @@ void expectSame(const EdgeMap &got, const EdgeMap &want, const std::string &what
 	EXPECT_EQ(bad, 0u) << what << ": first at (" << first % want.width << ", " << first / want.width
 	                   << ") got " << int(got.pixels[first]) << " want " << int(want.pixels[first]);
 	EXPECT_EQ(got.tiles, want.tiles) << what << ": tile mask";
+}
+
+void expectSame(const EdgeMap &got, const EdgeMap &want, const std::string &what)
+{
+	expectSameMap(got, want, what);
+	expectSameMap(got.regions, want.regions, what + " (regions)");
 }
 
 void compare(const Img &img, float scale, const FrontEndParams &p, unsigned seed, const std::string &what)
@@ -89,6 +97,7 @@ void compare(const Img &img, float scale, const FrontEndParams &p, unsigned seed
 	}
 	last_edges = edges;
 	last_corners = corners;
+	last_dark = static_cast<size_t>(std::count(want.regions.pixels.begin(), want.regions.pixels.end(), TraceMap::kEdge));
 }
 
 // Pass 1's planes from frappe-core's own scaling, smoothing and Sobel rows: B = m << 2 | dir
@@ -262,7 +271,11 @@ TEST(Vc4Kernels, ListingsRoundTrip)
 	EXPECT_EQ(vc4::kernels::edgePass().program.uniforms.size(), vc4::kernels::kEdgeUniforms + 1);
 	EXPECT_EQ(vc4::kernels::gradientPass().program.uniformIndex("vdw_stride"), 6u);
 	EXPECT_EQ(vc4::kernels::edgePass().program.uniformIndex("mask_dst"), 12u);
-	for (const auto &built : {vc4::kernels::gradientPass(), vc4::kernels::edgePass()}) {
+	EXPECT_EQ(vc4::kernels::regionMeansPass().program.uniforms.size(), vc4::kernels::kRegionMeansUniforms + 1);
+	EXPECT_EQ(vc4::kernels::regionDarkPass().program.uniforms.size(), vc4::kernels::kRegionDarkUniforms + 1);
+	EXPECT_EQ(vc4::kernels::regionDarkPass().program.uniformIndex("mask_dst"), 7u);
+	for (const auto &built : {vc4::kernels::gradientPass(), vc4::kernels::edgePass(), vc4::kernels::regionMeansPass(),
+	                          vc4::kernels::regionDarkPass()}) {
 		EXPECT_EQ(vc4::qasm::assembleText(vc4::isa::disassembleProgram(built.program.code)), built.program.code)
 			<< built.program.name;
 		EXPECT_EQ(built.program.uniforms.back().name, "more");
@@ -292,6 +305,22 @@ TEST(Vc4Kernels, FrameCounts)
 		            p.slowest_cycles / 250e3, p.slowest_cycles / 300e3);
 		EXPECT_GT(p.instructions, 0u);
 	}
+	// The region map: 64x16 blocks of the 320x240 map. DRAM: the means pass reads 4 source
+	// bytes a map pixel (4 B gathered words) and writes r and the tile words; the dark pass
+	// gathers 9 tile words a lane and tile row and one word of r a lane and row, and writes
+	// the dark bytes and 64 mask bytes a block.
+	const char *names[2] = {"region means", "region dark"};
+	for (int pass = 0; pass < 2; ++pass) {
+		const auto &p = c.region[pass];
+		const unsigned perQpu = (p.tiles + p.programs - 1) / p.programs;
+		std::printf("%s: %u blocks on %u QPUs; %.0f instructions/block; slowest QPU %llu cycles "
+		            "(%u blocks) = %.3f ms at 250 MHz\n",
+		            names[pass], p.tiles, p.programs, double(p.instructions) / p.tiles,
+		            static_cast<unsigned long long>(p.slowest_cycles), perQpu, p.slowest_cycles / 250e3);
+		EXPECT_EQ(p.tiles, 5u * 15u);
+		EXPECT_GT(p.instructions, 0u);
+	}
+	EXPECT_EQ(got.regions.width, 320);
 }
 
 TEST(Vc4FrontEnd, SmallScene)
@@ -418,6 +447,61 @@ TEST(Vc4FrontEnd, ReusesBuffersAcrossFrames)
 	}
 }
 
+// The region map (EdgeMap::regions) on the QPUs: every map size from 3x3 (frames 6x6 ..
+// 13x11, odd sizes leave a row or column out), contrasts from 1 to beyond 255, and 0 (off:
+// no map on either side).
+TEST(Vc4Regions, SmallMapsAndContrasts)
+{
+	for (const int h : {6, 7, 11})
+		for (const int w : {6, 7, 8, 9, 13})
+			for (const int contrast : {1, 41}) {
+				const std::string what = std::to_string(w) + "x" + std::to_string(h) + " contrast " +
+				                         std::to_string(contrast);
+				compare(scene(w, h, static_cast<unsigned>(w * 31 + h), 0), 1.0f, params(0, 0, contrast), 0, what);
+			}
+	const Img img = scene(150, 90, 7, 2);
+	for (const int contrast : {0, 1, 20, 41, 128, 255, 1000}) {
+		const std::string what = "contrast " + std::to_string(contrast);
+		compare(img, 1.0f, params(400, 2000, contrast), contrast % 3, what);
+		if (contrast == 0 || contrast > 255) {
+			EXPECT_EQ(last_dark, 0u) << what;
+		} else if (contrast <= 128) {
+			EXPECT_GT(last_dark, 100u) << what;
+		}
+	}
+	EdgeMap off;
+	vc4::makeFrontEnd({})->run(img.view(), 1.0f, params(400, 2000, 0), off);
+	EXPECT_EQ(off.regions.width, 0);
+	EXPECT_TRUE(vc4::makeFrontEnd({})->makesRegionMap());
+}
+
+// Markers at several sizes and scales, padded strides, random QPU interleavings: dark
+// regions inside the outlines, and blocks of the map's tile mask both set and clear.
+TEST(Vc4Regions, ScenesScalesAndSeeds)
+{
+	struct Case { int w, h, pad; float scale; unsigned seed; };
+	for (const Case c : {Case{256, 160, 0, 1.0f, 0}, Case{261, 177, 3, 1.0f, 7}, Case{400, 300, 1, 0.5f, 3},
+	                     Case{333, 251, 2, 0.7f, 12345}, Case{640, 96, 0, 0.33f, 2}}) {
+		const Img img = scene(c.w, c.h, c.w * 7 + c.h, 4, c.pad);
+		const std::string what = std::to_string(c.w) + "x" + std::to_string(c.h) + " scale " +
+		                         std::to_string(c.scale) + " seed " + std::to_string(c.seed);
+		compare(img, c.scale, params(), c.seed, what);
+		EXPECT_GT(last_dark, 20u) << what;
+	}
+	// A flat frame with one marker: most of the map's 16x16 blocks empty.
+	Img flat{300, 200, 300, std::vector<uint8_t>(300 * 200, 128)};
+	MutableImageView m{flat.pixels.data(), flat.width, flat.height, flat.stride};
+	renderMarker(m, *findDictionary("aruco_mip_36h12"), 5, perspectiveSquare(200, 90, 60, 15, 20),
+	             {.quiet_cells = 1, .supersample = 2, .black = 25, .white = 225});
+	EdgeMap want, got;
+	makeCpuFrontEnd(1)->run(flat.view(), 1.0f, params(), want);
+	vc4::makeFrontEnd({.seed = 4})->run(flat.view(), 1.0f, params(), got);
+	expectSame(got, want, "flat");
+	const auto set = std::count(want.regions.tiles.begin(), want.regions.tiles.end(), 1);
+	EXPECT_GT(set, 0);
+	EXPECT_LT(set, static_cast<long>(want.regions.tiles.size()) / 2);
+}
+
 } // namespace
 
 #if FRAPPE_VC4_TEST_OPENCV
@@ -445,7 +529,7 @@ TEST(Vc4FrontEnd, SharedImages)
 	const bool all = std::getenv("FRAPPE_VC4_ALL") && std::string(std::getenv("FRAPPE_VC4_ALL")) == "1";
 	const size_t limit = all ? files.size() : 10;
 	const size_t step = all ? 1 : std::max<size_t>(1, files.size() / limit);
-	const FrontEndParams p = params(4740, 12354); // Config's defaults 0.27 and 0.19
+	const FrontEndParams p = params(4740, 12354, 41); // Config's defaults 0.27, 0.19 and 0.16
 	size_t runs = 0, fallback = 0, frames = 0;
 	auto cpu = makeCpuFrontEnd(1);
 	// FRAPPE_VC4_SHARD=k/n: only images i with i % n == k (to spread a full run over cores).
