@@ -284,6 +284,33 @@ TEST(Vc4Kernels, ListingsRoundTrip)
 	}
 }
 
+// The region map's programs keep at most four TMU requests in flight, both TMUs together
+// (the hardware's reliable depth), counted along their listings (their loops are entered
+// and left with the same requests in flight).
+TEST(Vc4Kernels, RegionPassesTmuDepth)
+{
+	for (const auto &built : {vc4::kernels::regionMeansPass(), vc4::kernels::regionDarkPass()}) {
+		const std::string text = vc4::isa::disassembleProgram(built.program.code, false);
+		int outstanding = 0, most = 0, requests = 0;
+		size_t at = 0;
+		while (at < text.size()) {
+			const size_t end = std::min(text.find('\n', at), text.size());
+			const std::string line = text.substr(at, end - at);
+			at = end + 1;
+			for (const char *tmu : {" t0s,", " t1s,"})
+				if (line.find(tmu) != std::string::npos)
+					++outstanding, ++requests;
+			most = std::max(most, outstanding);
+			if (line.find("ldtmu") != std::string::npos)
+				--outstanding;
+			EXPECT_GE(outstanding, 0) << built.program.name << ": " << line;
+		}
+		EXPECT_EQ(most, 4) << built.program.name;
+		EXPECT_EQ(outstanding, 0) << built.program.name;
+		EXPECT_GT(requests, 8) << built.program.name;
+	}
+}
+
 // Instruction and modelled-cycle counts of both passes on a 640x480 frame (README table).
 TEST(Vc4Kernels, FrameCounts)
 {
@@ -321,6 +348,14 @@ TEST(Vc4Kernels, FrameCounts)
 		EXPECT_GT(p.instructions, 0u);
 	}
 	EXPECT_EQ(got.regions.width, 320);
+	// Bytes to and from memory (layout: kernels.hpp): the frame once, r and the tile words
+	// written (20 rows a block) and read back, the dark bytes and mask words written; and
+	// what the TMUs hand the QPUs (16 and 13 gathered words a lane, map row and tile row).
+	const size_t pitch = 320, blocks = c.region[0].tiles, frame = 640 * 480;
+	const size_t meansOut = 20 * pitch * blocks / 5, darkIn = meansOut, darkOut = 16 * pitch * blocks / 5 + 64 * blocks;
+	std::printf("region DRAM: %zu bytes (frame %zu, means out %zu, dark in %zu, dark out %zu); TMU: %zu bytes\n",
+	            frame + meansOut + darkIn + darkOut, frame, meansOut, darkIn, darkOut,
+	            blocks * 16 * 16 * 16 * 4 + blocks * 4 * 13 * 16 * 4);
 }
 
 TEST(Vc4FrontEnd, SmallScene)
