@@ -17,6 +17,8 @@
 //    column bytes makes that kEdge, a row mask from the uniform stream clears the outer
 //    rows. Four rows a VDW, double-buffered; the OR of the block's words is its mask row.
 // Gathers are pipelined four deep (both TMUs together): the hardware's reliable limit.
+#include <initializer_list>
+
 #include "isa/setup_words.hpp"
 #include "kernels/builder.hpp"
 #include "kernels/kernels.hpp"
@@ -41,6 +43,18 @@ void vpmRows(Builder &b, Reg vpmw, Reg vdws, uint8_t units)
 	b.ldi(r2, isa::VdwSetup{.units = units, .depth = 16, .horizontal = true, .vpm_base = 0, .modew = 0}.word());
 	b.op(shl(r1, r0, imm(10))); // Y = 8q at bit 7
 	b.op(add(vdws, r2, r1));
+}
+
+// A block's uniforms, in stream order, each into its register.
+struct UniformTo {
+	Reg reg;
+	const char *name;
+	UniformKind kind = UniformKind::Value;
+};
+void readUniforms(Builder &b, std::initializer_list<UniformTo> list)
+{
+	for (const UniformTo &u : list)
+		b.op(mov(u.reg, b.uniform(u.name, u.kind)));
 }
 
 // Starts the VDW of `setup` to `addr` (setup registers under the mutex, as the other passes).
@@ -132,13 +146,8 @@ Built build()
 	vpmRows(b, VPMW, VDWS, 5);
 
 	Label block = b.label();
-	b.op(mov(SWMAX, b.uniform("src_wmax")));
-	b.op(mov(STEPX, b.uniform("step_x")));
-	b.op(mov(RWMAX, b.uniform("rwmax")));
-	b.op(mov(XS, b.uniform("x0")));
-	b.op(mov(DST, b.uniform("dst", UniformKind::Address)));
-	b.op(mov(VDWSTRIDE, b.uniform("vdw_stride")));
-	b.op(mov(DSTSTEP, b.uniform("dst_step")));
+	readUniforms(b, {{SWMAX, "src_wmax"}, {STEPX, "step_x"}, {RWMAX, "rwmax"}, {XS, "x0"},
+	                 {DST, "dst", UniformKind::Address}, {VDWSTRIDE, "vdw_stride"}, {DSTSTEP, "dst_step"}});
 	// Per lane and pixel j: x = min(x0 + 4 lane + j, w - 1), frame columns 2x and 2x + 1,
 	// mapped like scaleNearest: min(W - 1, ((2X + 1) step_x) >> 17) in the source.
 	b.op(shl(r0, reg::elem_num, imm(2)));
@@ -246,14 +255,9 @@ Built build()
 	vpmRows(b, VPMROW, VDWS, 4);
 
 	Label block = b.label();
-	b.op(mov(CONTRAST, b.uniform("contrast")));
-	b.op(mov(XS, b.uniform("x0")));
-	b.op(mov(TXM1, b.uniform("txm1")));
-	b.op(mov(RWM2, b.uniform("rwm2")));
-	b.op(mov(EDST, b.uniform("out_dst", UniformKind::Address)));
-	b.op(mov(VDWSTRIDE, b.uniform("vdw_stride")));
-	b.op(mov(EPITCH4, b.uniform("out_pitch4")));
-	b.op(mov(MDST, b.uniform("mask_dst", UniformKind::Address)));
+	readUniforms(b, {{CONTRAST, "contrast"}, {XS, "x0"}, {TXM1, "txm1"}, {RWM2, "rwm2"},
+	                 {EDST, "out_dst", UniformKind::Address}, {VDWSTRIDE, "vdw_stride"},
+	                 {EPITCH4, "out_pitch4"}, {MDST, "mask_dst", UniformKind::Address}});
 	// Byte j of COLW: 1 when pixel x = x0 + 4 lane + j is in 1 .. w-2 (the outermost
 	// columns are never dark).
 	b.op(shl(r0, reg::elem_num, imm(2)));
