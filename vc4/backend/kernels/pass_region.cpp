@@ -57,6 +57,16 @@ void readUniforms(Builder &b, std::initializer_list<UniformTo> list)
 		b.op(mov(u.reg, b.uniform(u.name, u.kind)));
 }
 
+// The end of a block: the next one, or the end of the program.
+Built lastBlock(Builder &b, Label block)
+{
+	b.nextTileOrEnd(block);
+	Built out;
+	out.nops = b.nops();
+	out.program = b.finish();
+	return out;
+}
+
 // Starts the VDW of `setup` to `addr` (setup registers under the mutex, as the other passes).
 void startVdw(Builder &b, Reg stride, Src setup, Reg addr)
 {
@@ -178,11 +188,7 @@ Built build()
 	// The requests of the row after the block.
 	for (unsigned q = 0; q < kDepth; ++q)
 		b.ldtmu(q & 1);
-	b.nextTileOrEnd(block);
-	Built out;
-	out.nops = b.nops();
-	out.program = b.finish();
-	return out;
+	return lastBlock(b, block);
 }
 
 } // namespace means
@@ -292,11 +298,7 @@ Built build()
 	b.op(mov(reg::nop, reg::vw_wait));
 	startVdw(b, VDWSTRIDE, r2, MDST);
 	b.op(mov(reg::nop, reg::vw_wait));
-	b.nextTileOrEnd(block);
-	Built out;
-	out.nops = b.nops();
-	out.program = b.finish();
-	return out;
+	return lastBlock(b, block);
 }
 
 } // namespace dark
