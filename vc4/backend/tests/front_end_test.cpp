@@ -14,6 +14,7 @@
 #include "frappe/detector.h"
 #include "frappe/edge_map.h"
 #include "front_end_rows.h" // frappe-core's row kernels (internal header)
+#include "region_map.h"     // frappe-core's region map (internal header)
 #include "emu/device.hpp"
 #include "isa/disasm.hpp"
 #include "isa/setup_words.hpp"
@@ -190,6 +191,18 @@ TEST(Vc4Kernels, GradientPassMatchesCoreRows)
 	comparePass1(scene(161, 97, 6, 2), 0.7f, 4, "161x97 scale 0.7");
 }
 
+// One launch of a kernel driven without the front end (seed 0: round robin); every program
+// must raise the host interrupt.
+void runJobs(vc4::emu::Device &dev, const std::vector<vc4::emu::Job> &jobs, unsigned seed)
+{
+	vc4::emu::LaunchOptions lo;
+	if (seed) {
+		lo.schedule = vc4::emu::Schedule::Random;
+		lo.seed = seed;
+	}
+	EXPECT_EQ(dev.wait(dev.launch(jobs, lo)).host_interrupts, jobs.size());
+}
+
 // Pass 2 alone, on the emulator without the front end: fed referencePlanes() (frappe-core's
 // gradients), its edge bytes and tile mask against the CPU front end's EdgeMap.
 void comparePass2(const Img &img, const FrontEndParams &p, unsigned seed, const std::string &what)
@@ -230,13 +243,7 @@ void comparePass2(const Img &img, const FrontEndParams &p, unsigned seed, const 
 		}
 		jobs.push_back({dev.upload(u).bus, code.bus});
 	}
-	vc4::emu::LaunchOptions lo;
-	if (seed) {
-		lo.schedule = vc4::emu::Schedule::Random;
-		lo.seed = seed;
-	}
-	const auto stats = dev.wait(dev.launch(jobs, lo));
-	EXPECT_EQ(stats.host_interrupts, jobs.size());
+	runJobs(dev, jobs, seed);
 	EdgeMap want;
 	makeCpuFrontEnd(1)->run(img.view(), 1.0f, p, want);
 	size_t bad = 0;
@@ -260,6 +267,77 @@ TEST(Vc4Kernels, EdgePassMatchesCoreOnCoreGradients)
 	comparePass2(scene(7, 5, 3, 0), params(0, 0), 1, "7x5");
 	comparePass2(scene(200, 150, 5, 3), params(), 2, "200x150");
 	comparePass2(scene(131, 97, 6, 2), params(100, 500), 3, "131x97 low thresholds");
+}
+
+// The region map's means pass alone, on the emulator without the front end: its rows of r
+// against frappe-core's halveImage() of the scaled frame, and its tile words against the
+// least and greatest r of each 4x4 tile (partial at the right and bottom).
+void compareRegionMeans(const Img &img, float scale, unsigned seed, const std::string &what)
+{
+	namespace k = vc4::kernels;
+	const int W = scale < 1.0f ? scaledLength(img.width, scale) : img.width;
+	const int H = scale < 1.0f ? scaledLength(img.height, scale) : img.height;
+	std::vector<uint8_t> scaled(static_cast<size_t>(W) * H);
+	detail::scaleNearest(img.view(), W, H, scaled.data());
+	const int w = W / 2, h = H / 2;
+	std::vector<uint8_t> r(static_cast<size_t>(w) * h);
+	detail::halveImage(ImageView(scaled.data(), W, H, W), r.data());
+	const uint32_t pitch = (w + 63) / 64 * 64, bx = pitch / 64, blocks = bx * ((h + 15) / 16);
+	const uint32_t stride = (img.width + 3) / 4 * 4;
+	vc4::emu::Config config;
+	config.strict = true;
+	config.tmu_fifo_limit = 4;
+	vc4::emu::Device dev(config, 16u << 20);
+	auto src = dev.alloc(stride * img.height), buf = dev.alloc(20 * pitch * (blocks / bx));
+	for (int y = 0; y < img.height; ++y)
+		std::memcpy(src.cpu.data() + y * stride, img.view().row(y), img.width);
+	const uint32_t stepX = static_cast<uint32_t>((uint64_t{uint32_t(img.width)} * 65536u + W / 2) / W);
+	const uint32_t stepY = static_cast<uint32_t>((uint64_t{uint32_t(img.height)} * 65536u + H / 2) / H);
+	const auto code = dev.upload(k::regionMeansPass().program.code);
+	std::vector<vc4::emu::Job> jobs;
+	for (unsigned prog = 0; prog < std::min(12u, blocks); ++prog) {
+		std::vector<uint32_t> u;
+		for (unsigned b = prog; b < blocks; b += 12) {
+			const uint32_t x0 = b % bx * 64, y0 = b / bx * 16;
+			const k::RegionMeansUniforms m{uint32_t(img.width - 1), stepX, uint32_t(w - 1), x0,
+			                               buf.bus + 5 * (y0 / 4) * pitch + x0,
+			                               vc4::isa::VdwStride{.stride = uint16_t(pitch - 64)}.word(), 5 * pitch};
+			const auto *words = reinterpret_cast<const uint32_t *>(&m);
+			u.insert(u.end(), words, words + k::kRegionMeansUniforms);
+			u.resize(u.size() + k::kRegionSourceRows);
+			k::regionSourceRows(u.data() + u.size() - k::kRegionSourceRows, src.bus, stride, img.height, stepY, h,
+			                    int(y0));
+			u.push_back(b + 12 < blocks ? 1 : 0);
+		}
+		jobs.push_back({dev.upload(u).bus, code.bus});
+	}
+	runJobs(dev, jobs, seed);
+	size_t bad = 0;
+	for (int y = 0; y < h; ++y)
+		for (int x = 0; x < w; ++x)
+			bad += buf.cpu[(5 * (y / 4) + y % 4) * pitch + x] != r[static_cast<size_t>(y) * w + x];
+	EXPECT_EQ(bad, 0u) << what << ": means";
+	for (int ty = 0; ty < (h + 3) / 4; ++ty)
+		for (int tx = 0; tx < (w + 3) / 4; ++tx) {
+			int lo = 255, hi = 0;
+			for (int y = 4 * ty; y < std::min(h, 4 * ty + 4); ++y)
+				for (int x = 4 * tx; x < std::min(w, 4 * tx + 4); ++x) {
+					lo = std::min<int>(lo, r[static_cast<size_t>(y) * w + x]);
+					hi = std::max<int>(hi, r[static_cast<size_t>(y) * w + x]);
+				}
+			const uint8_t *word = buf.cpu.data() + (5 * ty + 4) * pitch + 4 * tx;
+			EXPECT_EQ(word[0], lo) << what << ": tile " << tx << ", " << ty;
+			EXPECT_EQ(word[1], 255 - hi) << what << ": tile " << tx << ", " << ty;
+		}
+}
+
+TEST(Vc4Kernels, RegionMeansPassMatchesCore)
+{
+	compareRegionMeans(scene(67, 33, 1, 1), 1.0f, 0, "67x33");
+	compareRegionMeans(scene(13, 11, 2, 0), 1.0f, 1, "13x11");
+	compareRegionMeans(scene(130, 70, 4, 2, 3), 1.0f, 2, "130x70 stride 133");
+	compareRegionMeans(scene(200, 150, 5, 2), 0.5f, 3, "200x150 scale 0.5");
+	compareRegionMeans(scene(161, 97, 6, 2), 0.7f, 4, "161x97 scale 0.7");
 }
 
 // The kernels survive a round trip through their vc4asm-syntax listings (what vc4asm
