@@ -243,7 +243,7 @@ void DetectorStages::frontEnd(Detector &detector, const ImageView &image, int sl
 	timer.lap(Stage::FrontEnd);
 	d.frontEnd->run(image, scale, d.params, s.edges);
 	if (!d.frontEnd->makesRegionMap()) {
-		/* A front end without a region map (the QPUs, for now): the
+		/* A front end without a region map (one of the caller's): the
 		 * CPU's, from the full-resolution frame (the edge map's scale
 		 * is taken into account when its quads are mapped); empty when
 		 * region_contrast is 0. */

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
 // vc4-fe-listing LISTING: writes the QPU programs of the vc4 backends, the front end's two
-// passes (kernels/kernels.hpp) and the candidate warp (kernels/warp.hpp), as one
+// passes and the region map's two (kernels/kernels.hpp) and the candidate warp (kernels/warp.hpp), as one
 // vc4asm-syntax listing, with their uniform streams, for review and for re-assembly by
 // vc4asm. Run by meson at build time (vc4_frontend.dis in the build directory).
 #include <cstdio>
@@ -20,8 +20,9 @@ int main(int argc, char **argv)
 	}
 	try {
 		std::ofstream listing(argv[1]);
-		for (const kernels::Built &b : {kernels::gradientPass(), kernels::edgePass()}) {
-			listing << "# " << b.program.name << ": " << b.program.code.size() << " instructions; uniforms per tile:";
+		for (const kernels::Built &b : {kernels::gradientPass(), kernels::edgePass(), kernels::regionMeansPass(),
+		                                kernels::regionDarkPass()}) {
+			listing << "# " << b.program.name << ": " << b.program.code.size() << " instructions; uniforms per tile or block:";
 			for (const auto &u : b.program.uniforms)
 				listing << " " << u.name;
 			listing << "\n" << isa::disassembleProgram(b.program.code, true) << "\n";

@@ -9,6 +9,7 @@
 
 #include "emu/device.hpp"
 #include "frontend/emulator.hpp"
+#include "frontend/region_pass.hpp"
 #include "isa/setup_words.hpp"
 #include "kernels/kernels.hpp"
 
@@ -124,6 +125,7 @@ public:
 		programs_[1] = kernels::edgePass().program;
 	}
 	const char *name() const override { return Backend::name(); }
+	bool makesRegionMap() const override { return true; }
 	const Backend &backend() const { return backend_; }
 
 	void run(const ImageView &image, float scale, const FrontEndParams &params, EdgeMap &out) override
@@ -196,6 +198,7 @@ public:
 			counts_.pass[pass].tiles = tiles;
 			backend_.run(std::span<const JobType>(jobs.data(), programs), counts_.pass[pass]);
 		}
+		runRegions(RegionSource{buf_.src.bus, stride, g.src_w, g.src_h, stepX, stepY}, params, out);
 		counted_ = true;
 
 		for (int y = 0; y < g.h; ++y)
@@ -244,6 +247,18 @@ private:
 #endif
 	                                   >;
 
+	// The region map (EdgeMap::regions): two launches of its own over the same source.
+	void runRegions(const RegionSource &src, const FrontEndParams &params, EdgeMap &out)
+	{
+		auto launch = [&](uint32_t code, const uint32_t *unif, unsigned programs, PassCounts &c) {
+			std::array<JobType, kPrograms> jobs;
+			for (unsigned p = 0; p < programs; ++p)
+				jobs[p] = {unif[p], code};
+			backend_.run(std::span<const JobType>(jobs.data(), programs), c);
+		};
+		region_.run(src, params.region_contrast, out.scale, launch, counts_.region, out.regions);
+	}
+
 	static uint8_t *append(uint8_t *at, const void *block, size_t bytes, bool more)
 	{
 		const uint32_t m = more ? 1u : 0u;
@@ -261,7 +276,9 @@ private:
 		const uint32_t u2 = 4 * g.uniformWords(kernels::kEdgeUniforms);
 		const uint32_t total = g.srcBytes() + g.gradBytes() + 2 * g.gradMargin() + g.edgeBytes() + g.maskBytes() +
 		                       kPrograms * (u1 + u2 + 2 * 4096) + 6 * 4096 + 2 * kCodeSlack;
-		device_ = &backend_.open(total, buf_);
+		if (device_)
+			region_.release(*device_);
+		device_ = &backend_.open(total + RegionPass<Device>::bytes(g.w, g.h), buf_);
 		buf_.src = device_->alloc(g.srcBytes());
 		buf_.grad = device_->alloc(g.gradBytes() + 2 * g.gradMargin());
 		buf_.edge = device_->alloc(g.edgeBytes());
@@ -272,6 +289,7 @@ private:
 			for (unsigned p = 0; p < kPrograms; ++p)
 				buf_.unif[pass][p] = device_->alloc(pass ? u2 : u1, 64);
 		}
+		region_.allocate(*device_, g.w, g.h, std::is_same_v<Device, emu::Device>);
 		geometry_ = g;
 	}
 
@@ -283,6 +301,7 @@ private:
 	FrameCounts counts_;
 	bool counted_ = false;
 	std::unique_ptr<FrontEnd> cpu_;
+	RegionPass<Device> region_;
 };
 
 } // namespace

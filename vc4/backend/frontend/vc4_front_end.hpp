@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 // frappe::FrontEnd on the VideoCore IV QPUs (issue 6): pass 1 and pass 2 of
-// kernels/kernels.hpp on the real GPU (backend "vc4") or on the emulator ("vc4-emu"),
-// producing exactly the CPU front end's EdgeMap.
+// kernels/kernels.hpp and the region map's two passes, on the real GPU (backend "vc4") or
+// on the emulator ("vc4-emu"), producing exactly the CPU front end's EdgeMap.
 #pragma once
 
 #include <cstdint>
@@ -29,7 +29,7 @@ std::unique_ptr<frappe::FrontEnd> makeFrontEnd(const FrontEndOptions &options = 
 // Empty when the real QPUs are usable, else the probe's one-sentence reason. Never throws.
 std::string probeGpu();
 
-// Counts of the last frame's two passes (emulator only: instructions are exact, cycles
+// Counts of the last frame's passes (emulator only: instructions are exact, cycles
 // follow emu::Timing, an uncalibrated model).
 struct PassCounts {
 	uint64_t instructions = 0;    // all QPUs
@@ -39,6 +39,7 @@ struct PassCounts {
 };
 struct FrameCounts {
 	PassCounts pass[2];
+	PassCounts region[2]; // the region map's means and dark passes (tiles: 64x16 blocks of the map)
 };
 // False when `front_end` is not an emulated VC4 front end or has not run a QPU frame.
 bool lastFrameCounts(const frappe::FrontEnd &front_end, FrameCounts &out);

@@ -113,4 +113,55 @@ struct Built {
 Built gradientPass();
 Built edgePass();
 
+// The region map (EdgeMap::regions; kernels/pass_region.cpp): two launches over blocks of
+// 64 x 16 pixels of the map (w = W / 2 by h = H / 2 for a W x H scaled frame), block b on
+// program b % 12. Lane i holds pixels x0 + 4i .. x0 + 4i + 3, one byte each in its word.
+// Region buffer (means -> dark), pitch P = w rounded up to 64, for tile row t (map rows
+// 4t .. 4t+3) five rows at buffer + 5 t P: the four rows of r = (2x2 sum + 2) >> 2, then
+// the tile words, lo | (255 - hi) << 8 at byte 4c for tile c (bytes 2, 3 undefined).
+// Rows and columns past the map repeat its last (their tiles are never read).
+// Output: dark bytes (kEdge or 0), rows of P bytes; per block a row of 16 mask words
+// (non-zero in one of words 4t .. 4t+3 when 16 x 16 block t holds a dark pixel).
+inline constexpr int kRegionBlockW = 64;
+inline constexpr int kRegionBlockH = 16;
+
+/// Means pass uniforms of one block; then regionSourceRows()'s kRegionSourceRows words,
+/// then `more`.
+struct RegionMeansUniforms {
+	uint32_t src_wmax;   ///< full width - 1
+	uint32_t step_x;     ///< as GradientUniforms::step_x
+	uint32_t rwmax;      ///< w - 1
+	uint32_t x0;         ///< block origin in the map
+	uint32_t dst;        ///< bus address of the block's first row: buffer + 5 (y0 / 4) P + x0
+	uint32_t vdw_stride; ///< VdwStride word: P - 64
+	uint32_t dst_step;   ///< 5 P: one tile row
+};
+inline constexpr unsigned kRegionMeansUniforms = sizeof(RegionMeansUniforms) / 4;
+/// For map rows y0 .. y0 + 16 (clamped to h - 1; the last is read ahead), the source-row
+/// addresses of scaled rows 2y and 2y + 1 (scaleNearest's rows; src, stride multiples of 4).
+inline constexpr unsigned kRegionSourceRows = 2 * (kRegionBlockH + 1);
+uint32_t *regionSourceRows(uint32_t *out, uint32_t src, uint32_t stride, int src_h, uint32_t step_y, int h, int y0);
+
+/// Dark pass uniforms of one block; then regionTileRows()'s kRegionTileRows words, then
+/// `more`.
+struct RegionDarkUniforms {
+	uint32_t contrast;   ///< FrontEndParams::region_contrast (> 0)
+	uint32_t x0;
+	uint32_t txm1;       ///< tiles across - 1: (w + 3) / 4 - 1
+	uint32_t rwm2;       ///< w - 2
+	uint32_t out_dst;    ///< bus address of output byte (x0, y0)
+	uint32_t vdw_stride; ///< VdwStride word: P - 64
+	uint32_t out_pitch4; ///< 4 P
+	uint32_t mask_dst;   ///< bus address of this block's 16 mask words
+};
+inline constexpr unsigned kRegionDarkUniforms = sizeof(RegionDarkUniforms) / 4;
+/// Per tile row of the block: the tile-word rows of tile rows t - 1, t, t + 1 (clamped to
+/// those that exist), the addresses of its four rows of r, and their masks (-1 for map
+/// rows 1 .. h-2, else 0).
+inline constexpr unsigned kRegionTileRows = 4 * 11;
+uint32_t *regionTileRows(uint32_t *out, uint32_t buffer, uint32_t pitch, int h, int y0);
+
+Built regionMeansPass();
+Built regionDarkPass();
+
 } // namespace frappe::vc4::kernels

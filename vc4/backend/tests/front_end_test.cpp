@@ -14,6 +14,7 @@
 #include "frappe/detector.h"
 #include "frappe/edge_map.h"
 #include "front_end_rows.h" // frappe-core's row kernels (internal header)
+#include "region_map.h"     // frappe-core's region map (internal header)
 #include "emu/device.hpp"
 #include "isa/disasm.hpp"
 #include "isa/setup_words.hpp"
@@ -56,15 +57,17 @@ Img scene(int width, int height, unsigned seed, int markers, int padding = 0)
 	return s;
 }
 
-size_t last_edges = 0, last_corners = 0;
+size_t last_edges = 0, last_corners = 0, last_dark = 0;
 
-FrontEndParams params(int64_t edge = 400, int64_t corner = 2000) { return {edge, corner}; }
+// Region contrast 41: Config's default 0.16, so every comparison covers the region map too.
+FrontEndParams params(int64_t edge = 400, int64_t corner = 2000, int region = 41) { return {edge, corner, region}; }
 
-void expectSame(const EdgeMap &got, const EdgeMap &want, const std::string &what)
+void expectSameMap(const TraceMap &got, const TraceMap &want, const std::string &what)
 {
 	ASSERT_EQ(got.width, want.width) << what;
 	ASSERT_EQ(got.height, want.height) << what;
 	ASSERT_EQ(got.scale, want.scale) << what;
+	ASSERT_EQ(got.pixels.size(), want.pixels.size()) << what;
 	size_t bad = 0, first = 0;
 	for (size_t i = 0; i < want.pixels.size(); ++i)
 		if (got.pixels[i] != want.pixels[i] && bad++ == 0)
@@ -72,6 +75,12 @@ void expectSame(const EdgeMap &got, const EdgeMap &want, const std::string &what
 	EXPECT_EQ(bad, 0u) << what << ": first at (" << first % want.width << ", " << first / want.width
 	                   << ") got " << int(got.pixels[first]) << " want " << int(want.pixels[first]);
 	EXPECT_EQ(got.tiles, want.tiles) << what << ": tile mask";
+}
+
+void expectSame(const EdgeMap &got, const EdgeMap &want, const std::string &what)
+{
+	expectSameMap(got, want, what);
+	expectSameMap(got.regions, want.regions, what + " (regions)");
 }
 
 void compare(const Img &img, float scale, const FrontEndParams &p, unsigned seed, const std::string &what)
@@ -89,6 +98,7 @@ void compare(const Img &img, float scale, const FrontEndParams &p, unsigned seed
 	}
 	last_edges = edges;
 	last_corners = corners;
+	last_dark = static_cast<size_t>(std::count(want.regions.pixels.begin(), want.regions.pixels.end(), TraceMap::kEdge));
 }
 
 // Pass 1's planes from frappe-core's own scaling, smoothing and Sobel rows: B = m << 2 | dir
@@ -181,6 +191,18 @@ TEST(Vc4Kernels, GradientPassMatchesCoreRows)
 	comparePass1(scene(161, 97, 6, 2), 0.7f, 4, "161x97 scale 0.7");
 }
 
+// One launch of a kernel driven without the front end (seed 0: round robin); every program
+// must raise the host interrupt.
+void runJobs(vc4::emu::Device &dev, const std::vector<vc4::emu::Job> &jobs, unsigned seed)
+{
+	vc4::emu::LaunchOptions lo;
+	if (seed) {
+		lo.schedule = vc4::emu::Schedule::Random;
+		lo.seed = seed;
+	}
+	EXPECT_EQ(dev.wait(dev.launch(jobs, lo)).host_interrupts, jobs.size());
+}
+
 // Pass 2 alone, on the emulator without the front end: fed referencePlanes() (frappe-core's
 // gradients), its edge bytes and tile mask against the CPU front end's EdgeMap.
 void comparePass2(const Img &img, const FrontEndParams &p, unsigned seed, const std::string &what)
@@ -221,13 +243,7 @@ void comparePass2(const Img &img, const FrontEndParams &p, unsigned seed, const 
 		}
 		jobs.push_back({dev.upload(u).bus, code.bus});
 	}
-	vc4::emu::LaunchOptions lo;
-	if (seed) {
-		lo.schedule = vc4::emu::Schedule::Random;
-		lo.seed = seed;
-	}
-	const auto stats = dev.wait(dev.launch(jobs, lo));
-	EXPECT_EQ(stats.host_interrupts, jobs.size());
+	runJobs(dev, jobs, seed);
 	EdgeMap want;
 	makeCpuFrontEnd(1)->run(img.view(), 1.0f, p, want);
 	size_t bad = 0;
@@ -253,6 +269,77 @@ TEST(Vc4Kernels, EdgePassMatchesCoreOnCoreGradients)
 	comparePass2(scene(131, 97, 6, 2), params(100, 500), 3, "131x97 low thresholds");
 }
 
+// The region map's means pass alone, on the emulator without the front end: its rows of r
+// against frappe-core's halveImage() of the scaled frame, and its tile words against the
+// least and greatest r of each 4x4 tile (partial at the right and bottom).
+void compareRegionMeans(const Img &img, float scale, unsigned seed, const std::string &what)
+{
+	namespace k = vc4::kernels;
+	const int W = scale < 1.0f ? scaledLength(img.width, scale) : img.width;
+	const int H = scale < 1.0f ? scaledLength(img.height, scale) : img.height;
+	std::vector<uint8_t> scaled(static_cast<size_t>(W) * H);
+	detail::scaleNearest(img.view(), W, H, scaled.data());
+	const int w = W / 2, h = H / 2;
+	std::vector<uint8_t> r(static_cast<size_t>(w) * h);
+	detail::halveImage(ImageView(scaled.data(), W, H, W), r.data());
+	const uint32_t pitch = (w + 63) / 64 * 64, bx = pitch / 64, blocks = bx * ((h + 15) / 16);
+	const uint32_t stride = (img.width + 3) / 4 * 4;
+	vc4::emu::Config config;
+	config.strict = true;
+	config.tmu_fifo_limit = 4;
+	vc4::emu::Device dev(config, 16u << 20);
+	auto src = dev.alloc(stride * img.height), buf = dev.alloc(20 * pitch * (blocks / bx));
+	for (int y = 0; y < img.height; ++y)
+		std::memcpy(src.cpu.data() + y * stride, img.view().row(y), img.width);
+	const uint32_t stepX = static_cast<uint32_t>((uint64_t{uint32_t(img.width)} * 65536u + W / 2) / W);
+	const uint32_t stepY = static_cast<uint32_t>((uint64_t{uint32_t(img.height)} * 65536u + H / 2) / H);
+	const auto code = dev.upload(k::regionMeansPass().program.code);
+	std::vector<vc4::emu::Job> jobs;
+	for (unsigned prog = 0; prog < std::min(12u, blocks); ++prog) {
+		std::vector<uint32_t> u;
+		for (unsigned b = prog; b < blocks; b += 12) {
+			const uint32_t x0 = b % bx * 64, y0 = b / bx * 16;
+			const k::RegionMeansUniforms m{uint32_t(img.width - 1), stepX, uint32_t(w - 1), x0,
+			                               buf.bus + 5 * (y0 / 4) * pitch + x0,
+			                               vc4::isa::VdwStride{.stride = uint16_t(pitch - 64)}.word(), 5 * pitch};
+			const auto *words = reinterpret_cast<const uint32_t *>(&m);
+			u.insert(u.end(), words, words + k::kRegionMeansUniforms);
+			u.resize(u.size() + k::kRegionSourceRows);
+			k::regionSourceRows(u.data() + u.size() - k::kRegionSourceRows, src.bus, stride, img.height, stepY, h,
+			                    int(y0));
+			u.push_back(b + 12 < blocks ? 1 : 0);
+		}
+		jobs.push_back({dev.upload(u).bus, code.bus});
+	}
+	runJobs(dev, jobs, seed);
+	size_t bad = 0;
+	for (int y = 0; y < h; ++y)
+		for (int x = 0; x < w; ++x)
+			bad += buf.cpu[(5 * (y / 4) + y % 4) * pitch + x] != r[static_cast<size_t>(y) * w + x];
+	EXPECT_EQ(bad, 0u) << what << ": means";
+	for (int ty = 0; ty < (h + 3) / 4; ++ty)
+		for (int tx = 0; tx < (w + 3) / 4; ++tx) {
+			int lo = 255, hi = 0;
+			for (int y = 4 * ty; y < std::min(h, 4 * ty + 4); ++y)
+				for (int x = 4 * tx; x < std::min(w, 4 * tx + 4); ++x) {
+					lo = std::min<int>(lo, r[static_cast<size_t>(y) * w + x]);
+					hi = std::max<int>(hi, r[static_cast<size_t>(y) * w + x]);
+				}
+			const uint8_t *word = buf.cpu.data() + (5 * ty + 4) * pitch + 4 * tx;
+			EXPECT_EQ(word[0], lo) << what << ": tile " << tx << ", " << ty;
+			EXPECT_EQ(word[1], 255 - hi) << what << ": tile " << tx << ", " << ty;
+		}
+}
+
+TEST(Vc4Kernels, RegionMeansPassMatchesCore)
+{
+	compareRegionMeans(scene(67, 33, 1, 1), 1.0f, 0, "67x33");
+	compareRegionMeans(scene(13, 11, 2, 0), 1.0f, 1, "13x11");
+	compareRegionMeans(scene(130, 70, 4, 2, 3), 1.0f, 2, "130x70 stride 133");
+	compareRegionMeans(scene(200, 150, 5, 2), 0.5f, 3, "200x150 scale 0.5");
+	compareRegionMeans(scene(161, 97, 6, 2), 0.7f, 4, "161x97 scale 0.7");
+}
+
 // The kernels survive a round trip through their vc4asm-syntax listings (what vc4asm
 // reads), and their hazard lint is clean (finish() throws otherwise).
 TEST(Vc4Kernels, ListingsRoundTrip)
@@ -262,12 +349,43 @@ TEST(Vc4Kernels, ListingsRoundTrip)
 	EXPECT_EQ(vc4::kernels::edgePass().program.uniforms.size(), vc4::kernels::kEdgeUniforms + 1);
 	EXPECT_EQ(vc4::kernels::gradientPass().program.uniformIndex("vdw_stride"), 6u);
 	EXPECT_EQ(vc4::kernels::edgePass().program.uniformIndex("mask_dst"), 12u);
-	for (const auto &built : {vc4::kernels::gradientPass(), vc4::kernels::edgePass()}) {
+	EXPECT_EQ(vc4::kernels::regionMeansPass().program.uniforms.size(), vc4::kernels::kRegionMeansUniforms + 1);
+	EXPECT_EQ(vc4::kernels::regionDarkPass().program.uniforms.size(), vc4::kernels::kRegionDarkUniforms + 1);
+	EXPECT_EQ(vc4::kernels::regionDarkPass().program.uniformIndex("mask_dst"), 7u);
+	for (const auto &built : {vc4::kernels::gradientPass(), vc4::kernels::edgePass(), vc4::kernels::regionMeansPass(),
+	                          vc4::kernels::regionDarkPass()}) {
 		EXPECT_EQ(vc4::qasm::assembleText(vc4::isa::disassembleProgram(built.program.code)), built.program.code)
 			<< built.program.name;
 		EXPECT_EQ(built.program.uniforms.back().name, "more");
 		std::printf("%s: %zu instructions, %u nops the builder could not fill\n", built.program.name.c_str(),
 		            built.program.code.size(), built.nops);
+	}
+}
+
+// The region map's programs keep at most four TMU requests in flight, both TMUs together
+// (the hardware's reliable depth), counted along their listings (their loops are entered
+// and left with the same requests in flight).
+TEST(Vc4Kernels, RegionPassesTmuDepth)
+{
+	for (const auto &built : {vc4::kernels::regionMeansPass(), vc4::kernels::regionDarkPass()}) {
+		const std::string text = vc4::isa::disassembleProgram(built.program.code, false);
+		int outstanding = 0, most = 0, requests = 0;
+		size_t at = 0;
+		while (at < text.size()) {
+			const size_t end = std::min(text.find('\n', at), text.size());
+			const std::string line = text.substr(at, end - at);
+			at = end + 1;
+			for (const char *tmu : {" t0s,", " t1s,"})
+				if (line.find(tmu) != std::string::npos)
+					++outstanding, ++requests;
+			most = std::max(most, outstanding);
+			if (line.find("ldtmu") != std::string::npos)
+				--outstanding;
+			EXPECT_GE(outstanding, 0) << built.program.name << ": " << line;
+		}
+		EXPECT_EQ(most, 4) << built.program.name;
+		EXPECT_EQ(outstanding, 0) << built.program.name;
+		EXPECT_GT(requests, 8) << built.program.name;
 	}
 }
 
@@ -292,6 +410,30 @@ TEST(Vc4Kernels, FrameCounts)
 		            p.slowest_cycles / 250e3, p.slowest_cycles / 300e3);
 		EXPECT_GT(p.instructions, 0u);
 	}
+	// The region map: 64x16 blocks of the 320x240 map. DRAM: the means pass reads 4 source
+	// bytes a map pixel (4 B gathered words) and writes r and the tile words; the dark pass
+	// gathers 9 tile words a lane and tile row and one word of r a lane and row, and writes
+	// the dark bytes and 64 mask bytes a block.
+	const char *names[2] = {"region means", "region dark"};
+	for (int pass = 0; pass < 2; ++pass) {
+		const auto &p = c.region[pass];
+		const unsigned perQpu = (p.tiles + p.programs - 1) / p.programs;
+		std::printf("%s: %u blocks on %u QPUs; %.0f instructions/block; slowest QPU %llu cycles "
+		            "(%u blocks) = %.3f ms at 250 MHz\n",
+		            names[pass], p.tiles, p.programs, double(p.instructions) / p.tiles,
+		            static_cast<unsigned long long>(p.slowest_cycles), perQpu, p.slowest_cycles / 250e3);
+		EXPECT_EQ(p.tiles, 5u * 15u);
+		EXPECT_GT(p.instructions, 0u);
+	}
+	EXPECT_EQ(got.regions.width, 320);
+	// Bytes to and from memory (layout: kernels.hpp): the frame once, r and the tile words
+	// written (20 rows a block) and read back, the dark bytes and mask words written; and
+	// what the TMUs hand the QPUs (16 and 13 gathered words a lane, map row and tile row).
+	const size_t pitch = 320, blocks = c.region[0].tiles, frame = 640 * 480;
+	const size_t meansOut = 20 * pitch * blocks / 5, darkIn = meansOut, darkOut = 16 * pitch * blocks / 5 + 64 * blocks;
+	std::printf("region DRAM: %zu bytes (frame %zu, means out %zu, dark in %zu, dark out %zu); TMU: %zu bytes\n",
+	            frame + meansOut + darkIn + darkOut, frame, meansOut, darkIn, darkOut,
+	            blocks * 16 * 16 * 16 * 4 + blocks * 4 * 13 * 16 * 4);
 }
 
 TEST(Vc4FrontEnd, SmallScene)
@@ -418,6 +560,61 @@ TEST(Vc4FrontEnd, ReusesBuffersAcrossFrames)
 	}
 }
 
+// The region map (EdgeMap::regions) on the QPUs: every map size from 3x3 (frames 6x6 ..
+// 13x11, odd sizes leave a row or column out), contrasts from 1 to beyond 255, and 0 (off:
+// no map on either side).
+TEST(Vc4Regions, SmallMapsAndContrasts)
+{
+	for (const int h : {6, 7, 11})
+		for (const int w : {6, 7, 8, 9, 13})
+			for (const int contrast : {1, 41}) {
+				const std::string what = std::to_string(w) + "x" + std::to_string(h) + " contrast " +
+				                         std::to_string(contrast);
+				compare(scene(w, h, static_cast<unsigned>(w * 31 + h), 0), 1.0f, params(0, 0, contrast), 0, what);
+			}
+	const Img img = scene(150, 90, 7, 2);
+	for (const int contrast : {0, 1, 20, 41, 128, 255, 1000}) {
+		const std::string what = "contrast " + std::to_string(contrast);
+		compare(img, 1.0f, params(400, 2000, contrast), contrast % 3, what);
+		if (contrast == 0 || contrast > 255) {
+			EXPECT_EQ(last_dark, 0u) << what;
+		} else if (contrast <= 128) {
+			EXPECT_GT(last_dark, 100u) << what;
+		}
+	}
+	EdgeMap off;
+	vc4::makeFrontEnd({})->run(img.view(), 1.0f, params(400, 2000, 0), off);
+	EXPECT_EQ(off.regions.width, 0);
+	EXPECT_TRUE(vc4::makeFrontEnd({})->makesRegionMap());
+}
+
+// Markers at several sizes and scales, padded strides, random QPU interleavings: dark
+// regions inside the outlines, and blocks of the map's tile mask both set and clear.
+TEST(Vc4Regions, ScenesScalesAndSeeds)
+{
+	struct Case { int w, h, pad; float scale; unsigned seed; };
+	for (const Case c : {Case{256, 160, 0, 1.0f, 0}, Case{261, 177, 3, 1.0f, 7}, Case{400, 300, 1, 0.5f, 3},
+	                     Case{333, 251, 2, 0.7f, 12345}, Case{640, 96, 0, 0.33f, 2}}) {
+		const Img img = scene(c.w, c.h, c.w * 7 + c.h, 4, c.pad);
+		const std::string what = std::to_string(c.w) + "x" + std::to_string(c.h) + " scale " +
+		                         std::to_string(c.scale) + " seed " + std::to_string(c.seed);
+		compare(img, c.scale, params(), c.seed, what);
+		EXPECT_GT(last_dark, 20u) << what;
+	}
+	// A flat frame with one marker: most of the map's 16x16 blocks empty.
+	Img flat{300, 200, 300, std::vector<uint8_t>(300 * 200, 128)};
+	MutableImageView m{flat.pixels.data(), flat.width, flat.height, flat.stride};
+	renderMarker(m, *findDictionary("aruco_mip_36h12"), 5, perspectiveSquare(200, 90, 60, 15, 20),
+	             {.quiet_cells = 1, .supersample = 2, .black = 25, .white = 225});
+	EdgeMap want, got;
+	makeCpuFrontEnd(1)->run(flat.view(), 1.0f, params(), want);
+	vc4::makeFrontEnd({.seed = 4})->run(flat.view(), 1.0f, params(), got);
+	expectSame(got, want, "flat");
+	const auto set = std::count(want.regions.tiles.begin(), want.regions.tiles.end(), 1);
+	EXPECT_GT(set, 0);
+	EXPECT_LT(set, static_cast<long>(want.regions.tiles.size()) / 2);
+}
+
 } // namespace
 
 #if FRAPPE_VC4_TEST_OPENCV
@@ -445,7 +642,7 @@ TEST(Vc4FrontEnd, SharedImages)
 	const bool all = std::getenv("FRAPPE_VC4_ALL") && std::string(std::getenv("FRAPPE_VC4_ALL")) == "1";
 	const size_t limit = all ? files.size() : 10;
 	const size_t step = all ? 1 : std::max<size_t>(1, files.size() / limit);
-	const FrontEndParams p = params(4740, 12354); // Config's defaults 0.27 and 0.19
+	const FrontEndParams p = params(4740, 12354, 41); // Config's defaults 0.27, 0.19 and 0.16
 	size_t runs = 0, fallback = 0, frames = 0;
 	auto cpu = makeCpuFrontEnd(1);
 	// FRAPPE_VC4_SHARD=k/n: only images i with i % n == k (to spread a full run over cores).
