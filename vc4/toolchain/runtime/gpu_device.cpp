@@ -245,6 +245,30 @@ std::string ProbeReport::summary() const
 	return s;
 }
 
+int allocateDmaHeapBuffer(Os &os, const DeviceOptions &options, std::size_t bytes, std::string &why)
+{
+	std::string notes;
+	for (const std::string &path : options.heaps) {
+		Fd heap{os, os.open(path, O_RDWR)};
+		if (heap.fd < 0) {
+			notes += (notes.empty() ? "" : "; ") + openFailure(path, heap.fd);
+			continue;
+		}
+		uapi::DmaHeapAllocationData alloc;
+		alloc.len = (bytes + kPage - 1) / kPage * kPage;
+		alloc.fd_flags = O_RDWR | O_CLOEXEC;
+		const int e = os.ioctl(heap.fd, uapi::kIoctlDmaHeapAlloc, &alloc);
+		if (e < 0) {
+			notes += (notes.empty() ? "" : "; ") + path + " cannot allocate " + std::to_string(alloc.len) +
+			         " bytes: " + errorText(e);
+			continue;
+		}
+		return static_cast<int>(alloc.fd);
+	}
+	why = "no dma-heap frame memory: " + (notes.empty() ? std::string("no heap configured") : notes);
+	return -1;
+}
+
 ProbeReport GpuDevice::probe(Os &os, const DeviceOptions &options)
 {
 	ProbeReport r;
@@ -279,6 +303,7 @@ GpuDevice::~GpuDevice() { cleanup(); }
 
 void GpuDevice::cleanup()
 {
+	imports_.clear([this](Imported &i) { releaseImport(i); });
 	for (auto &[bus, a] : buffers_)
 		free(a);
 	buffers_.clear();
@@ -414,17 +439,65 @@ void GpuDevice::release(const Buffer &buffer)
 	buffers_.erase(it);
 }
 
+GpuDevice::Import GpuDevice::importDmabuf(int fd)
+{
+	if (report_.memory != MemoryKind::DmaHeapVcsm)
+		throw RuntimeError(std::string("dma-buf import needs vcsm-cma, and this device uses ") +
+		                   toString(report_.memory) + " memory");
+	FileId id;
+	if (const int e = os_.fileId(fd, id); e < 0)
+		throw RuntimeError("fstat of dma-buf fd " + std::to_string(fd) + " failed: " + errorText(e));
+	if (Imported *hit = imports_.find(id))
+		return hit->view;
+	Imported i;
+	i.dmabuf = os_.dup(fd);
+	if (i.dmabuf < 0)
+		throw RuntimeError("cannot dup dma-buf fd " + std::to_string(fd) + ": " + errorText(i.dmabuf));
+	uapi::VcsmImportDmabuf import;
+	import.dmabuf_fd = i.dmabuf;
+	import.cached = uapi::kVcsmCacheNone;
+	std::memcpy(import.name, "vc4-frame", 9);
+	const int e = os_.ioctl(vcsm_, uapi::kIoctlVcsmImportDmabuf, &import);
+	if (e < 0 || import.handle < 0 || import.dma_addr == 0) {
+		if (e >= 0 && import.handle >= 0)
+			os_.close(import.handle);
+		os_.close(i.dmabuf);
+		throw RuntimeError(options_.vcsm + " refused to import dma-buf fd " + std::to_string(fd) + ": " +
+		                   (e < 0 ? errorText(e) : std::string("no bus address")) +
+		                   " (a buffer the GPU cannot address contiguously?)");
+	}
+	i.handle = import.handle;
+	i.view.bus = (static_cast<uint32_t>(import.dma_addr) & ~uapi::kBusAliasMask) | uapi::kBusAliasUncached;
+	i.view.bytes = id.size ? id.size : import.size;
+	// Open the CPU's access window, as for our own buffers; launches close and reopen it.
+	uapi::DmaBufSync sync{uapi::kDmaBufSyncStart | uapi::kDmaBufSyncRw};
+	os_.ioctl(i.dmabuf, uapi::kIoctlDmaBufSync, &sync);
+	return imports_.add(id, i, [this](Imported &old) { releaseImport(old); }).view;
+}
+
+void GpuDevice::releaseImport(Imported &i)
+{
+	if (i.handle >= 0)
+		os_.close(i.handle);
+	if (i.dmabuf >= 0)
+		os_.close(i.dmabuf);
+	i.handle = i.dmabuf = -1;
+}
+
 void GpuDevice::syncAll(uint64_t flags)
 {
 	if (report_.memory != MemoryKind::DmaHeapVcsm)
 		return; // /dev/mem O_SYNC mappings are uncached
-	for (auto &[bus, a] : buffers_) {
-		uapi::DmaBufSync sync{flags};
-		const int e = os_.ioctl(a.dmabuf, uapi::kIoctlDmaBufSync, &sync);
+	auto sync = [&](int fd, uint32_t bus) {
+		uapi::DmaBufSync s{flags};
+		const int e = os_.ioctl(fd, uapi::kIoctlDmaBufSync, &s);
 		if (e < 0)
 			throw RuntimeError("DMA_BUF_IOCTL_SYNC failed on the buffer at bus " + hex(bus) + ": " +
 			                   errorText(e));
-	}
+	};
+	for (auto &[bus, a] : buffers_)
+		sync(a.dmabuf, bus);
+	imports_.forEach([&](Imported &i) { sync(i.dmabuf, i.view.bus); });
 }
 
 GpuDevice::Fence GpuDevice::launch(std::span<const Job> jobs, std::chrono::milliseconds timeout)
