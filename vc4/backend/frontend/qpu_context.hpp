@@ -36,6 +36,13 @@ struct FrameSource {
 	uint32_t stride = 0;
 };
 
+// What a QPU front end's or warper's context holds, for tests and logs.
+struct ContextInfo {
+	const void *context = nullptr;   // equal for a front end and a warper sharing one device
+	std::size_t imports = 0;         // dma-bufs imported now (cached)
+	std::size_t copy_bytes = 0;      // bytes of the last frame copied (front end + warp)
+	std::string_view copy_reason;    // why they were copied; empty when read in place
+};
 template <class Device>
 class QpuContext {
 public:
@@ -88,6 +95,7 @@ public:
 	// the QPUs read the frame in place).
 	std::size_t copyBytes() const { return copy_bytes_; }
 	std::string_view copyReason() const { return copy_bytes_ ? std::string_view(reason_) : std::string_view(); }
+	ContextInfo info() const { return {this, imports(), copyBytes(), copyReason()}; }
 	std::size_t imports() const
 	{
 		if constexpr (kEmulated)
@@ -238,15 +246,20 @@ std::unique_ptr<frappe::FrontEnd> makeFrontEnd(std::shared_ptr<QpuContext<runtim
 std::unique_ptr<frappe::CandidateWarper> makeWarper(std::shared_ptr<QpuContext<runtime::GpuDevice>> context);
 #endif
 
-// What a QPU front end's or warper's context holds, for tests and logs.
-struct ContextInfo {
-	const void *context = nullptr;   // equal for a front end and a warper sharing one device
-	std::size_t imports = 0;         // dma-bufs imported now (cached)
-	std::size_t copy_bytes = 0;      // bytes of the last frame copied (front end + warp)
-	std::string_view copy_reason;    // why they were copied; empty when read in place
-};
 // False when `front_end` / `warper` is not a QPU one.
 bool contextInfo(const frappe::FrontEnd &front_end, ContextInfo &out);
 bool contextInfo(const frappe::CandidateWarper &warper, ContextInfo &out);
+
+// contextInfo() for the first of the classes `Qpu...` that `object` is.
+template <class... Qpu, class Base>
+bool contextInfoOf(const Base &object, ContextInfo &out)
+{
+	auto one = [&](const auto *qpu) {
+		if (qpu)
+			out = qpu->context().info();
+		return qpu != nullptr;
+	};
+	return (one(dynamic_cast<const Qpu *>(&object)) || ...);
+}
 
 } // namespace frappe::vc4

@@ -299,17 +299,11 @@ std::unique_ptr<frappe::FrontEnd> makeFrontEnd(std::shared_ptr<QpuContext<runtim
 
 bool contextInfo(const frappe::FrontEnd &front_end, ContextInfo &out)
 {
-	auto fill = [&](const auto &c) {
-		out = {&c, c.imports(), c.copyBytes(), c.copyReason()};
-		return true;
-	};
-	if (const auto *fe = dynamic_cast<const Vc4FrontEnd<EmuBackend> *>(&front_end))
-		return fill(fe->context());
 #if FRAPPE_VC4_HAVE_RUNTIME
-	if (const auto *fe = dynamic_cast<const Vc4FrontEnd<GpuBackend> *>(&front_end))
-		return fill(fe->context());
+	return contextInfoOf<Vc4FrontEnd<EmuBackend>, Vc4FrontEnd<GpuBackend>>(front_end, out);
+#else
+	return contextInfoOf<Vc4FrontEnd<EmuBackend>>(front_end, out);
 #endif
-	return false;
 }
 
 std::string probeGpu()

@@ -177,17 +177,11 @@ std::unique_ptr<frappe::CandidateWarper> makeWarper(std::shared_ptr<QpuContext<r
 
 bool contextInfo(const frappe::CandidateWarper &warper, ContextInfo &out)
 {
-	auto fill = [&](const auto &c) {
-		out = { &c, c.imports(), c.copyBytes(), c.copyReason() };
-		return true;
-	};
-	if (const auto *w = dynamic_cast<const QpuWarper<EmuTarget> *>(&warper))
-		return fill(w->context());
 #if FRAPPE_VC4_HAVE_RUNTIME
-	if (const auto *w = dynamic_cast<const QpuWarper<GpuTarget> *>(&warper))
-		return fill(w->context());
+	return contextInfoOf<QpuWarper<EmuTarget>, QpuWarper<GpuTarget>>(warper, out);
+#else
+	return contextInfoOf<QpuWarper<EmuTarget>>(warper, out);
 #endif
-	return false;
 }
 
 bool lastWarpCounts(const frappe::CandidateWarper &warper, WarpCounts &out)

@@ -91,6 +91,26 @@ std::string openFailure(const std::string &path, int err)
 	return path + ": " + errorText(err);
 }
 
+// A dma-buf of `bytes` (whole pages) from the heap at `path`, or -1 with why appended to `notes`.
+int heapBuffer(Os &os, const std::string &path, uint64_t bytes, std::string &notes)
+{
+	Fd heap{os, os.open(path, O_RDWR)};
+	if (heap.fd < 0) {
+		notes += (notes.empty() ? "" : "; ") + openFailure(path, heap.fd);
+		return -1;
+	}
+	uapi::DmaHeapAllocationData alloc;
+	alloc.len = (bytes + kPage - 1) / kPage * kPage;
+	alloc.fd_flags = O_RDWR | O_CLOEXEC;
+	const int e = os.ioctl(heap.fd, uapi::kIoctlDmaHeapAlloc, &alloc);
+	if (e < 0) {
+		notes += (notes.empty() ? "" : "; ") + path + " allocation of " + std::to_string(alloc.len) +
+		         " bytes failed: " + errorText(e);
+		return -1;
+	}
+	return static_cast<int>(alloc.fd);
+}
+
 // dma-heap allocation + vcsm-cma import of one page: proves the whole path works.
 bool tryDmaHeap(Os &os, const DeviceOptions &o, ProbeReport &r)
 {
@@ -102,25 +122,14 @@ bool tryDmaHeap(Os &os, const DeviceOptions &o, ProbeReport &r)
 		return false;
 	}
 	for (const std::string &path : o.heaps) {
-		Fd heap{os, os.open(path, O_RDWR)};
-		if (heap.fd < 0) {
-			notes += (notes.empty() ? "" : "; ") + openFailure(path, heap.fd);
+		Fd buf{os, heapBuffer(os, path, kPage, notes)};
+		if (buf.fd < 0)
 			continue;
-		}
-		uapi::DmaHeapAllocationData alloc;
-		alloc.len = kPage;
-		alloc.fd_flags = O_RDWR | O_CLOEXEC;
-		int e = os.ioctl(heap.fd, uapi::kIoctlDmaHeapAlloc, &alloc);
-		if (e < 0) {
-			notes += (notes.empty() ? "" : "; ") + path + " allocation failed: " + errorText(e);
-			continue;
-		}
-		Fd buf{os, static_cast<int>(alloc.fd)};
 		uapi::VcsmImportDmabuf import;
 		import.dmabuf_fd = buf.fd;
 		import.cached = uapi::kVcsmCacheNone;
 		std::memcpy(import.name, "vc4-qpu-probe", 13);
-		e = os.ioctl(vcsm.fd, uapi::kIoctlVcsmImportDmabuf, &import);
+		const int e = os.ioctl(vcsm.fd, uapi::kIoctlVcsmImportDmabuf, &import);
 		if (e < 0 || import.handle < 0 || import.dma_addr == 0) {
 			notes += (notes.empty() ? "" : "; ") + o.vcsm + " import of a " + path + " buffer failed: " +
 			         (e < 0 ? errorText(e) : std::string("no bus address"));
@@ -248,23 +257,9 @@ std::string ProbeReport::summary() const
 int allocateDmaHeapBuffer(Os &os, const DeviceOptions &options, std::size_t bytes, std::string &why)
 {
 	std::string notes;
-	for (const std::string &path : options.heaps) {
-		Fd heap{os, os.open(path, O_RDWR)};
-		if (heap.fd < 0) {
-			notes += (notes.empty() ? "" : "; ") + openFailure(path, heap.fd);
-			continue;
-		}
-		uapi::DmaHeapAllocationData alloc;
-		alloc.len = (bytes + kPage - 1) / kPage * kPage;
-		alloc.fd_flags = O_RDWR | O_CLOEXEC;
-		const int e = os.ioctl(heap.fd, uapi::kIoctlDmaHeapAlloc, &alloc);
-		if (e < 0) {
-			notes += (notes.empty() ? "" : "; ") + path + " cannot allocate " + std::to_string(alloc.len) +
-			         " bytes: " + errorText(e);
-			continue;
-		}
-		return static_cast<int>(alloc.fd);
-	}
+	for (const std::string &path : options.heaps)
+		if (const int fd = heapBuffer(os, path, bytes, notes); fd >= 0)
+			return fd;
 	why = "no dma-heap frame memory: " + (notes.empty() ? std::string("no heap configured") : notes);
 	return -1;
 }

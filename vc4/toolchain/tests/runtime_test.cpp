@@ -392,6 +392,19 @@ TEST(RuntimeDevice, MailboxMemoryOnBcm2835AndBcm2837)
 // file and not the fd number, bounded, synced around launches, released.
 namespace {
 
+// The message of the RuntimeError `f` throws; fails the test when it throws none.
+template <class F>
+std::string errorOf(F &&f)
+{
+	try {
+		f();
+	} catch (const RuntimeError &e) {
+		return e.what();
+	}
+	ADD_FAILURE() << "no RuntimeError";
+	return {};
+}
+
 size_t countOf(const std::vector<std::string> &log, const std::string &part)
 {
 	return static_cast<size_t>(std::count_if(log.begin(), log.end(), [&](const std::string &l) { return contains(l, part); }));
@@ -503,20 +516,12 @@ TEST(RuntimeImport, RefusedImportSaysWhyAndLeaksNothing)
 	const int fd = os.cameraBuffer("scattered", 4096, 400);
 	os.refuse_import.insert("scattered");
 	const size_t open_before = os.open_fds.size();
-	try {
-		d.importDmabuf(fd);
-		FAIL() << "import of a refused buffer succeeded";
-	} catch (const RuntimeError &e) {
-		EXPECT_TRUE(contains(e.what(), "/dev/vcsm-cma refused to import dma-buf fd " + std::to_string(fd))) << e.what();
-	}
+	const std::string refused = errorOf([&] { d.importDmabuf(fd); });
+	EXPECT_TRUE(contains(refused, "/dev/vcsm-cma refused to import dma-buf fd " + std::to_string(fd))) << refused;
 	EXPECT_EQ(os.open_fds.size(), open_before);
 	EXPECT_EQ(d.imports(), 0u);
-	try {
-		d.importDmabuf(999);
-		FAIL() << "import of a closed fd succeeded";
-	} catch (const RuntimeError &e) {
-		EXPECT_TRUE(contains(e.what(), "fstat of dma-buf fd 999 failed")) << e.what();
-	}
+	const std::string closed = errorOf([&] { d.importDmabuf(999); });
+	EXPECT_TRUE(contains(closed, "fstat of dma-buf fd 999 failed")) << closed;
 	os.close(fd);
 }
 
@@ -528,11 +533,25 @@ TEST(RuntimeImport, MailboxMemoryCannotImport)
 	GpuDevice d(os);
 	ASSERT_EQ(d.report().memory, MemoryKind::MailboxDevMem);
 	const int fd = os.cameraBuffer("cam", 4096, 500);
-	try {
-		d.importDmabuf(fd);
-		FAIL() << "import without vcsm-cma succeeded";
-	} catch (const RuntimeError &e) {
-		EXPECT_TRUE(contains(e.what(), "needs vcsm-cma")) << e.what();
-	}
+	const std::string why = errorOf([&] { d.importDmabuf(fd); });
+	EXPECT_TRUE(contains(why, "dma-buf import needs vcsm-cma, and this device uses mailbox + /dev/mem memory")) << why;
 	os.close(fd);
+}
+
+TEST(RuntimeImport, FrameMemoryFromTheRuntimesHeap)
+{
+	FakeOs os;
+	os.dmaHeap();
+	std::string why;
+	const int fd = allocateDmaHeapBuffer(os, DeviceOptions{}, 640 * 480, why);
+	ASSERT_GE(fd, 0) << why;
+	EXPECT_EQ(os.open_fds.at(fd), "dmabuf1");
+	EXPECT_EQ(countOf(os.log, "len=307200 -> dmabuf1"), 1u); // 75 pages exactly
+	os.close(fd);
+	EXPECT_TRUE(os.open_fds.empty()); // the heap's fd is not kept
+
+	FakeOs none;
+	EXPECT_EQ(allocateDmaHeapBuffer(none, DeviceOptions{}, 4096, why), -1);
+	EXPECT_EQ(why, "no dma-heap frame memory: /dev/dma_heap/vidbuf_cached does not exist; "
+	               "/dev/dma_heap/linux,cma does not exist");
 }
