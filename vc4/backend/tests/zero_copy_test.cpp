@@ -18,7 +18,9 @@
 #include "frappe/frappe.h"
 #include "frappe/render.h"
 #include "frontend/backend.hpp"
+#include "emu/v3d.hpp"
 #include "frontend/qpu_context.hpp"
+#include "frontend/vc4_warper.hpp"
 #include "runtime_fake_os.hpp"
 
 using namespace frappe;
@@ -206,6 +208,22 @@ using vc4::runtime::test::FakeOs;
 
 constexpr int kGw = 128, kGh = 64;
 
+/* The fake firmware's execute_qpu, made real: the programs run on the emulator over the
+ * fake kernel's memory, every buffer (camera imports included) mapped at its bus address. */
+uint32_t executeOnEmulator(FakeOs &os, uint32_t programs, uint32_t control)
+{
+	vc4::emu::Memory memory(4096);
+	for (const auto &[bus, cpu] : os.bus_to_cpu)
+		memory.mapExternal({ cpu, static_cast<std::size_t>(os.bus_size.at(bus)) }, true, bus);
+	vc4::emu::Config config;
+	config.tmu_fifo_limit = 4;
+	vc4::emu::V3d v3d(memory, config);
+	std::vector<vc4::emu::Job> jobs(programs);
+	for (uint32_t i = 0; i < programs; ++i)
+		jobs[i] = { memory.read32(control + 8 * i), memory.read32(control + 8 * i + 4) };
+	return v3d.launch(jobs).host_interrupts == programs ? 0u : 0x80000000u;
+}
+
 struct FakeGpu {
 	FakeOs os;
 	std::shared_ptr<vc4::QpuContext<vc4::runtime::GpuDevice>> context;
@@ -216,8 +234,10 @@ struct FakeGpu {
 	std::vector<std::uint8_t> ok = std::vector<std::uint8_t>(1);
 	EdgeMap edges;
 
-	FakeGpu()
+	explicit FakeGpu(bool run_programs = false)
 	{
+		if (run_programs)
+			os.execute = [this](uint32_t n, uint32_t control) { return executeOnEmulator(os, n, control); };
 		os.pi();
 		os.dmaHeap();
 		context = vc4::makeGpuContext(os, {});
@@ -322,4 +342,40 @@ TEST(ZeroCopyGpu, SystemMemoryUnalignedStrideAndRefusedImportAreCopiedOnce)
 	/* The warper alone (the front end ran on the CPU or not at all) copies the frame itself. */
 	gpu.warper->warp(ImageView{ pixels.data(), kGw, kGh, kGw }, gpu.quads, 16, gpu.samples, gpu.ok);
 	EXPECT_EQ(gpu.frontEnd->lastCopyBytes(), 2u * kGw * kGh);
+}
+
+TEST(ZeroCopyGpu, ProgramsOnTheFakeFirmwareReadTheCameraBufferInPlace)
+{
+	FakeGpu gpu(true);
+	const int fd = gpu.os.cameraBuffer("cam", kGw * kGh, 900);
+	uint8_t *pixels = gpu.os.cpu("cam");
+	ImageView image{ pixels, kGw, kGh, kGw };
+	image.dmabuf_fd = fd;
+	const FrontEndParams params = Detector(Config{}).frontEndParams();
+	auto cpu = makeCpuFrontEnd(1);
+	auto emuWarper = vc4::makeWarper(vc4::FrontEndOptions{ .emulate = true });
+	for (unsigned f = 0; f < 2; ++f) {
+		/* The camera writes a new frame into the same buffer: the cached import reads it. */
+		const auto frame = scene(40 + f, kGw, kGh, 1);
+		std::memcpy(pixels, frame.data(), frame.size());
+		EdgeMap want;
+		cpu->run(image, 1.0f, params, want);
+		gpu.frontEnd->run(image, 1.0f, params, gpu.edges);
+		EXPECT_EQ(gpu.frontEnd->lastCopyBytes(), 0u);
+		ASSERT_EQ(gpu.edges.pixels.size(), want.pixels.size());
+		EXPECT_TRUE(gpu.edges.pixels == want.pixels) << "frame " << f << ": edge bytes differ from the CPU's";
+		EXPECT_TRUE(gpu.edges.tiles == want.tiles) << "frame " << f << ": tile mask differs from the CPU's";
+		EXPECT_GT(std::count(want.pixels.begin(), want.pixels.end(), 0), 0);
+		EXPECT_LT(std::count(want.pixels.begin(), want.pixels.end(), 0), static_cast<long>(want.pixels.size()));
+
+		std::vector<CandidateSamples> ref(1);
+		std::vector<std::uint8_t> refOk(1);
+		emuWarper->warp(image, gpu.quads, 16, ref, refOk);
+		gpu.warper->warp(image, gpu.quads, 16, gpu.samples, gpu.ok);
+		ASSERT_TRUE(gpu.ok[0] && refOk[0]);
+		EXPECT_TRUE(gpu.samples[0].samples == ref[0].samples) << "frame " << f << ": warp samples differ";
+		EXPECT_EQ(gpu.frontEnd->lastCopyBytes(), 0u);
+	}
+	EXPECT_EQ(gpu.count("name=vc4-frame"), 1u);
+	gpu.os.close(fd);
 }

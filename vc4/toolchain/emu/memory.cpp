@@ -75,7 +75,7 @@ uint32_t Memory::alloc(uint32_t bytes, uint32_t align)
 	return addRegion(std::move(r), align);
 }
 
-uint32_t Memory::mapExternal(std::span<uint8_t> host, bool writable)
+uint32_t Memory::mapExternal(std::span<uint8_t> host, bool writable, uint32_t at)
 {
 	if (host.empty() || host.size() > 0x7fffffffu)
 		throw MemoryError("external memory of " + std::to_string(host.size()) + " bytes cannot be mapped");
@@ -83,7 +83,17 @@ uint32_t Memory::mapExternal(std::span<uint8_t> host, bool writable)
 	r.size = static_cast<uint32_t>(host.size());
 	r.data = host.data();
 	r.writable = writable;
-	return addRegion(std::move(r), 4096);
+	if (!at)
+		return addRegion(std::move(r), 4096);
+	const uint64_t end = uint64_t{at} + r.size;
+	const auto next = regions_.lower_bound(at);
+	const bool overlaps = (at < base_ + bytes_.size() && end > base_) ||
+			      (next != regions_.end() && next->first < end) ||
+			      (next != regions_.begin() && uint64_t{std::prev(next)->first} + std::prev(next)->second.size > at);
+	if (overlaps || end > 0x100000000ull)
+		throw MemoryError("external memory at bus address 0x" + hex(at) + " overlaps mapped memory");
+	regions_.emplace(at, std::move(r));
+	return at;
 }
 
 void Memory::release(uint32_t address)

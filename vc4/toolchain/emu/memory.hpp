@@ -32,9 +32,10 @@ public:
 	uint32_t load(std::span<const uint64_t> code);
 	uint32_t load(std::span<const uint32_t> words);
 
-	// Maps host memory the caller keeps alive (until release()) at a new bus address,
-	// without copying; QPU writes to a read-only mapping fault.
-	uint32_t mapExternal(std::span<uint8_t> host, bool writable);
+	// Maps host memory the caller keeps alive (until release()) at a new bus address, or
+	// at `at` when given (a region must not overlap another), without copying; QPU
+	// writes to a read-only mapping fault.
+	uint32_t mapExternal(std::span<uint8_t> host, bool writable, uint32_t at = 0);
 	// Frees a region (own allocation or external mapping) starting at `address`; arena
 	// allocations are not freed (a no-op). Throws MemoryError for an unknown address.
 	void release(uint32_t address);

@@ -401,6 +401,13 @@ TEST(EmuMemory, RegionsAndExternalMappings)
 	EXPECT_THROW(m.write32(ext, 0), emu::MemoryError);
 	EXPECT_THROW(m.read32(ext + 8192), emu::MemoryError);
 	EXPECT_EQ(m.read32(big + 8), 0xdeadbeefu); // the other region still found
+	std::vector<uint8_t> fixed(4096, 9);
+	EXPECT_EQ(m.mapExternal(fixed, true, 0xDF000000u), 0xDF000000u); // where a fake GPU put it
+	m.write32(0xDF000ffc, 0x05060708);
+	EXPECT_EQ(fixed[4095], 5);
+	EXPECT_THROW(m.mapExternal(fixed, true, 0xDF000800u), emu::MemoryError); // overlaps
+	EXPECT_THROW(m.mapExternal(fixed, true, m.base()), emu::MemoryError);     // the arena
+	m.release(0xDF000000u);
 
 	emu::Device d(emu::Config{}, 64u << 10);
 	std::vector<uint8_t> frame(4096, 3);

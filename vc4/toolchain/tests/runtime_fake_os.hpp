@@ -8,6 +8,7 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
+#include <functional>
 #include <list>
 #include <map>
 #include <set>
@@ -38,6 +39,9 @@ public:
 	uint32_t enable_status = 0;  // set_enable_qpu answer
 	uint32_t execute_status = 0; // execute_qpu answer
 	int execute_errno = 0;       // ioctl result for execute_qpu (e.g. -ETIMEDOUT)
+	// When set, runs execute_qpu's programs (count, control block bus address) over the
+	// fake's memory (bus_to_cpu) and returns its status.
+	std::function<uint32_t(uint32_t, uint32_t)> execute;
 	uint32_t parse_code = uapi::kResponseSuccess;
 	uint32_t v3d_hz = 300'000'000;
 	uint32_t next_handle = 7;
@@ -244,7 +248,7 @@ private:
 			}
 			if (execute_errno)
 				return execute_errno;
-			v[0] = execute_status;
+			v[0] = execute ? execute(v[0], v[1]) : execute_status;
 			break;
 		case uapi::tag::clock_rate: v[1] = v3d_hz; words = 2; break;
 		case uapi::tag::firmware_revision: v[0] = 0x5f5e1000; break;
