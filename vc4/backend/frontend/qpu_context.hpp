@@ -129,12 +129,8 @@ private:
 			return false;
 		}
 		Imported im;
-		try {
-			im = import(image.dmabuf_fd);
-		} catch (const std::exception &e) {
-			because("the frame's dma-buf could not be imported: %s", e.what());
+		if (!import(image.dmabuf_fd, im))
 			return false;
-		}
 		const uint64_t need = image.dmabuf_offset + uint64_t(image.stride) * uint64_t(image.height);
 		if (need > im.bytes) {
 			because("the frame's dma-buf (%llu bytes) is smaller than the frame (%llu bytes from offset %zu)",
@@ -164,38 +160,53 @@ private:
 		return {staging_.bus, stride};
 	}
 
-	Imported import(int fd)
+	// The frame's dma-buf as the QPUs see it, imported once per buffer; false with the
+	// reason set when it cannot be (a refusal costs nothing more on later frames).
+	bool import(int fd, Imported &out)
 	{
 		if constexpr (kEmulated) {
 			// The emulator reads host memory: the dma-buf mmapped once and mapped in place.
 			struct stat st;
-			if (::fstat(fd, &st) != 0)
-				throw std::runtime_error("fstat of fd " + std::to_string(fd) + " failed");
+			if (::fstat(fd, &st) != 0) {
+				because("the frame's dma-buf fd %d cannot be fstat'ed", fd);
+				return false;
+			}
 			const runtime::FileId id{static_cast<uint64_t>(st.st_dev), static_cast<uint64_t>(st.st_ino),
 			                         static_cast<uint64_t>(st.st_size)};
-			if (Mapped *hit = mapped_.find(id))
-				return {hit->bus, hit->bytes};
-			if (st.st_size <= 0)
-				throw std::runtime_error("fd " + std::to_string(fd) + " has no size to map");
-			void *p = ::mmap(nullptr, static_cast<std::size_t>(st.st_size), PROT_READ, MAP_SHARED, fd, 0);
-			if (p == MAP_FAILED)
-				throw std::runtime_error("mmap of fd " + std::to_string(fd) + " failed");
+			if (const Mapped *hit = mapped_.find(id)) {
+				out = {hit->bus, hit->bytes};
+				return true;
+			}
+			void *p = st.st_size > 0 ? ::mmap(nullptr, static_cast<std::size_t>(st.st_size), PROT_READ, MAP_SHARED, fd, 0)
+			                         : MAP_FAILED;
+			if (p == MAP_FAILED) {
+				because("the frame's dma-buf fd %d cannot be mapped", fd);
+				return false;
+			}
 			Mapped m{0, p, static_cast<uint64_t>(st.st_size)};
 			try {
 				m.bus = device_->importExternal({static_cast<uint8_t *>(p), static_cast<std::size_t>(m.bytes)}).bus;
-			} catch (...) {
+			} catch (const std::exception &e) {
 				::munmap(p, static_cast<std::size_t>(m.bytes));
-				throw;
+				because("the frame's dma-buf could not be mapped into the emulator: %s", e.what());
+				return false;
 			}
 			mapped_.add(id, m, [this](Mapped &old) { unmap(old); });
-			return {m.bus, m.bytes};
+			out = {m.bus, m.bytes};
+			return true;
 		} else {
 #if FRAPPE_VC4_HAVE_RUNTIME
-			const auto im = device_->importDmabuf(fd);
-			return {im.bus, im.bytes};
+			std::string_view why;
+			const auto *im = device_->tryImportDmabuf(fd, why);
+			if (!im) {
+				because("the frame's dma-buf could not be imported: %.*s", static_cast<int>(why.size()), why.data());
+				return false;
+			}
+			out = {im->bus, im->bytes};
+			return true;
 #else
-			(void)fd;
-			throw std::runtime_error("no runtime");
+			because("the frame's dma-buf fd %d cannot be imported without the runtime", fd);
+			return false;
 #endif
 		}
 	}

@@ -339,6 +339,9 @@ TEST(ZeroCopyGpu, SystemMemoryUnalignedStrideAndRefusedImportAreCopiedOnce)
 	EXPECT_NE(why.find("could not be imported"), std::string_view::npos) << why;
 	EXPECT_NE(why.find("refused to import"), std::string_view::npos) << why;
 	EXPECT_EQ(gpu.context->imports(), 0u);
+	gpu.frame(image); /* the refusal is remembered: no second import ioctl */
+	EXPECT_EQ(gpu.frontEnd->lastCopyBytes(), static_cast<std::size_t>(kGw) * kGh);
+	EXPECT_EQ(gpu.count("scattered refused"), 1u);
 	/* The warper alone (the front end ran on the CPU or not at all) copies the frame itself. */
 	gpu.warper->warp(ImageView{ pixels.data(), kGw, kGh, kGw }, gpu.quads, 16, gpu.samples, gpu.ok);
 	EXPECT_EQ(gpu.frontEnd->lastCopyBytes(), 2u * kGw * kGh);

@@ -436,18 +436,51 @@ void GpuDevice::release(const Buffer &buffer)
 
 GpuDevice::Import GpuDevice::importDmabuf(int fd)
 {
-	if (report_.memory != MemoryKind::DmaHeapVcsm)
-		throw RuntimeError(std::string("dma-buf import needs vcsm-cma, and this device uses ") +
-		                   toString(report_.memory) + " memory");
+	std::string_view why;
+	if (const Import *im = tryImportDmabuf(fd, why))
+		return *im;
+	throw RuntimeError(std::string(why));
+}
+
+const GpuDevice::Import *GpuDevice::tryImportDmabuf(int fd, std::string_view &why)
+{
+	if (report_.memory != MemoryKind::DmaHeapVcsm) {
+		std::snprintf(why_, sizeof why_, "dma-buf import needs vcsm-cma, and this device uses %s memory",
+		              toString(report_.memory));
+		why = why_;
+		return nullptr;
+	}
 	FileId id;
-	if (const int e = os_.fileId(fd, id); e < 0)
-		throw RuntimeError("fstat of dma-buf fd " + std::to_string(fd) + " failed: " + errorText(e));
-	if (Imported *hit = imports_.find(id))
-		return hit->view;
+	if (const int e = os_.fileId(fd, id); e < 0) {
+		std::snprintf(why_, sizeof why_, "fstat of dma-buf fd %d failed: %s", fd, errorText(e).c_str());
+		why = why_;
+		return nullptr;
+	}
+	Imported *hit = imports_.find(id);
+	if (!hit) {
+		hit = &imports_.add(id, importOnce(fd, id), [this](Imported &old) { releaseImport(old); });
+		if (hit->handle >= 0) {
+			// Open the CPU's access window, as for our own buffers; launches close and reopen it.
+			uapi::DmaBufSync sync{uapi::kDmaBufSyncStart | uapi::kDmaBufSyncRw};
+			os_.ioctl(hit->dmabuf, uapi::kIoctlDmaBufSync, &sync);
+		}
+	}
+	if (hit->handle < 0) {
+		why = hit->why;
+		return nullptr;
+	}
+	return &hit->view;
+}
+
+GpuDevice::Imported GpuDevice::importOnce(int fd, const FileId &id)
+{
 	Imported i;
 	i.dmabuf = os_.dup(fd);
-	if (i.dmabuf < 0)
-		throw RuntimeError("cannot dup dma-buf fd " + std::to_string(fd) + ": " + errorText(i.dmabuf));
+	if (i.dmabuf < 0) {
+		std::snprintf(i.why, sizeof i.why, "cannot dup dma-buf fd %d: %s", fd, errorText(i.dmabuf).c_str());
+		i.dmabuf = -1;
+		return i;
+	}
 	uapi::VcsmImportDmabuf import;
 	import.dmabuf_fd = i.dmabuf;
 	import.cached = uapi::kVcsmCacheNone;
@@ -457,17 +490,23 @@ GpuDevice::Import GpuDevice::importDmabuf(int fd)
 		if (e >= 0 && import.handle >= 0)
 			os_.close(import.handle);
 		os_.close(i.dmabuf);
-		throw RuntimeError(options_.vcsm + " refused to import dma-buf fd " + std::to_string(fd) + ": " +
-		                   (e < 0 ? errorText(e) : std::string("no bus address")) +
-		                   " (a buffer the GPU cannot address contiguously?)");
+		i.dmabuf = -1;
+		std::snprintf(i.why, sizeof i.why,
+		              "%s refused to import dma-buf fd %d: %s (a buffer the GPU cannot address contiguously?)",
+		              options_.vcsm.c_str(), fd, e < 0 ? errorText(e).c_str() : "no bus address");
+		return i;
 	}
 	i.handle = import.handle;
 	i.view.bus = (static_cast<uint32_t>(import.dma_addr) & ~uapi::kBusAliasMask) | uapi::kBusAliasUncached;
 	i.view.bytes = id.size ? id.size : import.size;
-	// Open the CPU's access window, as for our own buffers; launches close and reopen it.
-	uapi::DmaBufSync sync{uapi::kDmaBufSyncStart | uapi::kDmaBufSyncRw};
-	os_.ioctl(i.dmabuf, uapi::kIoctlDmaBufSync, &sync);
-	return imports_.add(id, i, [this](Imported &old) { releaseImport(old); }).view;
+	return i;
+}
+
+std::size_t GpuDevice::imports() const
+{
+	std::size_t n = 0;
+	imports_.forEach([&](const Imported &i) { n += i.handle >= 0; });
+	return n;
 }
 
 void GpuDevice::releaseImport(Imported &i)
@@ -492,7 +531,10 @@ void GpuDevice::syncAll(uint64_t flags)
 	};
 	for (auto &[bus, a] : buffers_)
 		sync(a.dmabuf, bus);
-	imports_.forEach([&](Imported &i) { sync(i.dmabuf, i.view.bus); });
+	imports_.forEach([&](Imported &i) {
+		if (i.handle >= 0)
+			sync(i.dmabuf, i.view.bus);
+	});
 }
 
 GpuDevice::Fence GpuDevice::launch(std::span<const Job> jobs, std::chrono::milliseconds timeout)

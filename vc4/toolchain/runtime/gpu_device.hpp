@@ -16,6 +16,7 @@
 #include <memory>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "runtime/import_cache.hpp"
@@ -113,8 +114,12 @@ public:
 	// launches like the device's own buffers. Throws RuntimeError saying why when the
 	// buffer cannot be imported (mailbox memory in use, not contiguous, ...).
 	Import importDmabuf(int fd);
-	// dma-bufs imported now (cached).
-	std::size_t imports() const { return imports_.size(); }
+	// The same without throwing or allocating once a buffer has been seen, for the frame
+	// path: nullptr when it cannot be imported, with `why` (valid until the next call). A
+	// refusal is remembered per buffer too, so a refused buffer is not retried each frame.
+	const Import *tryImportDmabuf(int fd, std::string_view &why);
+	// dma-bufs imported now (cached; refusals not counted).
+	std::size_t imports() const;
 
 	// Runs jobs[i] on one QPU each and returns when all have ended (execute_qpu blocks;
 	// run it on a worker thread to overlap with the CPU). CPU caches of every buffer are
@@ -142,11 +147,13 @@ private:
 	void free(Allocation &a);
 	struct Imported {
 		Import view;
-		int dmabuf = -1; // our dup of the caller's fd
-		int handle = -1; // vcsm-cma import
+		int dmabuf = -1;    // our dup of the caller's fd
+		int handle = -1;    // vcsm-cma import; -1: refused, for the reason in `why`
+		char why[200] = {};
 	};
 
 	void syncAll(uint64_t flags);
+	Imported importOnce(int fd, const FileId &id);
 	void releaseImport(Imported &i);
 	void cleanup();
 
@@ -157,6 +164,7 @@ private:
 	int heap_ = -1, vcsm_ = -1, devmem_ = -1;
 	std::map<uint32_t, Allocation> buffers_;
 	ImportCache<Imported> imports_;
+	char why_[200] = {}; // the last failure not tied to a buffer (fstat)
 	Buffer control_;
 	Fence next_ = 1;
 	std::map<Fence, LaunchResult> done_;

@@ -61,6 +61,12 @@ public:
 		for (Slot &s : slots_)
 			fn(s.entry);
 	}
+	template <class Fn>
+	void forEach(Fn &&fn) const
+	{
+		for (const Slot &s : slots_)
+			fn(s.entry);
+	}
 
 	std::size_t size() const { return slots_.size(); }
 

@@ -520,6 +520,12 @@ TEST(RuntimeImport, RefusedImportSaysWhyAndLeaksNothing)
 	EXPECT_TRUE(contains(refused, "/dev/vcsm-cma refused to import dma-buf fd " + std::to_string(fd))) << refused;
 	EXPECT_EQ(os.open_fds.size(), open_before);
 	EXPECT_EQ(d.imports(), 0u);
+	// The refusal is remembered for the buffer: later frames cost an fstat, not an import.
+	os.log.clear();
+	std::string_view why;
+	EXPECT_EQ(d.tryImportDmabuf(fd, why), nullptr);
+	EXPECT_EQ(why, refused);
+	EXPECT_TRUE(os.log.empty());
 	const std::string closed = errorOf([&] { d.importDmabuf(999); });
 	EXPECT_TRUE(contains(closed, "fstat of dma-buf fd 999 failed")) << closed;
 	os.close(fd);
