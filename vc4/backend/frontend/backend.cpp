@@ -6,10 +6,38 @@
 #include <sys/mman.h>
 #include <unistd.h>
 
+#include "frontend/qpu_context.hpp"
 #include "frontend/vc4_front_end.hpp"
 #include "frontend/vc4_warper.hpp"
+#if FRAPPE_VC4_HAVE_RUNTIME
+#include "runtime/gpu_device.hpp"
+#endif
 
 namespace frappe::vc4 {
+
+namespace {
+
+/* One device per detector: the front end and the warper share one context. */
+void makeQpuPair(bool emulate, BackendChoice &choice)
+{
+	if (emulate) {
+		auto context = makeEmuContext(FrontEndOptions{ .emulate = true });
+		choice.frontEnd = makeFrontEnd(context);
+		choice.warper = makeWarper(context);
+		return;
+	}
+#if FRAPPE_VC4_HAVE_RUNTIME
+	if (const std::string reason = probeGpu(); !reason.empty())
+		throw std::runtime_error(reason);
+	auto context = makeGpuContext(runtime::systemOs(), {});
+	choice.frontEnd = makeFrontEnd(context);
+	choice.warper = makeWarper(context);
+#else
+	throw std::runtime_error("the VideoCore IV runtime is only built for Linux.");
+#endif
+}
+
+} // namespace
 
 BackendChoice selectFrontEnd(std::string_view name, int threads)
 {
@@ -17,9 +45,7 @@ BackendChoice selectFrontEnd(std::string_view name, int threads)
 	if (name == "cpu") {
 		choice.frontEnd = makeCpuFrontEnd(threads);
 	} else if (name == "vc4" || name == "vc4-emu") {
-		const FrontEndOptions options{ .emulate = name == "vc4-emu" };
-		choice.frontEnd = makeFrontEnd(options);
-		choice.warper = makeWarper(options);
+		makeQpuPair(name == "vc4-emu", choice);
 	} else if (name == "auto") {
 #if !defined(__arm__) && !defined(__aarch64__)
 		/* No VideoCore IV outside a Raspberry Pi: nothing to probe or say. */
@@ -31,10 +57,10 @@ BackendChoice selectFrontEnd(std::string_view name, int threads)
 		const std::string reason = probeGpu();
 		if (reason.empty()) {
 			try {
-				choice.frontEnd = makeFrontEnd(FrontEndOptions{ .emulate = false });
-				choice.warper = makeWarper(FrontEndOptions{ .emulate = false });
+				makeQpuPair(false, choice);
 			} catch (const std::exception &e) {
 				choice.frontEnd.reset();
+				choice.warper.reset();
 				choice.fallback = e.what();
 			}
 		} else {
@@ -51,12 +77,20 @@ BackendChoice selectFrontEnd(std::string_view name, int threads)
 
 int allocateFrameMemory(std::string_view backend, std::size_t bytes, std::string &why)
 {
-	/* First cut, for both: a memfd. The real GPU's dma-heap comes with
-	 * the zero-copy path (issue 14). */
-	if (backend != "vc4" && backend != "vc4-emu") {
+	if (backend == "vc4") {
+#if FRAPPE_VC4_HAVE_RUNTIME
+		/* The heaps the runtime's own buffers come from: vcsm-cma imports them. */
+		return runtime::allocateDmaHeapBuffer(runtime::systemOs(), runtime::DeviceOptions{}, bytes, why);
+#else
+		why = "the VideoCore IV runtime is only built for Linux";
+		return -1;
+#endif
+	}
+	if (backend != "vc4-emu") {
 		why = "no QPU frame memory for backend '" + std::string(backend) + "'";
 		return -1;
 	}
+	/* The emulator reads host memory: a memfd, mapped in place like a dma-buf. */
 	const int fd = memfd_create("frappe-frame", MFD_CLOEXEC);
 	if (fd < 0 || ftruncate(fd, static_cast<off_t>(bytes)) != 0) {
 		why = "memfd_create failed";
@@ -65,6 +99,12 @@ int allocateFrameMemory(std::string_view backend, std::size_t bytes, std::string
 		return -1;
 	}
 	return fd;
+}
+
+std::string_view copyReason(const frappe::FrontEnd &front_end)
+{
+	ContextInfo info;
+	return contextInfo(front_end, info) ? info.copy_reason : std::string_view();
 }
 
 } // namespace frappe::vc4

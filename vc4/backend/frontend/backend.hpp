@@ -26,6 +26,8 @@ struct BackendChoice {
 /// The names selectFrontEnd() takes, for usage texts.
 inline constexpr std::string_view kBackendNames = "auto, cpu, vc4, vc4-emu";
 
+/// "vc4" and "vc4-emu" share one device between the front end and the warper, and the
+/// warper reads the frame the front end imported or copied (lastCopyBytes() counts both).
 /// "cpu": the reference CPU front end with `threads` bands. "vc4": the QPU
 /// kernels (front end and candidate warp) on the real GPU; throws std::runtime_error with the probe's reason
 /// when it cannot be used. "vc4-emu": the same kernels on the emulator, bit
@@ -41,5 +43,11 @@ BackendChoice selectFrontEnd(std::string_view name, int threads);
 /// reads host memory. Returns the file descriptor (the caller owns it) or -1
 /// with `why` set in one sentence. Never throws.
 int allocateFrameMemory(std::string_view backend, std::size_t bytes, std::string &why);
+
+/// Why the last frame was copied into GPU memory (front_end.lastCopyBytes() > 0: a
+/// system-memory frame, a stride the QPUs cannot gather from, an import the kernel
+/// refused), in one sentence for a debug line; empty when the QPUs read it in place or
+/// `front_end` is not a QPU one. Valid until the next frame.
+std::string_view copyReason(const frappe::FrontEnd &front_end);
 
 } // namespace frappe::vc4

@@ -42,20 +42,12 @@ public:
 		return contrast > 0 && width / 2 >= 3 && height / 2 >= 3;
 	}
 
-	/// Device bytes allocate() takes for a scaled width x height frame, alignment included.
-	static uint32_t bytes(int width, int height)
-	{
-		const Layout l(width, height);
-		return l.bufferBytes() + l.outBytes() + l.maskBytes() +
-		       kPrograms * (l.unifBytes(0) + l.unifBytes(1) + 2 * 64) + 5 * 4096 + 2 * 8192;
-	}
-
-	/// Buffers for a scaled width x height frame; `fresh` when the device is new (the
-	/// emulator's is re-created with the geometry), which needs the code again.
-	void allocate(Device &device, int width, int height, bool fresh)
+	/// Buffers for a scaled width x height frame (the code is uploaded once: the
+	/// detector's device lives as long as the front end).
+	void allocate(Device &device, int width, int height)
 	{
 		for (int pass = 0; pass < 2; ++pass)
-			if (fresh || !code_[pass].bus)
+			if (!code_[pass].bus)
 				code_[pass] = device.upload(programs_[pass].code);
 		layout_ = Layout(width, height);
 		if (!makesMap(width, height, 1))
@@ -68,8 +60,7 @@ public:
 				u = device.alloc(layout_.unifBytes(pass), 64);
 	}
 
-	/// Gives the data buffers back before the geometry changes (the GPU's; the emulator's
-	/// memory goes with its device).
+	/// Gives the data buffers back before the geometry changes.
 	void release(Device &device)
 	{
 		if constexpr (requires(Device &d, const Buffer &b) { d.release(b); }) {

@@ -9,6 +9,7 @@
 
 #include "emu/device.hpp"
 #include "frontend/emulator.hpp"
+#include "frontend/qpu_context.hpp"
 #include "frontend/region_pass.hpp"
 #include "isa/setup_words.hpp"
 #include "kernels/kernels.hpp"
@@ -26,7 +27,6 @@ using kernels::kTileH;
 using kernels::kTileW;
 
 constexpr unsigned kPrograms = 12;
-constexpr uint32_t kCodeSlack = 1u << 16;
 
 uint32_t roundUp(uint32_t v, uint32_t m) { return (v + m - 1) / m * m; }
 
@@ -34,14 +34,12 @@ uint32_t roundUp(uint32_t v, uint32_t m) { return (v + m - 1) / m * m; }
 struct Geometry {
 	int src_w = 0, src_h = 0, w = 0, h = 0;
 	bool operator==(const Geometry &) const = default;
-	uint32_t srcStride() const { return roundUp(static_cast<uint32_t>(src_w), 4); }
 	uint32_t paddedW() const { return roundUp(static_cast<uint32_t>(w), kTileW); }
 	uint32_t paddedH() const { return roundUp(static_cast<uint32_t>(h), kTileH); }
 	uint32_t tilesX() const { return paddedW() / kTileW; }
 	uint32_t tilesY() const { return paddedH() / kTileH; }
 	uint32_t tiles() const { return tilesX() * tilesY(); }
 	uint32_t gradPitch() const { return 16 * paddedW(); }
-	uint32_t srcBytes() const { return srcStride() * static_cast<uint32_t>(src_h) + 64; }
 	uint32_t gradBytes() const { return gradPitch() * paddedH(); }
 	/// Pass 2 reads border pixels' neighbours unclamped: a margin of a row and more.
 	uint32_t gradMargin() const { return gradPitch() + 64; }
@@ -55,63 +53,50 @@ struct Geometry {
 
 template <class Device>
 struct Buffers {
-	typename Device::Buffer src, grad, edge, mask, code[2];
+	typename Device::Buffer grad, edge, mask, code[2];
 	typename Device::Buffer unif[2][kPrograms];
 };
 
-// Device adapters: the emulator owns its memory (re-created when the geometry grows);
-// the GPU releases buffers one by one.
-struct EmuBackend {
-	using Device = emu::Device;
-	FrontEndOptions options;
-	std::unique_ptr<emu::Device> device;
-	FrameCounts counts;
-	bool counted = false;
+// The device adapter: the detector's shared QpuContext (one device, never re-created);
+// buffers of an old geometry are released one by one.
+template <class Dev>
+struct SharedBackend {
+	using Device = Dev;
+	std::shared_ptr<QpuContext<Device>> context;
 
-	static const char *name() { return "vc4-emu"; }
-	Device &open(uint32_t bytes, Buffers<Device> &)
+	static const char *name() { return QpuContext<Device>::kEmulated ? "vc4-emu" : "vc4"; }
+	Device &open(Buffers<Device> &old)
 	{
-		device = openEmulator(options, bytes);
-		return *device;
-	}
-	void run(std::span<const emu::Job> jobs, PassCounts &c)
-	{
-		const emu::LaunchStats s = runOnEmulator(*device, jobs, options);
-		c.instructions = s.instructions;
-		c.slowest_cycles = s.cycles;
-		c.programs = static_cast<unsigned>(jobs.size());
-	}
-};
-
-#if FRAPPE_VC4_HAVE_RUNTIME
-struct GpuBackend {
-	using Device = runtime::GpuDevice;
-	std::unique_ptr<runtime::GpuDevice> device;
-
-	static const char *name() { return "vc4"; }
-	Device &open(uint32_t, Buffers<Device> &old)
-	{
-		if (!device)
-			device = std::make_unique<runtime::GpuDevice>();
-		for (auto *b : {&old.src, &old.grad, &old.edge, &old.mask}) {
+		Device &device = context->device();
+		for (auto *b : {&old.grad, &old.edge, &old.mask}) {
 			if (b->bus)
-				device->release(*b);
+				device.release(*b);
 			*b = {};
 		}
 		for (auto &pass : old.unif)
 			for (auto &b : pass) {
 				if (b.bus)
-					device->release(b);
+					device.release(b);
 				b = {};
 			}
-		return *device;
+		return device;
 	}
-	void run(std::span<const runtime::Job> jobs, PassCounts &c)
+	template <class Job>
+	void run(std::span<const Job> jobs, PassCounts &c)
 	{
-		device->wait(device->launch(jobs));
+		if constexpr (QpuContext<Device>::kEmulated) {
+			const emu::LaunchStats s = runOnEmulator(context->device(), jobs, context->options());
+			c.instructions = s.instructions;
+			c.slowest_cycles = s.cycles;
+		} else {
+			context->device().wait(context->device().launch(jobs));
+		}
 		c.programs = static_cast<unsigned>(jobs.size());
 	}
 };
+using EmuBackend = SharedBackend<emu::Device>;
+#if FRAPPE_VC4_HAVE_RUNTIME
+using GpuBackend = SharedBackend<runtime::GpuDevice>;
 #endif
 
 template <class Backend>
@@ -128,8 +113,12 @@ public:
 	bool makesRegionMap() const override { return true; }
 	const Backend &backend() const { return backend_; }
 
+	std::size_t lastCopyBytes() const override { return backend_.context->copyBytes(); }
+	const QpuContext<Device> &context() const { return *backend_.context; }
+
 	void run(const ImageView &image, float scale, const FrontEndParams &params, EdgeMap &out) override
 	{
+		backend_.context->beginFrame();
 		Geometry g;
 		g.src_w = image.width;
 		g.src_h = image.height;
@@ -147,11 +136,9 @@ public:
 		out.resize(g.w, g.h);
 		out.scale = scale < 1.0f ? scale : 1.0f;
 
-		// The source frame, rows 4-aligned.
-		const uint32_t stride = g.srcStride();
-		for (int y = 0; y < g.src_h; ++y)
-			std::memcpy(buf_.src.cpu.data() + static_cast<size_t>(y) * stride, image.row(y),
-			            static_cast<size_t>(g.src_w));
+		// The source frame: its dma-buf in place, else a copy (the shared context decides).
+		const FrameSource src = backend_.context->frame(image, true);
+		const uint32_t stride = src.stride;
 
 		const uint32_t stepX = static_cast<uint32_t>((static_cast<uint64_t>(g.src_w) * 65536u + g.w / 2) / g.w);
 		const uint32_t stepY = static_cast<uint32_t>((static_cast<uint64_t>(g.src_h) * 65536u + g.h / 2) / g.h);
@@ -181,7 +168,7 @@ public:
 				p1 += sizeof(u1);
 				for (int strip = 0; strip < 4; ++strip) {
 					uint32_t rows[kernels::kGradientRowUniforms];
-					kernels::gradientRowUniforms(rows, buf_.src.bus, stride, g.src_h, stepY, g.h, static_cast<int>(y0));
+					kernels::gradientRowUniforms(rows, src.bus, stride, g.src_h, stepY, g.h, static_cast<int>(y0));
 					std::memcpy(p1, rows, sizeof(rows));
 					p1 += sizeof(rows);
 				}
@@ -196,9 +183,9 @@ public:
 			for (unsigned p = 0; p < programs; ++p)
 				jobs[p] = {buf_.unif[pass][p].bus, buf_.code[pass].bus};
 			counts_.pass[pass].tiles = tiles;
-			backend_.run(std::span<const JobType>(jobs.data(), programs), counts_.pass[pass]);
+			backend_.template run<JobType>(std::span<const JobType>(jobs.data(), programs), counts_.pass[pass]);
 		}
-		runRegions(RegionSource{buf_.src.bus, stride, g.src_w, g.src_h, stepX, stepY}, params, out);
+		runRegions(RegionSource{src.bus, stride, g.src_w, g.src_h, stepX, stepY}, params, out);
 		counted_ = true;
 
 		for (int y = 0; y < g.h; ++y)
@@ -274,22 +261,19 @@ private:
 			return;
 		const uint32_t u1 = 4 * g.uniformWords(kernels::kGradientUniforms + 4 * kernels::kGradientRowUniforms);
 		const uint32_t u2 = 4 * g.uniformWords(kernels::kEdgeUniforms);
-		const uint32_t total = g.srcBytes() + g.gradBytes() + 2 * g.gradMargin() + g.edgeBytes() + g.maskBytes() +
-		                       kPrograms * (u1 + u2 + 2 * 4096) + 6 * 4096 + 2 * kCodeSlack;
 		if (device_)
 			region_.release(*device_);
-		device_ = &backend_.open(total + RegionPass<Device>::bytes(g.w, g.h), buf_);
-		buf_.src = device_->alloc(g.srcBytes());
+		device_ = &backend_.open(buf_);
 		buf_.grad = device_->alloc(g.gradBytes() + 2 * g.gradMargin());
 		buf_.edge = device_->alloc(g.edgeBytes());
 		buf_.mask = device_->alloc(g.maskBytes());
 		for (int pass = 0; pass < 2; ++pass) {
-			if (!buf_.code[pass].bus || std::is_same_v<Device, emu::Device>)
+			if (!buf_.code[pass].bus)
 				buf_.code[pass] = device_->upload(programs_[pass].code);
 			for (unsigned p = 0; p < kPrograms; ++p)
 				buf_.unif[pass][p] = device_->alloc(pass ? u2 : u1, 64);
 		}
-		region_.allocate(*device_, g.w, g.h, std::is_same_v<Device, emu::Device>);
+		region_.allocate(*device_, g.w, g.h);
 		geometry_ = g;
 	}
 
@@ -308,18 +292,36 @@ private:
 
 std::unique_ptr<frappe::FrontEnd> makeFrontEnd(const FrontEndOptions &options)
 {
-	if (options.emulate) {
-		EmuBackend b;
-		b.options = options;
-		return std::make_unique<Vc4FrontEnd<EmuBackend>>(std::move(b));
-	}
+	if (options.emulate)
+		return makeFrontEnd(makeEmuContext(options));
 #if FRAPPE_VC4_HAVE_RUNTIME
 	const runtime::ProbeReport report = runtime::GpuDevice::probe();
 	if (!report.usable)
 		throw std::runtime_error(report.reason);
-	return std::make_unique<Vc4FrontEnd<GpuBackend>>(GpuBackend{});
+	return makeFrontEnd(makeGpuContext(runtime::systemOs(), {}));
 #else
 	throw std::runtime_error("the VideoCore IV runtime is only built for Linux.");
+#endif
+}
+
+std::unique_ptr<frappe::FrontEnd> makeFrontEnd(std::shared_ptr<QpuContext<emu::Device>> context)
+{
+	return std::make_unique<Vc4FrontEnd<EmuBackend>>(EmuBackend{std::move(context)});
+}
+
+#if FRAPPE_VC4_HAVE_RUNTIME
+std::unique_ptr<frappe::FrontEnd> makeFrontEnd(std::shared_ptr<QpuContext<runtime::GpuDevice>> context)
+{
+	return std::make_unique<Vc4FrontEnd<GpuBackend>>(GpuBackend{std::move(context)});
+}
+#endif
+
+bool contextInfo(const frappe::FrontEnd &front_end, ContextInfo &out)
+{
+#if FRAPPE_VC4_HAVE_RUNTIME
+	return contextInfoOf<Vc4FrontEnd<EmuBackend>, Vc4FrontEnd<GpuBackend>>(front_end, out);
+#else
+	return contextInfoOf<Vc4FrontEnd<EmuBackend>>(front_end, out);
 #endif
 }
 

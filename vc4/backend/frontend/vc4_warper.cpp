@@ -8,6 +8,7 @@
 
 #include "emu/device.hpp"
 #include "frontend/emulator.hpp"
+#include "frontend/qpu_context.hpp"
 #include "kernels/warp.hpp"
 #include "kernels/warp_reference.hpp"
 #if FRAPPE_VC4_HAVE_RUNTIME
@@ -23,44 +24,31 @@ constexpr unsigned kPrograms = 12;
 constexpr uint32_t kUniformBytes = 4 * (kernels::kWarpProgramUniforms + 3 * kernels::kWarpCandidateUniforms);
 constexpr uint32_t kOutputBytes = kernels::kWarpOutputBytes * kernels::kWarpMaxCandidates;
 
-uint32_t roundUp(uint32_t v, uint32_t m) { return (v + m - 1) / m * m; }
-
-/* The emulator: one device, re-created when a larger frame arrives. */
-struct EmuTarget {
-	using Device = emu::Device;
-	using Job = emu::Job;
-	FrontEndOptions options;
-	std::unique_ptr<emu::Device> device;
-
-	static const char *name() { return "vc4-emu"; }
-	Device &open(uint32_t bytes)
-	{
-		device = openEmulator(options, bytes);
-		return *device;
-	}
-	void run(std::span<const Job> jobs) { runOnEmulator(*device, jobs, options); }
-};
-
+/* The detector's shared context: the front end's device, and the frame it staged. */
+template <class Dev>
+struct SharedTarget {
+	using Device = Dev;
+	using Job = std::conditional_t<QpuContext<Dev>::kEmulated, emu::Job,
 #if FRAPPE_VC4_HAVE_RUNTIME
-/* The real GPU: buffers released and allocated again when a larger frame arrives. */
-struct GpuTarget {
-	using Device = runtime::GpuDevice;
-	using Job = runtime::Job;
-	std::unique_ptr<runtime::GpuDevice> device;
-	std::vector<Device::Buffer> owned;
+				       runtime::Job
+#else
+				       emu::Job
+#endif
+				       >;
+	std::shared_ptr<QpuContext<Device>> context;
 
-	static const char *name() { return "vc4"; }
-	Device &open(uint32_t)
+	static const char *name() { return QpuContext<Device>::kEmulated ? "vc4-emu" : "vc4"; }
+	void run(std::span<const Job> jobs)
 	{
-		if (!device)
-			device = std::make_unique<runtime::GpuDevice>();
-		for (const auto &b : owned)
-			device->release(b);
-		owned.clear();
-		return *device;
+		if constexpr (QpuContext<Device>::kEmulated)
+			runOnEmulator(context->device(), jobs, context->options());
+		else
+			context->device().wait(context->device().launch(jobs));
 	}
-	void run(std::span<const Job> jobs) { device->wait(device->launch(jobs)); }
 };
+using EmuTarget = SharedTarget<emu::Device>;
+#if FRAPPE_VC4_HAVE_RUNTIME
+using GpuTarget = SharedTarget<runtime::GpuDevice>;
 #endif
 
 template <class Target>
@@ -87,12 +75,10 @@ public:
 			counts_.on_cpu = static_cast<unsigned>(n);
 			return;
 		}
-		prepare(image.width, image.height);
-		const uint32_t stride = roundUp(static_cast<uint32_t>(image.width), 4);
-		for (int y = 0; y < image.height; ++y)
-			std::memcpy(src_.cpu.data() + static_cast<std::size_t>(y) * stride, image.row(y),
-				    static_cast<std::size_t>(image.width));
-		const kernels::WarpImage qpuImage{ src_.bus, stride, image.width, image.height };
+		prepare();
+		/* The frame the front end staged (imported or copied), else staged now. */
+		const FrameSource src = target_.context->frame(image, false);
+		const kernels::WarpImage qpuImage{ src.bus, src.stride, image.width, image.height };
 
 		/* Quantise every candidate; the ones the fixed point refuses go to the CPU. */
 		onQpu_.clear();
@@ -136,40 +122,26 @@ public:
 
 	const WarpCounts &counts() const { return counts_; }
 
+	const QpuContext<Device> &context() const { return *target_.context; }
+
 private:
-	/* Device buffers for frames up to this size; kept while frames fit. */
-	void prepare(int width, int height)
+	/* Device buffers of a constant size, allocated once on the shared device. */
+	void prepare()
 	{
-		const uint32_t bytes = roundUp(static_cast<uint32_t>(width), 4) * static_cast<uint32_t>(height) + 64;
-		if (device_ && bytes <= srcBytes_)
+		if (device_)
 			return;
-		const uint32_t total = bytes + kOutputBytes + kPrograms * roundUp(kUniformBytes, 64) +
-				       4 * 4096 + static_cast<uint32_t>(8 * program_.code.size());
-		device_ = &target_.open(total);
-		src_ = device_->alloc(bytes);
+		device_ = &target_.context->device();
 		out_ = device_->alloc(kOutputBytes);
 		for (auto &u : unif_)
 			u = device_->alloc(kUniformBytes, 64);
 		code_ = device_->upload(program_.code);
-		remember();
-		srcBytes_ = bytes;
-	}
-	void remember()
-	{
-#if FRAPPE_VC4_HAVE_RUNTIME
-		if constexpr (std::is_same_v<Target, GpuTarget>) {
-			target_.owned = { src_, out_, code_ };
-			target_.owned.insert(target_.owned.end(), std::begin(unif_), std::end(unif_));
-		}
-#endif
 	}
 
 	Target target_;
 	qasm::Program program_;
 	std::unique_ptr<CandidateWarper> cpu_;
 	Device *device_ = nullptr;
-	typename Device::Buffer src_, out_, code_, unif_[kPrograms];
-	uint32_t srcBytes_ = 0;
+	typename Device::Buffer out_, code_, unif_[kPrograms];
 	std::vector<std::size_t> onQpu_;
 	std::vector<kernels::WarpParams> params_;
 	WarpCounts counts_;
@@ -179,18 +151,36 @@ private:
 
 std::unique_ptr<frappe::CandidateWarper> makeWarper(const FrontEndOptions &options)
 {
-	if (options.emulate) {
-		EmuTarget t;
-		t.options = options;
-		return std::make_unique<QpuWarper<EmuTarget>>(std::move(t));
-	}
+	if (options.emulate)
+		return makeWarper(makeEmuContext(options));
 #if FRAPPE_VC4_HAVE_RUNTIME
 	const std::string reason = probeGpu();
 	if (!reason.empty())
 		throw std::runtime_error(reason);
-	return std::make_unique<QpuWarper<GpuTarget>>(GpuTarget{});
+	return makeWarper(makeGpuContext(runtime::systemOs(), {}));
 #else
 	throw std::runtime_error("the VideoCore IV runtime is only built for Linux.");
+#endif
+}
+
+std::unique_ptr<frappe::CandidateWarper> makeWarper(std::shared_ptr<QpuContext<emu::Device>> context)
+{
+	return std::make_unique<QpuWarper<EmuTarget>>(EmuTarget{ std::move(context) });
+}
+
+#if FRAPPE_VC4_HAVE_RUNTIME
+std::unique_ptr<frappe::CandidateWarper> makeWarper(std::shared_ptr<QpuContext<runtime::GpuDevice>> context)
+{
+	return std::make_unique<QpuWarper<GpuTarget>>(GpuTarget{ std::move(context) });
+}
+#endif
+
+bool contextInfo(const frappe::CandidateWarper &warper, ContextInfo &out)
+{
+#if FRAPPE_VC4_HAVE_RUNTIME
+	return contextInfoOf<QpuWarper<EmuTarget>, QpuWarper<GpuTarget>>(warper, out);
+#else
+	return contextInfoOf<QpuWarper<EmuTarget>>(warper, out);
 #endif
 }
 

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // The emulator behind the interface the hardware runtime will offer: GPU buffers with a
 // CPU view and a bus address, and asynchronous-looking launches completed by a fence.
+// Host memory (an mmapped dma-buf) can be mapped in place, as the runtime imports one.
 #pragma once
 
 #include <cstdint>
@@ -24,6 +25,14 @@ public:
 	Buffer alloc(uint32_t bytes, uint32_t align = 4096);
 	Buffer upload(std::span<const uint64_t> code);
 	Buffer upload(std::span<const uint32_t> words);
+	// Frees a buffer that did not fit the arena (see Memory::alloc); others stay.
+	void release(const Buffer &buffer) { memory_.release(buffer.bus); }
+	// The QPUs read (and, if `writable`, write) `host` in place at the returned bus
+	// address until release(); the caller keeps the memory alive until then.
+	Buffer importExternal(std::span<uint8_t> host, bool writable = false)
+	{
+		return {memory_.mapExternal(host, writable), host};
+	}
 
 	// Queues one launch of up to 12 (uniforms, code) jobs. The emulator runs it at once;
 	// wait() hands back its statistics, as the hardware backend's fence will.

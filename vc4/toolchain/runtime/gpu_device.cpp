@@ -91,6 +91,26 @@ std::string openFailure(const std::string &path, int err)
 	return path + ": " + errorText(err);
 }
 
+// A dma-buf of `bytes` (whole pages) from the heap at `path`, or -1 with why appended to `notes`.
+int heapBuffer(Os &os, const std::string &path, uint64_t bytes, std::string &notes)
+{
+	Fd heap{os, os.open(path, O_RDWR)};
+	if (heap.fd < 0) {
+		notes += (notes.empty() ? "" : "; ") + openFailure(path, heap.fd);
+		return -1;
+	}
+	uapi::DmaHeapAllocationData alloc;
+	alloc.len = (bytes + kPage - 1) / kPage * kPage;
+	alloc.fd_flags = O_RDWR | O_CLOEXEC;
+	const int e = os.ioctl(heap.fd, uapi::kIoctlDmaHeapAlloc, &alloc);
+	if (e < 0) {
+		notes += (notes.empty() ? "" : "; ") + path + " allocation of " + std::to_string(alloc.len) +
+		         " bytes failed: " + errorText(e);
+		return -1;
+	}
+	return static_cast<int>(alloc.fd);
+}
+
 // dma-heap allocation + vcsm-cma import of one page: proves the whole path works.
 bool tryDmaHeap(Os &os, const DeviceOptions &o, ProbeReport &r)
 {
@@ -102,25 +122,14 @@ bool tryDmaHeap(Os &os, const DeviceOptions &o, ProbeReport &r)
 		return false;
 	}
 	for (const std::string &path : o.heaps) {
-		Fd heap{os, os.open(path, O_RDWR)};
-		if (heap.fd < 0) {
-			notes += (notes.empty() ? "" : "; ") + openFailure(path, heap.fd);
+		Fd buf{os, heapBuffer(os, path, kPage, notes)};
+		if (buf.fd < 0)
 			continue;
-		}
-		uapi::DmaHeapAllocationData alloc;
-		alloc.len = kPage;
-		alloc.fd_flags = O_RDWR | O_CLOEXEC;
-		int e = os.ioctl(heap.fd, uapi::kIoctlDmaHeapAlloc, &alloc);
-		if (e < 0) {
-			notes += (notes.empty() ? "" : "; ") + path + " allocation failed: " + errorText(e);
-			continue;
-		}
-		Fd buf{os, static_cast<int>(alloc.fd)};
 		uapi::VcsmImportDmabuf import;
 		import.dmabuf_fd = buf.fd;
 		import.cached = uapi::kVcsmCacheNone;
 		std::memcpy(import.name, "vc4-qpu-probe", 13);
-		e = os.ioctl(vcsm.fd, uapi::kIoctlVcsmImportDmabuf, &import);
+		const int e = os.ioctl(vcsm.fd, uapi::kIoctlVcsmImportDmabuf, &import);
 		if (e < 0 || import.handle < 0 || import.dma_addr == 0) {
 			notes += (notes.empty() ? "" : "; ") + o.vcsm + " import of a " + path + " buffer failed: " +
 			         (e < 0 ? errorText(e) : std::string("no bus address"));
@@ -245,6 +254,16 @@ std::string ProbeReport::summary() const
 	return s;
 }
 
+int allocateDmaHeapBuffer(Os &os, const DeviceOptions &options, std::size_t bytes, std::string &why)
+{
+	std::string notes;
+	for (const std::string &path : options.heaps)
+		if (const int fd = heapBuffer(os, path, bytes, notes); fd >= 0)
+			return fd;
+	why = "no dma-heap frame memory: " + (notes.empty() ? std::string("no heap configured") : notes);
+	return -1;
+}
+
 ProbeReport GpuDevice::probe(Os &os, const DeviceOptions &options)
 {
 	ProbeReport r;
@@ -279,6 +298,7 @@ GpuDevice::~GpuDevice() { cleanup(); }
 
 void GpuDevice::cleanup()
 {
+	imports_.clear([this](Imported &i) { releaseImport(i); });
 	for (auto &[bus, a] : buffers_)
 		free(a);
 	buffers_.clear();
@@ -414,17 +434,107 @@ void GpuDevice::release(const Buffer &buffer)
 	buffers_.erase(it);
 }
 
+GpuDevice::Import GpuDevice::importDmabuf(int fd)
+{
+	std::string_view why;
+	if (const Import *im = tryImportDmabuf(fd, why))
+		return *im;
+	throw RuntimeError(std::string(why));
+}
+
+const GpuDevice::Import *GpuDevice::tryImportDmabuf(int fd, std::string_view &why)
+{
+	if (report_.memory != MemoryKind::DmaHeapVcsm) {
+		std::snprintf(why_, sizeof why_, "dma-buf import needs vcsm-cma, and this device uses %s memory",
+		              toString(report_.memory));
+		why = why_;
+		return nullptr;
+	}
+	FileId id;
+	if (const int e = os_.fileId(fd, id); e < 0) {
+		std::snprintf(why_, sizeof why_, "fstat of dma-buf fd %d failed: %s", fd, errorText(e).c_str());
+		why = why_;
+		return nullptr;
+	}
+	Imported *hit = imports_.find(id);
+	if (!hit) {
+		hit = &imports_.add(id, importOnce(fd, id), [this](Imported &old) { releaseImport(old); });
+		if (hit->handle >= 0) {
+			// Open the CPU's access window, as for our own buffers; launches close and reopen it.
+			uapi::DmaBufSync sync{uapi::kDmaBufSyncStart | uapi::kDmaBufSyncRw};
+			os_.ioctl(hit->dmabuf, uapi::kIoctlDmaBufSync, &sync);
+		}
+	}
+	if (hit->handle < 0) {
+		why = hit->why;
+		return nullptr;
+	}
+	return &hit->view;
+}
+
+GpuDevice::Imported GpuDevice::importOnce(int fd, const FileId &id)
+{
+	Imported i;
+	i.dmabuf = os_.dup(fd);
+	if (i.dmabuf < 0) {
+		std::snprintf(i.why, sizeof i.why, "cannot dup dma-buf fd %d: %s", fd, errorText(i.dmabuf).c_str());
+		i.dmabuf = -1;
+		return i;
+	}
+	uapi::VcsmImportDmabuf import;
+	import.dmabuf_fd = i.dmabuf;
+	import.cached = uapi::kVcsmCacheNone;
+	std::memcpy(import.name, "vc4-frame", 9);
+	const int e = os_.ioctl(vcsm_, uapi::kIoctlVcsmImportDmabuf, &import);
+	if (e < 0 || import.handle < 0 || import.dma_addr == 0) {
+		if (e >= 0 && import.handle >= 0)
+			os_.close(import.handle);
+		os_.close(i.dmabuf);
+		i.dmabuf = -1;
+		std::snprintf(i.why, sizeof i.why,
+		              "%s refused to import dma-buf fd %d: %s (a buffer the GPU cannot address contiguously?)",
+		              options_.vcsm.c_str(), fd, e < 0 ? errorText(e).c_str() : "no bus address");
+		return i;
+	}
+	i.handle = import.handle;
+	i.view.bus = (static_cast<uint32_t>(import.dma_addr) & ~uapi::kBusAliasMask) | uapi::kBusAliasUncached;
+	i.view.bytes = id.size ? id.size : import.size;
+	return i;
+}
+
+std::size_t GpuDevice::imports() const
+{
+	std::size_t n = 0;
+	imports_.forEach([&](const Imported &i) { n += i.handle >= 0; });
+	return n;
+}
+
+void GpuDevice::releaseImport(Imported &i)
+{
+	if (i.handle >= 0)
+		os_.close(i.handle);
+	if (i.dmabuf >= 0)
+		os_.close(i.dmabuf);
+	i.handle = i.dmabuf = -1;
+}
+
 void GpuDevice::syncAll(uint64_t flags)
 {
 	if (report_.memory != MemoryKind::DmaHeapVcsm)
 		return; // /dev/mem O_SYNC mappings are uncached
-	for (auto &[bus, a] : buffers_) {
-		uapi::DmaBufSync sync{flags};
-		const int e = os_.ioctl(a.dmabuf, uapi::kIoctlDmaBufSync, &sync);
+	auto sync = [&](int fd, uint32_t bus) {
+		uapi::DmaBufSync s{flags};
+		const int e = os_.ioctl(fd, uapi::kIoctlDmaBufSync, &s);
 		if (e < 0)
 			throw RuntimeError("DMA_BUF_IOCTL_SYNC failed on the buffer at bus " + hex(bus) + ": " +
 			                   errorText(e));
-	}
+	};
+	for (auto &[bus, a] : buffers_)
+		sync(a.dmabuf, bus);
+	imports_.forEach([&](Imported &i) {
+		if (i.handle >= 0)
+			sync(i.dmabuf, i.view.bus);
+	});
 }
 
 GpuDevice::Fence GpuDevice::launch(std::span<const Job> jobs, std::chrono::milliseconds timeout)

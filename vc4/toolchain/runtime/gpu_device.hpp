@@ -5,7 +5,9 @@
 // mailbox (execute_qpu); memory comes from a CPU-cached dma-heap imported into vcsm-cma
 // for its bus address, or, as a fallback, from the firmware's own allocator mapped through
 // /dev/mem (uncached, root only). probe() says, in one sentence, why the GPU cannot be
-// used when it cannot. All system calls go through Os, so tests run on any machine.
+// used when it cannot. A dma-buf made elsewhere (a camera frame) is imported into vcsm-cma
+// once per buffer and read by the QPUs in place. All system calls go through Os, so tests
+// run on any machine.
 #pragma once
 
 #include <chrono>
@@ -14,8 +16,10 @@
 #include <memory>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
+#include "runtime/import_cache.hpp"
 #include "runtime/mailbox.hpp"
 #include "runtime/os.hpp"
 
@@ -62,6 +66,12 @@ struct LaunchResult {
 	std::chrono::nanoseconds elapsed{0}; // wall time of the execute_qpu call
 };
 
+// A dma-buf of `bytes` from the first of `options.heaps` that allocates (the heaps the
+// runtime's own memory comes from, so vcsm-cma can import it): frame memory for a camera
+// or an upstream element to fill and the QPUs to read in place. Returns the fd (the
+// caller owns it) or -1 with `why` set in one sentence. Never throws.
+int allocateDmaHeapBuffer(Os &os, const DeviceOptions &options, std::size_t bytes, std::string &why);
+
 class GpuDevice {
 public:
 	struct Buffer {
@@ -92,6 +102,25 @@ public:
 	Buffer upload(std::span<const uint32_t> words);
 	void release(const Buffer &buffer);
 
+	// A dma-buf of someone else's (a camera frame) as the QPUs see it, in place.
+	struct Import {
+		uint32_t bus = 0;   // of the dma-buf's first byte (uncached alias)
+		uint64_t bytes = 0; // the dma-buf's size
+	};
+	// Imports `fd`'s dma-buf into vcsm-cma, once per buffer: the import (of a dup of
+	// `fd`, so the caller may close or reuse its number) is cached by the file's identity
+	// (st_dev, st_ino), up to ImportCache::kCapacity buffers, the least recently used
+	// released beyond that and all on destruction. Imports are cache-synced around
+	// launches like the device's own buffers. Throws RuntimeError saying why when the
+	// buffer cannot be imported (mailbox memory in use, not contiguous, ...).
+	Import importDmabuf(int fd);
+	// The same without throwing or allocating once a buffer has been seen, for the frame
+	// path: nullptr when it cannot be imported, with `why` (valid until the next call). A
+	// refusal is remembered per buffer too, so a refused buffer is not retried each frame.
+	const Import *tryImportDmabuf(int fd, std::string_view &why);
+	// dma-bufs imported now (cached; refusals not counted).
+	std::size_t imports() const;
+
 	// Runs jobs[i] on one QPU each and returns when all have ended (execute_qpu blocks;
 	// run it on a worker thread to overlap with the CPU). CPU caches of every buffer are
 	// written back before and invalidated after. Throws TimeoutError when the programs do
@@ -116,7 +145,16 @@ private:
 	Allocation allocateDmaHeap(uint32_t bytes, uint32_t align);
 	Allocation allocateMailbox(uint32_t bytes, uint32_t align);
 	void free(Allocation &a);
+	struct Imported {
+		Import view;
+		int dmabuf = -1;    // our dup of the caller's fd
+		int handle = -1;    // vcsm-cma import; -1: refused, for the reason in `why`
+		char why[200] = {};
+	};
+
 	void syncAll(uint64_t flags);
+	Imported importOnce(int fd, const FileId &id);
+	void releaseImport(Imported &i);
 	void cleanup();
 
 	Os &os_;
@@ -125,6 +163,8 @@ private:
 	std::unique_ptr<Mailbox> mailbox_;
 	int heap_ = -1, vcsm_ = -1, devmem_ = -1;
 	std::map<uint32_t, Allocation> buffers_;
+	ImportCache<Imported> imports_;
+	char why_[200] = {}; // the last failure not tied to a buffer (fstat)
 	Buffer control_;
 	Fence next_ = 1;
 	std::map<Fence, LaunchResult> done_;

@@ -9,6 +9,7 @@
 #include <iterator>
 #include <sys/ioctl.h>
 #include <sys/mman.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 namespace frappe::vc4::runtime {
@@ -23,6 +24,21 @@ public:
 		return fd < 0 ? -errno : fd;
 	}
 	int close(int fd) override { return ::close(fd) < 0 ? -errno : 0; }
+	int dup(int fd) override
+	{
+		const int r = ::fcntl(fd, F_DUPFD_CLOEXEC, 0);
+		return r < 0 ? -errno : r;
+	}
+	int fileId(int fd, FileId &out) override
+	{
+		struct stat st;
+		if (::fstat(fd, &st) < 0)
+			return -errno;
+		out.device = st.st_dev;
+		out.inode = st.st_ino;
+		out.size = static_cast<uint64_t>(st.st_size);
+		return 0;
+	}
 	int ioctl(int fd, unsigned long request, void *arg) override
 	{
 		int r;

@@ -11,11 +11,22 @@
 
 namespace frappe::vc4::runtime {
 
+// Which file an fd is (fstat): two fds name the same dma-buf when device and inode match,
+// whatever their numbers.
+struct FileId {
+	uint64_t device = 0;
+	uint64_t inode = 0;
+	uint64_t size = 0; // bytes (a dma-buf's size)
+	bool operator==(const FileId &o) const { return device == o.device && inode == o.inode; }
+};
+
 class Os {
 public:
 	virtual ~Os() = default;
 	virtual int open(const std::string &path, int flags) = 0;
 	virtual int close(int fd) = 0;
+	virtual int dup(int fd) = 0;
+	virtual int fileId(int fd, FileId &out) = 0;
 	virtual int ioctl(int fd, unsigned long request, void *arg) = 0;
 	// Shared read-write mapping of `length` bytes of `fd` at `offset`; nullptr on failure
 	// with -errno in `error`.

@@ -5,6 +5,7 @@
 // semaphores and the mutex (section 3), branch forms (section 3 "Branches" + addendum).
 #include <gtest/gtest.h>
 
+#include "emu/device.hpp"
 #include "harness.hpp"
 #include "isa/setup_words.hpp"
 
@@ -372,4 +373,54 @@ TEST(EmuSync, ConditionalSetupWriteUsesElementZero)
 	a.emit(mov(reg::host_int, imm(1)).ifz());
 	a.thrend();
 	EXPECT_EQ(run(a.finish(false))->stats.host_interrupts, 1u);
+}
+
+// Memory beyond the arena: allocations too large for it get releasable regions of their
+// own; host memory (an mmapped dma-buf) is mapped in place, read-only when asked.
+TEST(EmuMemory, RegionsAndExternalMappings)
+{
+	emu::Memory m(64u << 10);
+	const uint32_t small = m.alloc(16u << 10);
+	EXPECT_GE(small, m.base());
+	EXPECT_LT(small, m.base() + m.size());
+	const uint32_t big = m.alloc(1u << 20, 65536);
+	EXPECT_GE(big, m.base() + m.size());
+	EXPECT_EQ(big % 65536, 0u);
+	EXPECT_EQ(m.read32(big + (1u << 20) - 4), 0u);
+	m.write32(big + 8, 0xdeadbeef);
+	EXPECT_EQ(m.read32(big + 8), 0xdeadbeefu);
+	EXPECT_THROW(m.read32(big + (1u << 20)), emu::MemoryError); // one past the region
+	EXPECT_EQ(m.regions(), 1u);
+
+	std::vector<uint8_t> host(8192, 7);
+	const uint32_t ext = m.mapExternal(host, false);
+	EXPECT_NE(ext, big);
+	EXPECT_EQ(m.read32(ext), 0x07070707u);
+	host[4] = 1; // in place: the host's writes are what the QPUs read
+	EXPECT_EQ(m.read32(ext + 4), 0x07070701u);
+	EXPECT_THROW(m.write32(ext, 0), emu::MemoryError);
+	EXPECT_THROW(m.read32(ext + 8192), emu::MemoryError);
+	EXPECT_EQ(m.read32(big + 8), 0xdeadbeefu); // the other region still found
+	std::vector<uint8_t> fixed(4096, 9);
+	EXPECT_EQ(m.mapExternal(fixed, true, 0xDF000000u), 0xDF000000u); // where a fake GPU put it
+	m.write32(0xDF000ffc, 0x05060708);
+	EXPECT_EQ(fixed[4095], 5);
+	EXPECT_THROW(m.mapExternal(fixed, true, 0xDF000800u), emu::MemoryError); // overlaps
+	EXPECT_THROW(m.mapExternal(fixed, true, m.base()), emu::MemoryError);     // the arena
+	m.release(0xDF000000u);
+
+	emu::Device d(emu::Config{}, 64u << 10);
+	std::vector<uint8_t> frame(4096, 3);
+	const auto b = d.importExternal(frame, true);
+	d.v3d().memory().write32(b.bus, 0x01020304);
+	EXPECT_EQ(frame[0], 4);
+	d.release(b);
+	EXPECT_THROW(d.v3d().memory().read32(b.bus), emu::MemoryError);
+
+	m.release(big);
+	m.release(ext);
+	m.release(small); // arena allocations stay: a no-op
+	EXPECT_EQ(m.regions(), 0u);
+	EXPECT_THROW(m.read32(big), emu::MemoryError);
+	EXPECT_THROW(m.release(ext), emu::MemoryError);
 }

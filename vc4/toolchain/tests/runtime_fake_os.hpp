@@ -8,6 +8,7 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
+#include <functional>
 #include <list>
 #include <map>
 #include <set>
@@ -38,6 +39,9 @@ public:
 	uint32_t enable_status = 0;  // set_enable_qpu answer
 	uint32_t execute_status = 0; // execute_qpu answer
 	int execute_errno = 0;       // ioctl result for execute_qpu (e.g. -ETIMEDOUT)
+	// When set, runs execute_qpu's programs (count, control block bus address) over the
+	// fake's memory (bus_to_cpu) and returns its status.
+	std::function<uint32_t(uint32_t, uint32_t)> execute;
 	uint32_t parse_code = uapi::kResponseSuccess;
 	uint32_t v3d_hz = 300'000'000;
 	uint32_t next_handle = 7;
@@ -83,6 +87,44 @@ public:
 		open_fds.erase(it);
 		return 0;
 	}
+	// A dma-buf made elsewhere (a camera's): `inode` names the buffer, `fd` its number
+	// (-1: the next free one), backed by zeroed memory the test fills (cpu()).
+	int cameraBuffer(const std::string &name, size_t bytes, uint64_t inode, int fd = -1)
+	{
+		if (fd < 0)
+			fd = next_fd_++;
+		open_fds[fd] = name;
+		sizes_[fd] = bytes;
+		inodes_[name] = inode;
+		auto &m = maps_.emplace_back(bytes, uint8_t{0});
+		dmabuf_map_[name] = m.data();
+		return fd;
+	}
+	uint8_t *cpu(const std::string &name) { return dmabuf_map_[name]; }
+	std::set<std::string> refuse_import; // dma-bufs vcsm-cma will not import (-EINVAL)
+
+	int dup(int fd) override
+	{
+		auto it = open_fds.find(fd);
+		if (it == open_fds.end())
+			return -EBADF;
+		const int d = next_fd_++;
+		open_fds[d] = it->second;
+		sizes_[d] = sizes_[fd];
+		log.push_back("dup " + it->second);
+		return d;
+	}
+	int fileId(int fd, FileId &out) override
+	{
+		auto it = open_fds.find(fd);
+		if (it == open_fds.end())
+			return -EBADF;
+		auto ino = inodes_.find(it->second);
+		out.device = 9;
+		out.inode = ino == inodes_.end() ? 1000 + static_cast<uint64_t>(fd) : ino->second;
+		out.size = sizes_[fd];
+		return 0;
+	}
 	int ioctl(int fd, unsigned long request, void *arg) override
 	{
 		auto it = open_fds.find(fd);
@@ -106,6 +148,10 @@ public:
 			auto src = open_fds.find(im->dmabuf_fd);
 			if (src == open_fds.end())
 				return -EBADF;
+			if (refuse_import.count(src->second)) {
+				log.back() += " " + src->second + " refused";
+				return -EINVAL;
+			}
 			const int h = next_fd_++;
 			open_fds[h] = "import-of-" + src->second;
 			im->handle = h;
@@ -113,12 +159,13 @@ public:
 			im->size = static_cast<uint32_t>(sizes_[im->dmabuf_fd]);
 			im->dma_addr = next_dma_addr;
 			bus_to_cpu[(static_cast<uint32_t>(next_dma_addr) & 0x3fffffffu) | 0xC0000000u] = dmabuf_map_[src->second];
+			bus_size[(static_cast<uint32_t>(next_dma_addr) & 0x3fffffffu) | 0xC0000000u] = sizes_[im->dmabuf_fd];
 			next_dma_addr += (sizes_[im->dmabuf_fd] + 0xffff) & ~uint64_t{0xffff};
 			log.back() += " " + src->second + " cached=" + std::to_string(im->cached) + " name=" +
 			              reinterpret_cast<const char *>(im->name);
 			return 0;
 		}
-		if (path.rfind("dmabuf", 0) == 0 && request == uapi::kIoctlDmaBufSync) {
+		if ((path.rfind("dmabuf", 0) == 0 || inodes_.count(path)) && request == uapi::kIoctlDmaBufSync) {
 			log.back() = "sync " + path + " " + hex32(static_cast<uapi::DmaBufSync *>(arg)->flags);
 			return 0;
 		}
@@ -134,8 +181,10 @@ public:
 		log.push_back("mmap " + it->second + " " + std::to_string(length) + " @" + hex32(offset));
 		auto &m = maps_.emplace_back(length, uint8_t{0xA5}); // garbage: alloc must zero
 		mapped_[m.data()] = {it->second, offset};
-		if (it->second == "/dev/mem")
+		if (it->second == "/dev/mem") {
 			bus_to_cpu[static_cast<uint32_t>(offset) | 0xC0000000u] = m.data();
+			bus_size[static_cast<uint32_t>(offset) | 0xC0000000u] = length;
+		}
 		else
 			dmabuf_map_[it->second] = m.data();
 		error = 0;
@@ -164,11 +213,12 @@ public:
 	const uint8_t *cpuOf(uint32_t bus) const
 	{
 		for (const auto &[bus0, ptr] : bus_to_cpu)
-			if (bus >= bus0 && bus < bus0 + 0x10000)
+			if (bus >= bus0 && bus - bus0 < bus_size.at(bus0))
 				return ptr + (bus - bus0);
 		return nullptr;
 	}
 	std::map<uint32_t, uint8_t *> bus_to_cpu; // from /dev/mem offsets and vcsm imports
+	std::map<uint32_t, uint64_t> bus_size;
 
 	std::vector<std::string> entries(const std::string &prefix) const
 	{
@@ -198,7 +248,7 @@ private:
 			}
 			if (execute_errno)
 				return execute_errno;
-			v[0] = execute_status;
+			v[0] = execute ? execute(v[0], v[1]) : execute_status;
 			break;
 		case uapi::tag::clock_rate: v[1] = v3d_hz; words = 2; break;
 		case uapi::tag::firmware_revision: v[0] = 0x5f5e1000; break;
@@ -219,6 +269,7 @@ private:
 	std::list<std::vector<uint8_t>> maps_;
 	std::map<void *, std::pair<std::string, uint64_t>> mapped_;
 	std::map<std::string, uint8_t *> dmabuf_map_;
+	std::map<std::string, uint64_t> inodes_;
 };
 
 } // namespace frappe::vc4::runtime::test

@@ -5,6 +5,8 @@
 // the execute_qpu control block, the timeout path and clean-up.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <linux/dma-buf.h>
 #include <linux/dma-heap.h>
 
@@ -384,4 +386,178 @@ TEST(RuntimeDevice, MailboxMemoryOnBcm2835AndBcm2837)
 		}
 		EXPECT_TRUE(os.open_fds.empty());
 	}
+}
+
+// Camera frames (dma-bufs made elsewhere) imported in place: once per buffer, keyed by the
+// file and not the fd number, bounded, synced around launches, released.
+namespace {
+
+// The message of the RuntimeError `f` throws; fails the test when it throws none.
+template <class F>
+std::string errorOf(F &&f)
+{
+	try {
+		f();
+	} catch (const RuntimeError &e) {
+		return e.what();
+	}
+	ADD_FAILURE() << "no RuntimeError";
+	return {};
+}
+
+size_t countOf(const std::vector<std::string> &log, const std::string &part)
+{
+	return static_cast<size_t>(std::count_if(log.begin(), log.end(), [&](const std::string &l) { return contains(l, part); }));
+}
+
+} // namespace
+
+TEST(RuntimeImport, OncePerBufferOverManyFramesAndSyncedAroundLaunches)
+{
+	FakeOs os;
+	os.pi();
+	os.dmaHeap();
+	const int cam[3] = {os.cameraBuffer("cam0", 320 * 240, 100), os.cameraBuffer("cam1", 320 * 240, 101),
+	                    os.cameraBuffer("cam2", 320 * 240, 102)};
+	{
+		GpuDevice d(os);
+		const auto code = d.upload(std::vector<uint64_t>{0x100009e7009e7000ull});
+		os.log.clear();
+		uint32_t bus[3] = {};
+		for (int frame = 0; frame < 12; ++frame) {
+			const auto im = d.importDmabuf(cam[frame % 3]);
+			EXPECT_EQ(im.bytes, 320u * 240u);
+			if (frame < 3)
+				bus[frame] = im.bus;
+			EXPECT_EQ(im.bus, bus[frame % 3]) << "frame " << frame;
+			EXPECT_EQ(im.bus & 0xC0000000u, 0xC0000000u); // the uncached alias
+		}
+		EXPECT_NE(bus[0], bus[1]);
+		EXPECT_EQ(d.imports(), 3u);
+		EXPECT_EQ(countOf(os.log, "name=vc4-frame"), 3u); // one vcsm-cma import a buffer
+		EXPECT_EQ(countOf(os.log, "dup cam"), 3u);
+		os.log.clear();
+		const Job job{code.bus, code.bus};
+		d.wait(d.launch(std::span<const Job>(&job, 1)));
+		// Each imported frame written back before the launch and invalidated after, as the
+		// device's own buffers.
+		for (const char *c : {"cam0", "cam1", "cam2"}) {
+			EXPECT_EQ(countOf(os.log, std::string("sync ") + c + " 0x00000007"), 1u) << c;
+			EXPECT_EQ(countOf(os.log, std::string("sync ") + c + " 0x00000003"), 1u) << c;
+		}
+		const auto launch = std::find_if(os.log.begin(), os.log.end(), [](const std::string &l) { return contains(l, "tag=0x00030011"); });
+		ASSERT_NE(launch, os.log.end());
+		EXPECT_EQ(std::count_if(os.log.begin(), launch, [](const std::string &l) { return contains(l, "sync cam"); }), 3);
+		EXPECT_EQ(std::count_if(launch, os.log.end(), [](const std::string &l) { return contains(l, "sync cam"); }), 3);
+	}
+	// Destruction released the imports and our dups; the caller's fds stay open.
+	EXPECT_EQ(os.open_fds.size(), 3u);
+	for (int fd : cam)
+		EXPECT_EQ(os.close(fd), 0);
+	EXPECT_TRUE(os.open_fds.empty());
+}
+
+TEST(RuntimeImport, RecycledFdNumberOfAnotherBufferIsImportedAfresh)
+{
+	FakeOs os;
+	os.pi();
+	os.dmaHeap();
+	GpuDevice d(os);
+	const int fd = os.cameraBuffer("camA", 4096, 200);
+	const auto a = d.importDmabuf(fd);
+	os.close(fd);
+	// The same number now names another buffer: a new import, not the old bus address.
+	ASSERT_EQ(os.cameraBuffer("camB", 8192, 201, fd), fd);
+	const auto b = d.importDmabuf(fd);
+	EXPECT_NE(a.bus, b.bus);
+	EXPECT_EQ(b.bytes, 8192u);
+	EXPECT_EQ(d.imports(), 2u);
+	// Another number for the same buffer (as a pool's dup would be) hits the cache.
+	const int again = os.dup(fd);
+	os.log.clear();
+	EXPECT_EQ(d.importDmabuf(again).bus, b.bus);
+	EXPECT_EQ(countOf(os.log, "vcsm-cma"), 0u);
+	os.close(again);
+	os.close(fd);
+}
+
+TEST(RuntimeImport, BoundedLeastRecentlyUsedFirstAndReleased)
+{
+	FakeOs os;
+	os.pi();
+	os.dmaHeap();
+	GpuDevice d(os);
+	constexpr size_t kCap = ImportCache<int>::kCapacity;
+	std::vector<int> fds;
+	for (size_t i = 0; i <= kCap; ++i)
+		fds.push_back(os.cameraBuffer("cam" + std::to_string(i), 4096, 300 + i));
+	for (size_t i = 0; i < kCap; ++i)
+		d.importDmabuf(fds[i]);
+	d.importDmabuf(fds[0]); // cam0 used again: cam1 is now the oldest
+	os.log.clear();
+	d.importDmabuf(fds[kCap]);
+	EXPECT_EQ(d.imports(), kCap);
+	// cam1's import and our dup of it closed; cam0 still cached.
+	EXPECT_EQ(countOf(os.log, "close import-of-cam1"), 1u);
+	EXPECT_EQ(countOf(os.log, "close cam1"), 1u);
+	os.log.clear();
+	d.importDmabuf(fds[0]);
+	EXPECT_EQ(countOf(os.log, "vcsm-cma"), 0u);
+	for (int fd : fds)
+		os.close(fd);
+}
+
+TEST(RuntimeImport, RefusedImportSaysWhyAndLeaksNothing)
+{
+	FakeOs os;
+	os.pi();
+	os.dmaHeap();
+	GpuDevice d(os);
+	const int fd = os.cameraBuffer("scattered", 4096, 400);
+	os.refuse_import.insert("scattered");
+	const size_t open_before = os.open_fds.size();
+	const std::string refused = errorOf([&] { d.importDmabuf(fd); });
+	EXPECT_TRUE(contains(refused, "/dev/vcsm-cma refused to import dma-buf fd " + std::to_string(fd))) << refused;
+	EXPECT_EQ(os.open_fds.size(), open_before);
+	EXPECT_EQ(d.imports(), 0u);
+	// The refusal is remembered for the buffer: later frames cost an fstat, not an import.
+	os.log.clear();
+	std::string_view why;
+	EXPECT_EQ(d.tryImportDmabuf(fd, why), nullptr);
+	EXPECT_EQ(why, refused);
+	EXPECT_TRUE(os.log.empty());
+	const std::string closed = errorOf([&] { d.importDmabuf(999); });
+	EXPECT_TRUE(contains(closed, "fstat of dma-buf fd 999 failed")) << closed;
+	os.close(fd);
+}
+
+TEST(RuntimeImport, MailboxMemoryCannotImport)
+{
+	FakeOs os;
+	os.pi();
+	os.devices.insert("/dev/mem");
+	GpuDevice d(os);
+	ASSERT_EQ(d.report().memory, MemoryKind::MailboxDevMem);
+	const int fd = os.cameraBuffer("cam", 4096, 500);
+	const std::string why = errorOf([&] { d.importDmabuf(fd); });
+	EXPECT_TRUE(contains(why, "dma-buf import needs vcsm-cma, and this device uses mailbox + /dev/mem memory")) << why;
+	os.close(fd);
+}
+
+TEST(RuntimeImport, FrameMemoryFromTheRuntimesHeap)
+{
+	FakeOs os;
+	os.dmaHeap();
+	std::string why;
+	const int fd = allocateDmaHeapBuffer(os, DeviceOptions{}, 640 * 480, why);
+	ASSERT_GE(fd, 0) << why;
+	EXPECT_EQ(os.open_fds.at(fd), "dmabuf1");
+	EXPECT_EQ(countOf(os.log, "len=307200 -> dmabuf1"), 1u); // 75 pages exactly
+	os.close(fd);
+	EXPECT_TRUE(os.open_fds.empty()); // the heap's fd is not kept
+
+	FakeOs none;
+	EXPECT_EQ(allocateDmaHeapBuffer(none, DeviceOptions{}, 4096, why), -1);
+	EXPECT_EQ(why, "no dma-heap frame memory: /dev/dma_heap/vidbuf_cached does not exist; "
+	               "/dev/dma_heap/linux,cma does not exist");
 }
