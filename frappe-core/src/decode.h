@@ -19,8 +19,10 @@ constexpr int kSamplesPerCell = 2;
 /// a cell (16x16 for 6x6 codes).
 using WarpedMarker = CandidateSamples;
 
-/// Warps the quad into `side` x `side` samples (CandidateSamples' grid).
-/// False when the quad is degenerate.
+/// Warps the quad into `side` x `side` samples (CandidateSamples' grid):
+/// the fixed-point warp of frappe/fixed_warp.h (integer grey levels) where
+/// quantiseWarp() holds the quad, else a float warp (double homography,
+/// float bilinear). False when the quad is degenerate.
 bool warpToGrid(const ImageView &image, const std::array<Point2f, 4> &corners, int side, WarpedMarker &out);
 /// warpToGrid without SIMD, the reference its vectorised sampling is tested
 /// against.
