@@ -105,6 +105,11 @@ std::optional<FixedWarp> quantiseWarp(const std::array<Point2f, 4> &corners, int
 
 std::uint8_t fixedWarpSample(const ImageView &image, const FixedWarp &w, int i, int j)
 {
+	return static_cast<std::uint8_t>((fixedWarpValue(image, w, i, j) + (1u << 19)) >> 20);
+}
+
+std::uint32_t fixedWarpValue(const ImageView &image, const FixedWarp &w, int i, int j)
+{
 	const std::int64_t d = w.d.at(i, j);
 	auto quotient = [d](std::int64_t n) {
 		return (std::clamp<std::int64_t>(n, 0, (d << kFixedWarpIntBits) - 1) << kFixedWarpFracBits) / d;

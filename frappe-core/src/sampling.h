@@ -48,9 +48,9 @@ inline std::int32_t fixedPosition(std::int64_t q, std::int32_t origin, int exten
 	return static_cast<std::int32_t>(std::clamp<std::int64_t>(p, 0, std::int64_t{ extent - 1 } * 1024));
 }
 
-/// The fixed-point warp's exact bilinear sample at (X, Y), 10 fraction
+/// The fixed-point warp's exact bilinear value v at (X, Y), 10 fraction
 /// bits, both clamped to the image (width and height at least 2).
-inline std::uint8_t fixedBilinear(const ImageView &img, std::int32_t X, std::int32_t Y)
+inline std::uint32_t fixedBilinear(const ImageView &img, std::int32_t X, std::int32_t Y)
 {
 	const int x0 = std::min(X >> 10, img.width - 2), y0 = std::min(Y >> 10, img.height - 2);
 	const std::uint32_t fx = static_cast<std::uint32_t>(X - (x0 << 10));
@@ -59,7 +59,15 @@ inline std::uint8_t fixedBilinear(const ImageView &img, std::int32_t X, std::int
 	const std::uint8_t *r1 = img.row(y0 + 1) + x0;
 	const std::uint32_t top = r0[0] * (1024 - fx) + r0[1] * fx;
 	const std::uint32_t bot = r1[0] * (1024 - fx) + r1[1] * fx;
-	return static_cast<std::uint8_t>((top * (1024 - fy) + bot * fy + (1u << 19)) >> 20);
+	return top * (1024 - fy) + bot * fy;
+}
+
+/// v as a sample: 8 bits, rounded, or fine (v 2^-20, exact but for the
+/// float's rounding of v).
+inline float fixedSample(std::uint32_t v, bool fine)
+{
+	return fine ? static_cast<float>(static_cast<std::int32_t>(v)) * (1.0f / 1048576.0f)
+		    : static_cast<float>((v + (1u << 19)) >> 20);
 }
 
 } // namespace frappe::detail

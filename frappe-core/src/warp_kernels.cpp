@@ -144,14 +144,14 @@ void WarpSamples(const ImageView &image, const Homography &H, int side, bool ins
 #endif
 }
 
-void WarpFixedSamples(const ImageView &image, const FixedWarp &w, float *out)
+void WarpFixedSamples(const ImageView &image, const FixedWarp &w, bool fine, float *out)
 {
 #if !HWY_ARCH_X86 || HWY_TARGET > HWY_AVX2
 	/* No gathers: as WarpSamples. */
-	warpFixedSamplesScalar(image, w, out);
+	warpFixedSamplesScalar(image, w, fine, out);
 #else
 	if (!offsetsFit(image)) {
-		warpFixedSamplesScalar(image, w, out);
+		warpFixedSamplesScalar(image, w, fine, out);
 		return;
 	}
 	const hn::ScalableTag<std::int32_t> di;
@@ -188,7 +188,8 @@ void WarpFixedSamples(const ImageView &image, const FixedWarp &w, float *out)
 	};
 
 	const auto x0Max = hn::Set(di, image.width - 2), y0Max = hn::Set(di, image.height - 2);
-	const auto one1024 = hn::Set(di, 1024), round = hn::Set(di, 1 << 19);
+	const auto one1024 = hn::Set(di, 1024), round = hn::Set(di, fine ? 0 : 1 << 19);
+	const auto unit = hn::Set(df, 1.0f / 1048576.0f);
 	const int total = side * side;
 	for (int k = 0; k < total; k += N) {
 		const Point lo = point(k), hi = point(k + M);
@@ -200,7 +201,8 @@ void WarpFixedSamples(const ImageView &image, const FixedWarp &w, float *out)
 		const auto top = hn::Add(hn::Mul(p.p00, gx), hn::Mul(p.p01, fx));
 		const auto bottom = hn::Add(hn::Mul(p.p10, gx), hn::Mul(p.p11, fx));
 		const auto v = hn::Add(hn::Add(hn::Mul(top, gy), hn::Mul(bottom, fy)), round);
-		storeSamples(df, hn::ConvertTo(df, hn::ShiftRight<20>(v)), k, total, out);
+		storeSamples(df, fine ? hn::Mul(hn::ConvertTo(df, v), unit) : hn::ConvertTo(df, hn::ShiftRight<20>(v)), k,
+			     total, out);
 	}
 #endif
 }
@@ -231,7 +233,7 @@ void warpSamplesScalar(const ImageView &image, const Homography &H, int side, bo
 	}
 }
 
-void warpFixedSamplesScalar(const ImageView &image, const FixedWarp &w, float *out)
+void warpFixedSamplesScalar(const ImageView &image, const FixedWarp &w, bool fine, float *out)
 {
 	for (int j = 0; j < w.side; ++j) {
 		for (int i = 0; i < w.side; ++i) {
@@ -243,7 +245,7 @@ void warpFixedSamplesScalar(const ImageView &image, const FixedWarp &w, float *o
 			};
 			const std::int32_t X = fixedPosition(quotient(w.x.at(i, j)), w.ox, image.width);
 			const std::int32_t Y = fixedPosition(quotient(w.y.at(i, j)), w.oy, image.height);
-			out[static_cast<std::size_t>(j) * w.side + i] = fixedBilinear(image, X, Y);
+			out[static_cast<std::size_t>(j) * w.side + i] = fixedSample(fixedBilinear(image, X, Y), fine);
 		}
 	}
 }
@@ -251,14 +253,14 @@ void warpFixedSamplesScalar(const ImageView &image, const FixedWarp &w, float *o
 #ifdef FRAPPE_HAVE_HWY
 HWY_EXPORT(WarpFixedSamples);
 
-void warpFixedSamples(const ImageView &image, const FixedWarp &w, float *out)
+void warpFixedSamples(const ImageView &image, const FixedWarp &w, bool fine, float *out)
 {
-	HWY_DYNAMIC_DISPATCH(WarpFixedSamples)(image, w, out);
+	HWY_DYNAMIC_DISPATCH(WarpFixedSamples)(image, w, fine, out);
 }
 #else
 void warpFixedSamples(const ImageView &image, const FixedWarp &w, float *out)
 {
-	warpFixedSamplesScalar(image, w, out);
+	warpFixedSamplesScalar(image, w, fine, out);
 }
 #endif
 

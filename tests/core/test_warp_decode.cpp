@@ -281,6 +281,9 @@ TEST(Warp, VectorFormMatchesTheScalarOne)
 		std::vector<Warped> scalar;
 		for (const Quad &q : quads) {
 			for (int side = 1; side <= CandidateSamples::kMaxSide; ++side) {
+				Warped fine;
+				fine.ok = detail::warpToGridScalar(view, q, side, fine.samples, true);
+				scalar.push_back(fine);
 				Warped s;
 				s.ok = detail::warpToGridScalar(view, q, side, s.samples);
 				/* The float fallback's no-clamp shortcut changes nothing. */
@@ -297,13 +300,16 @@ TEST(Warp, VectorFormMatchesTheScalarOne)
 		onEveryTarget([&](const char *target) {
 			std::size_t n = 0;
 			for (const Quad &q : quads) {
-				for (int side = 1; side <= CandidateSamples::kMaxSide; ++side, ++n) {
-					Warped v;
-					v.ok = detail::warpToGrid(view, q, side, v.samples);
-					ASSERT_TRUE(sameBits(v, scalar[n]))
-						<< target << ", " << size.width << "x" << size.height << " stride " << size.stride
-						<< ", quad " << n / CandidateSamples::kMaxSide << ", side " << side;
-					++compared;
+				for (int side = 1; side <= CandidateSamples::kMaxSide; ++side) {
+					for (const bool fine : { true, false }) {
+						Warped v;
+						v.ok = detail::warpToGrid(view, q, side, v.samples, fine);
+						ASSERT_TRUE(sameBits(v, scalar[n++]))
+							<< target << ", " << size.width << "x" << size.height << " stride "
+							<< size.stride << ", quad " << n / (2 * CandidateSamples::kMaxSide)
+							<< ", side " << side << (fine ? ", fine" : "");
+						++compared;
+					}
 				}
 			}
 		});
@@ -389,13 +395,19 @@ TEST(FixedWarp, ScalarFormIsTheIntegerDefinition)
 				const auto w = quantiseWarp(q, side);
 				if (!w)
 					continue;
-				std::array<float, CandidateSamples::kMaxSide * CandidateSamples::kMaxSide> got;
-				detail::warpFixedSamplesScalar(view, *w, got.data());
-				for (int j = 0; j < side; ++j)
-					for (int i = 0; i < side; ++i)
-						ASSERT_EQ(got[static_cast<std::size_t>(j * side + i)],
-							  static_cast<float>(fixedWarpSample(view, *w, i, j)))
+				std::array<float, CandidateSamples::kMaxSide * CandidateSamples::kMaxSide> got, fine;
+				detail::warpFixedSamplesScalar(view, *w, false, got.data());
+				detail::warpFixedSamplesScalar(view, *w, true, fine.data());
+				for (int j = 0; j < side; ++j) {
+					for (int i = 0; i < side; ++i) {
+						const auto k = static_cast<std::size_t>(j * side + i);
+						ASSERT_EQ(got[k], static_cast<float>(fixedWarpSample(view, *w, i, j)))
 							<< width << "x" << height << " side " << side << " (" << i << "," << j << ")";
+						const std::uint32_t v = fixedWarpValue(view, *w, i, j);
+						ASSERT_EQ(got[k], static_cast<float>((v + (1u << 19)) >> 20));
+						ASSERT_EQ(fine[k], static_cast<float>(v) / 1048576.0f);
+					}
+				}
 				++compared;
 			}
 		}

@@ -17,7 +17,10 @@
 // cell and weight: x0 = min(X >> 10, width - 2), fx = X - x0 2^10 (0 .. 1024);
 // the same for y. Bilinear, exact:
 //   v = (p00 (1024 - fx) + p01 fx) (1024 - fy) + (p10 (1024 - fx) + p11 fx) fy
-// sample = (v + 2^19) >> 20, an integer grey level 0 .. 255.
+// sample = (v + 2^19) >> 20, an integer grey level 0 .. 255 (what the
+// candidate warp and the QPU kernel give), or, for the warps only the CPU
+// runs (the probe's cell centres, warpCellCentres), where sharpening would
+// amplify that rounding, the fine sample v 2^-20 rounded to float.
 // The image must be at least 2 x 2 pixels. Quads the fixed point cannot
 // hold are refused; frappe-core then warps them in float (warpToGrid's one
 // fallback), and so does every backend, through the CPU's warper.
@@ -68,5 +71,7 @@ FRAPPE_EXPORT std::optional<FixedWarp> quantiseWarp(const std::array<Point2f, 4>
 /// grid (a backend computing a wider grid) as long as the forms stay in range
 /// there (0 < D < 2^20).
 FRAPPE_EXPORT std::uint8_t fixedWarpSample(const ImageView &image, const FixedWarp &warp, int i, int j);
+/// v of sample (i, j), 2^20 units a grey level, before any rounding.
+FRAPPE_EXPORT std::uint32_t fixedWarpValue(const ImageView &image, const FixedWarp &warp, int i, int j);
 
 } // namespace frappe
