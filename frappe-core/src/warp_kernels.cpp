@@ -258,7 +258,7 @@ void warpFixedSamples(const ImageView &image, const FixedWarp &w, bool fine, flo
 	HWY_DYNAMIC_DISPATCH(WarpFixedSamples)(image, w, fine, out);
 }
 #else
-void warpFixedSamples(const ImageView &image, const FixedWarp &w, float *out)
+void warpFixedSamples(const ImageView &image, const FixedWarp &w, bool fine, float *out)
 {
 	warpFixedSamplesScalar(image, w, fine, out);
 }
