@@ -149,7 +149,10 @@ void Detector::Impl::refineAndWarpAll(const ImageView &image, Slot &slot, float 
 		batch.refined[k] = 0;
 		if (readBlock(cellSide(corners, dict->bits)) > 1)
 			continue; /* read on a halved frame by finish() */
-		batch.refined[k] = refineQuad(image, slot, slot.quads[k], search, 1);
+		/* What readCandidate() would refine, as it would: the same
+		 * corners whichever way the warp runs. */
+		batch.refined[k] = slot.quads[k].probeRead < whiteFrame() &&
+				   refineQuad(image, slot, slot.quads[k], std::max(search, kSearch), 1);
 		if (batch.refined[k] && bigEnough(corners, config.min_marker_side)) {
 			batch.place[k] = static_cast<int>(batch.quads.size());
 			batch.quads.push_back(corners);

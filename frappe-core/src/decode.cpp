@@ -1,4 +1,6 @@
 // SPDX-License-Identifier: MIT
+// PERSPECTIVE_WARP (the fixed-point warp, its float fallback and the warps
+// built on them) and BINARISE_DECODE.
 #include "decode.h"
 
 #include <algorithm>
@@ -19,9 +21,21 @@ bool warpMarker(const ImageView &image, const std::array<Point2f, 4> &corners, i
 
 namespace {
 
-bool warpWith(void (*sample)(const ImageView &, const Homography &, int, bool, float *), const ImageView &image,
-	      const std::array<Point2f, 4> &corners, int side, WarpedMarker &out)
+using FloatSampler = void (*)(const ImageView &, const Homography &, int, bool, float *);
+using FixedSampler = void (*)(const ImageView &, const FixedWarp &, bool, float *);
+
+/* The warp: the fixed point's (frappe/fixed_warp.h) where it holds the quad,
+ * else the float one, the single fallback every backend shares. */
+bool warpWith(FixedSampler fixed, FloatSampler sample, const ImageView &image,
+	      const std::array<Point2f, 4> &corners, int side, bool fine, WarpedMarker &out)
 {
+	if (image.width >= 2 && image.height >= 2) {
+		if (const auto w = quantiseWarp(corners, side)) {
+			out.side = side;
+			fixed(image, *w, fine, out.samples.data());
+			return true;
+		}
+	}
 	const auto H = Homography::fromUnitSquare(corners);
 	if (!H)
 		return false;
@@ -42,14 +56,16 @@ bool warpWith(void (*sample)(const ImageView &, const Homography &, int, bool, f
 
 } // namespace
 
-bool warpToGrid(const ImageView &image, const std::array<Point2f, 4> &corners, int side, WarpedMarker &out)
+bool warpToGrid(const ImageView &image, const std::array<Point2f, 4> &corners, int side, WarpedMarker &out,
+		bool fine)
 {
-	return warpWith(warpSamples, image, corners, side, out);
+	return warpWith(warpFixedSamples, warpSamples, image, corners, side, fine, out);
 }
 
-bool warpToGridScalar(const ImageView &image, const std::array<Point2f, 4> &corners, int side, WarpedMarker &out)
+bool warpToGridScalar(const ImageView &image, const std::array<Point2f, 4> &corners, int side, WarpedMarker &out,
+		      bool fine)
 {
-	return warpWith(warpSamplesScalar, image, corners, side, out);
+	return warpWith(warpFixedSamplesScalar, warpSamplesScalar, image, corners, side, fine, out);
 }
 
 bool warpCellCentres(const ImageView &image, const std::array<Point2f, 4> &corners, int bits, float sharpening,
@@ -65,7 +81,7 @@ bool warpCellCentres(const ImageView &image, const std::array<Point2f, 4> &corne
 	const std::array<Point2f, 4> grown = { H->map(-m, -m), H->map(1 + m, -m), H->map(1 + m, 1 + m),
 					       H->map(-m, 1 + m) };
 	WarpedMarker grid;
-	if (!warpToGrid(image, grown, side, grid))
+	if (!warpToGrid(image, grown, side, grid, true))
 		return false;
 	out.side = cells;
 	/* The grey level between the black border and the ring around it. */

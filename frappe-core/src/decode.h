@@ -19,12 +19,17 @@ constexpr int kSamplesPerCell = 2;
 /// a cell (16x16 for 6x6 codes).
 using WarpedMarker = CandidateSamples;
 
-/// Warps the quad into `side` x `side` samples (CandidateSamples' grid).
-/// False when the quad is degenerate.
-bool warpToGrid(const ImageView &image, const std::array<Point2f, 4> &corners, int side, WarpedMarker &out);
+/// Warps the quad into `side` x `side` samples (CandidateSamples' grid):
+/// the fixed-point warp of frappe/fixed_warp.h (integer grey levels) where
+/// quantiseWarp() holds the quad, else a float warp (double homography,
+/// float bilinear). `fine`: the fixed point's fine samples, for the warps
+/// only the CPU runs. False when the quad is degenerate.
+bool warpToGrid(const ImageView &image, const std::array<Point2f, 4> &corners, int side, WarpedMarker &out,
+		bool fine = false);
 /// warpToGrid without SIMD, the reference its vectorised sampling is tested
 /// against.
-bool warpToGridScalar(const ImageView &image, const std::array<Point2f, 4> &corners, int side, WarpedMarker &out);
+bool warpToGridScalar(const ImageView &image, const std::array<Point2f, 4> &corners, int side, WarpedMarker &out,
+		      bool fine = false);
 
 /// Warps the quad (clockwise, corners[0] mapped to the grid's top-left) into
 /// the sample grid of a marker with `bits` bits a side. False when the quad

@@ -85,7 +85,7 @@ public:
 		std::array<Point2f, 4> corners;
 		for (int i = 0; i < 4; ++i)
 			corners[i] = toFullResolution(quad.corners[i], scale_);
-		if (!detail::warpToGrid(image_, corners, dict_.bits + 2, cellCentres_))
+		if (!detail::warpToGrid(image_, corners, dict_.bits + 2, cellCentres_, true))
 			return false;
 		const detail::Binarised b = detail::binarise(cellCentres_, dict_.bits);
 		quad.probeRead = b.border_errors;

@@ -1,7 +1,9 @@
 // SPDX-License-Identifier: MIT
-// The perspective warp's sampling (see warp_kernels.h), vectorised with
-// Highway where it is built in, else a plain loop. With Highway the library
-// is built with -ffp-contract=off, so that both forms give the same bits.
+// The perspective warp's sampling (see warp_kernels.h): the fixed-point
+// form and the float fallback, each vectorised with Highway where it is
+// built in, else a plain loop. With Highway the library is built with
+// -ffp-contract=off, so that both float forms give the same bits; the
+// fixed-point forms compute exact integers.
 
 #include "warp_kernels.h"
 
@@ -25,6 +27,62 @@ namespace HWY_NAMESPACE {
 
 namespace hn = hwy::HWY_NAMESPACE;
 
+#if HWY_ARCH_X86 && HWY_TARGET <= HWY_AVX2
+/* Lanes k, k + 1, ... of a side x side grid as (i, j), in doubles. Row
+ * j = floor((k + l + 0.5) / side): that quotient lies at least 1 / (2 side)
+ * from an integer, far beyond the rounding of the product below, so i and j
+ * are exact. */
+template <class DD>
+HWY_INLINE void gridLanes(DD dd, int k, int side, hn::Vec<DD> &i, hn::Vec<DD> &j)
+{
+	const auto kd = hn::Iota(dd, k);
+	j = hn::Floor(hn::Mul(hn::Add(kd, hn::Set(dd, 0.5)), hn::Set(dd, 1.0 / side)));
+	i = hn::Sub(kd, hn::Mul(j, hn::Set(dd, side)));
+}
+
+/* The 2x2 neighbourhoods at (x0, y0), x0 <= width - 2, y0 <= height - 2,
+ * by two 32-bit gathers a lane that take pixels by byte offset (x86: lowest
+ * address in the low byte): row y0 from x0 on (the word's low bytes) and
+ * row y0 + 1 up to x0 + 1 (its high bytes), so that neither word reaches
+ * past the image, whose last row may end the buffer. */
+template <class DI>
+struct Neighbours {
+	hn::Vec<DI> p00, p01, p10, p11;
+};
+template <class DI>
+HWY_INLINE Neighbours<DI> gatherNeighbours(DI di, const ImageView &image, hn::Vec<DI> x0, hn::Vec<DI> y0)
+{
+	const hn::RebindToUnsigned<DI> du;
+	const auto *words = reinterpret_cast<const std::uint32_t *>(image.data);
+	const auto byte = hn::Set(du, 0xFFu);
+	const auto at = hn::Add(hn::Mul(y0, hn::Set(di, image.stride)), x0);
+	const auto above = hn::GatherOffset(du, words, at);
+	const auto below = hn::GatherOffset(du, words, hn::Add(at, hn::Set(di, image.stride - 2)));
+	return { hn::BitCast(di, hn::And(above, byte)), hn::BitCast(di, hn::And(hn::ShiftRight<8>(above), byte)),
+		 hn::BitCast(di, hn::And(hn::ShiftRight<16>(below), byte)), hn::BitCast(di, hn::ShiftRight<24>(below)) };
+}
+
+/* Stores lanes k .. min(k + N, total) - 1 of the grid. */
+template <class DF>
+HWY_INLINE void storeSamples(DF df, hn::Vec<DF> sample, int k, int total, float *out)
+{
+	if (k + static_cast<int>(hn::Lanes(df)) <= total) {
+		hn::StoreU(sample, df, out + k);
+	} else {
+		HWY_ALIGN float lanes[HWY_MAX_BYTES / sizeof(float)];
+		hn::Store(sample, df, lanes);
+		std::copy(lanes, lanes + (total - k), out + k);
+	}
+}
+
+/* Images too large for 32-bit byte offsets go the scalar way. */
+inline bool offsetsFit(const ImageView &image)
+{
+	const std::int64_t bytes = static_cast<std::int64_t>(image.height - 1) * image.stride + image.width;
+	return bytes <= std::numeric_limits<std::int32_t>::max();
+}
+#endif
+
 void WarpSamples(const ImageView &image, const Homography &H, int side, bool inside, float *out)
 {
 #if !HWY_ARCH_X86 || HWY_TARGET > HWY_AVX2
@@ -33,36 +91,25 @@ void WarpSamples(const ImageView &image, const Homography &H, int side, bool ins
 	 * the scalar one, on SSSE3 twice as slow. */
 	warpSamplesScalar(image, H, side, inside, out);
 #else
-	/* The gathers below take pixels from 32-bit words by their byte
-	 * offset (x86: lowest address in the low byte); images too small for
-	 * a 2x2 neighbourhood, or too large for such offsets, go the scalar
-	 * way. */
-	const std::int64_t bytes = static_cast<std::int64_t>(image.height - 1) * image.stride + image.width;
-	if (image.width < 2 || image.height < 2 || bytes > std::numeric_limits<std::int32_t>::max()) {
+	if (image.width < 2 || image.height < 2 || !offsetsFit(image)) {
 		warpSamplesScalar(image, H, side, inside, out);
 		return;
 	}
 	const hn::ScalableTag<float> df;
 	const hn::RebindToSigned<decltype(df)> di;
-	const hn::RebindToUnsigned<decltype(df)> du;
 	const hn::Half<decltype(df)> dh;
 	const hn::Repartition<double, decltype(df)> dd;
 	const int N = static_cast<int>(hn::Lanes(df)), M = static_cast<int>(hn::Lanes(dd));
 
 	const auto &h = H.h;
-	const double step = 1.0 / side;
-	const auto vStep = hn::Set(dd, step), vSide = hn::Set(dd, side), half = hn::Set(dd, 0.5);
+	const auto vStep = hn::Set(dd, 1.0 / side), half = hn::Set(dd, 0.5);
 	struct Point {
 		hn::Vec<decltype(dh)> x, y;
 	};
-	/* Lane l is sample k + l, in row j = floor((k + l + 0.5) / side): that
-	 * quotient lies at least 1 / (2 side) from an integer, far beyond the
-	 * rounding of the product below, so j and i are exact and u, v are
-	 * the scalar form's. */
+	/* u, v are the scalar form's (gridLanes is exact). */
 	auto point = [&](int k) HWY_ATTR {
-		const auto kd = hn::Iota(dd, k);
-		const auto j = hn::Floor(hn::Mul(hn::Add(kd, half), vStep));
-		const auto i = hn::Sub(kd, hn::Mul(j, vSide));
+		hn::Vec<decltype(dd)> i, j;
+		gridLanes(dd, k, side, i, j);
 		const auto u = hn::Mul(hn::Add(i, half), vStep), v = hn::Mul(hn::Add(j, half), vStep);
 		auto line = [&](int row) HWY_ATTR {
 			const auto c = hn::Add(hn::Mul(hn::Set(dd, h[3 * row + 1]), v), hn::Set(dd, h[3 * row + 2]));
@@ -76,10 +123,6 @@ void WarpSamples(const ImageView &image, const Homography &H, int side, bool ins
 	const auto xMax = hn::Set(df, static_cast<float>(image.width - 1));
 	const auto yMax = hn::Set(df, static_cast<float>(image.height - 1));
 	const auto x0Max = hn::Set(di, image.width - 2), y0Max = hn::Set(di, image.height - 2);
-	const auto stride = hn::Set(di, image.stride), nextRowLeft2 = hn::Set(di, image.stride - 2);
-	const auto byte = hn::Set(du, 0xFFu);
-	const auto *words = reinterpret_cast<const std::uint32_t *>(image.data);
-	auto toFloat = [&](hn::Vec<decltype(du)> v) HWY_ATTR { return hn::ConvertTo(df, hn::BitCast(di, v)); };
 
 	const int total = side * side;
 	for (int k = 0; k < total; k += N) {
@@ -91,24 +134,75 @@ void WarpSamples(const ImageView &image, const Homography &H, int side, bool ins
 		y = hn::IfThenElseZero(hn::Ge(y, zero), hn::Min(y, yMax));
 		const auto x0 = hn::Min(hn::ConvertTo(di, x), x0Max), y0 = hn::Min(hn::ConvertTo(di, y), y0Max);
 		const auto fx = hn::Sub(x, hn::ConvertTo(df, x0)), fy = hn::Sub(y, hn::ConvertTo(df, y0));
-		/* Row y0 from x0 on (the word's low bytes) and row y0 + 1 up to
-		 * x0 + 1 (its high bytes): neither word reaches past the image,
-		 * whose last row may end the buffer. */
-		const auto at = hn::Add(hn::Mul(y0, stride), x0);
-		const auto above = hn::GatherOffset(du, words, at);
-		const auto below = hn::GatherOffset(du, words, hn::Add(at, nextRowLeft2));
-		const auto p00 = toFloat(hn::And(above, byte)), p01 = toFloat(hn::And(hn::ShiftRight<8>(above), byte));
-		const auto p10 = toFloat(hn::And(hn::ShiftRight<16>(below), byte)), p11 = toFloat(hn::ShiftRight<24>(below));
+		const auto p = gatherNeighbours(di, image, x0, y0);
+		const auto p00 = hn::ConvertTo(df, p.p00), p01 = hn::ConvertTo(df, p.p01);
+		const auto p10 = hn::ConvertTo(df, p.p10), p11 = hn::ConvertTo(df, p.p11);
 		const auto top = hn::Add(p00, hn::Mul(fx, hn::Sub(p01, p00)));
 		const auto bottom = hn::Add(p10, hn::Mul(fx, hn::Sub(p11, p10)));
-		const auto sample = hn::Add(top, hn::Mul(fy, hn::Sub(bottom, top)));
-		if (k + N <= total) {
-			hn::StoreU(sample, df, out + k);
-		} else {
-			HWY_ALIGN float lanes[HWY_MAX_BYTES / sizeof(float)];
-			hn::Store(sample, df, lanes);
-			std::copy(lanes, lanes + (total - k), out + k);
-		}
+		storeSamples(df, hn::Add(top, hn::Mul(fy, hn::Sub(bottom, top))), k, total, out);
+	}
+#endif
+}
+
+void WarpFixedSamples(const ImageView &image, const FixedWarp &w, bool fine, float *out)
+{
+#if !HWY_ARCH_X86 || HWY_TARGET > HWY_AVX2
+	/* No gathers: as WarpSamples. */
+	warpFixedSamplesScalar(image, w, fine, out);
+#else
+	if (!offsetsFit(image)) {
+		warpFixedSamplesScalar(image, w, fine, out);
+		return;
+	}
+	const hn::ScalableTag<std::int32_t> di;
+	const hn::RebindToFloat<decltype(di)> df;
+	const hn::Repartition<double, decltype(di)> dd;
+	const hn::Rebind<std::int32_t, decltype(dd)> dh; /* half of di */
+	const int N = static_cast<int>(hn::Lanes(di)), M = static_cast<int>(hn::Lanes(dd));
+	const int side = w.side;
+
+	using VD = hn::Vec<decltype(dd)>;
+	const auto zero = hn::Zero(dd), one = hn::Set(dd, 1.0), k1024 = hn::Set(dd, 1024.0), k2048 = hn::Set(dd, 2048.0);
+	const auto xMax = hn::Set(dd, 1024.0 * (image.width - 1)), yMax = hn::Set(dd, 1024.0 * (image.height - 1));
+	const auto xOrigin = hn::Set(dd, 1024.0 * w.ox), yOrigin = hn::Set(dd, 1024.0 * w.oy);
+	auto form = [&](const FixedWarpForm &f, VD i, VD j) HWY_ATTR {
+		return hn::Add(hn::Add(hn::Set(dd, f.at00), hn::Mul(hn::Set(dd, f.di), i)), hn::Mul(hn::Set(dd, f.dj), j));
+	};
+	/* The contract's position in double, where every value is an exact
+	 * integer and the quotient's floor exact (warpFixedSamplesScalar).
+	 * The clamp also takes the lanes past the grid, whose forms may be out
+	 * of range (NaN included), into the image. */
+	auto position = [&](VD n, VD d, VD origin, VD max) HWY_ATTR {
+		const auto nc = hn::Min(hn::Max(n, zero), hn::Sub(hn::Mul(d, k2048), one));
+		const auto p = hn::Add(origin, hn::Floor(hn::Div(hn::Mul(nc, k1024), d)));
+		return hn::DemoteTo(dh, hn::IfThenElseZero(hn::Ge(p, zero), hn::Min(p, max)));
+	};
+	struct Point {
+		hn::Vec<decltype(dh)> x, y;
+	};
+	auto point = [&](int k) HWY_ATTR {
+		VD i, j;
+		gridLanes(dd, k, side, i, j);
+		const auto d = form(w.d, i, j);
+		return Point{ position(form(w.x, i, j), d, xOrigin, xMax), position(form(w.y, i, j), d, yOrigin, yMax) };
+	};
+
+	const auto x0Max = hn::Set(di, image.width - 2), y0Max = hn::Set(di, image.height - 2);
+	const auto one1024 = hn::Set(di, 1024), round = hn::Set(di, fine ? 0 : 1 << 19);
+	const auto unit = hn::Set(df, 1.0f / 1048576.0f);
+	const int total = side * side;
+	for (int k = 0; k < total; k += N) {
+		const Point lo = point(k), hi = point(k + M);
+		const auto X = hn::Combine(di, hi.x, lo.x), Y = hn::Combine(di, hi.y, lo.y);
+		const auto x0 = hn::Min(hn::ShiftRight<10>(X), x0Max), y0 = hn::Min(hn::ShiftRight<10>(Y), y0Max);
+		const auto fx = hn::Sub(X, hn::ShiftLeft<10>(x0)), fy = hn::Sub(Y, hn::ShiftLeft<10>(y0));
+		const auto p = gatherNeighbours(di, image, x0, y0);
+		const auto gx = hn::Sub(one1024, fx), gy = hn::Sub(one1024, fy);
+		const auto top = hn::Add(hn::Mul(p.p00, gx), hn::Mul(p.p01, fx));
+		const auto bottom = hn::Add(hn::Mul(p.p10, gx), hn::Mul(p.p11, fx));
+		const auto v = hn::Add(hn::Add(hn::Mul(top, gy), hn::Mul(bottom, fy)), round);
+		storeSamples(df, fine ? hn::Mul(hn::ConvertTo(df, v), unit) : hn::ConvertTo(df, hn::ShiftRight<20>(v)), k,
+			     total, out);
 	}
 #endif
 }
@@ -138,6 +232,37 @@ void warpSamplesScalar(const ImageView &image, const Homography &H, int side, bo
 		}
 	}
 }
+
+void warpFixedSamplesScalar(const ImageView &image, const FixedWarp &w, bool fine, float *out)
+{
+	for (int j = 0; j < w.side; ++j) {
+		for (int i = 0; i < w.side; ++i) {
+			const std::int64_t d = w.d.at(i, j);
+			auto quotient = [d](std::int64_t n) {
+				const std::int64_t nc = std::clamp<std::int64_t>(n, 0, (d << kFixedWarpIntBits) - 1);
+				return static_cast<std::int64_t>(static_cast<double>(nc << kFixedWarpFracBits) /
+								 static_cast<double>(d));
+			};
+			const std::int32_t X = fixedPosition(quotient(w.x.at(i, j)), w.ox, image.width);
+			const std::int32_t Y = fixedPosition(quotient(w.y.at(i, j)), w.oy, image.height);
+			out[static_cast<std::size_t>(j) * w.side + i] = fixedSample(fixedBilinear(image, X, Y), fine);
+		}
+	}
+}
+
+#ifdef FRAPPE_HAVE_HWY
+HWY_EXPORT(WarpFixedSamples);
+
+void warpFixedSamples(const ImageView &image, const FixedWarp &w, bool fine, float *out)
+{
+	HWY_DYNAMIC_DISPATCH(WarpFixedSamples)(image, w, fine, out);
+}
+#else
+void warpFixedSamples(const ImageView &image, const FixedWarp &w, bool fine, float *out)
+{
+	warpFixedSamplesScalar(image, w, fine, out);
+}
+#endif
 
 #ifdef FRAPPE_HAVE_HWY
 HWY_EXPORT(WarpSamples);

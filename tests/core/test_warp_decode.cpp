@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
-// Homographies, the perspective warp and binarisation on known inputs, and
-// the vectorised warp against the scalar one on every Highway target.
+// Homographies, the perspective warp and binarisation on known inputs, the
+// fixed-point warp's scalar form against its integer definition, and the
+// vectorised warp against the scalar one on every Highway target.
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -16,6 +17,7 @@
 
 #include "decode.h"
 #include "every_target.h"
+#include "frappe/fixed_warp.h"
 #include "frappe/frappe.h"
 #include "frappe/homography.h"
 #include "frappe/render.h"
@@ -279,10 +281,13 @@ TEST(Warp, VectorFormMatchesTheScalarOne)
 		std::vector<Warped> scalar;
 		for (const Quad &q : quads) {
 			for (int side = 1; side <= CandidateSamples::kMaxSide; ++side) {
+				Warped fine;
+				fine.ok = detail::warpToGridScalar(view, q, side, fine.samples, true);
+				scalar.push_back(fine);
 				Warped s;
 				s.ok = detail::warpToGridScalar(view, q, side, s.samples);
-				/* The no-clamp shortcut changes nothing. */
-				if (s.ok) {
+				/* The float fallback's no-clamp shortcut changes nothing. */
+				if (s.ok && !quantiseWarp(q, side)) {
 					Warped clamped{ true, {} };
 					clamped.samples.side = side;
 					detail::warpSamplesScalar(view, *Homography::fromUnitSquare(q), side, false,
@@ -295,16 +300,117 @@ TEST(Warp, VectorFormMatchesTheScalarOne)
 		onEveryTarget([&](const char *target) {
 			std::size_t n = 0;
 			for (const Quad &q : quads) {
-				for (int side = 1; side <= CandidateSamples::kMaxSide; ++side, ++n) {
-					Warped v;
-					v.ok = detail::warpToGrid(view, q, side, v.samples);
-					ASSERT_TRUE(sameBits(v, scalar[n]))
-						<< target << ", " << size.width << "x" << size.height << " stride " << size.stride
-						<< ", quad " << n / CandidateSamples::kMaxSide << ", side " << side;
-					++compared;
+				for (int side = 1; side <= CandidateSamples::kMaxSide; ++side) {
+					for (const bool fine : { true, false }) {
+						Warped v;
+						v.ok = detail::warpToGrid(view, q, side, v.samples, fine);
+						ASSERT_TRUE(sameBits(v, scalar[n++]))
+							<< target << ", " << size.width << "x" << size.height << " stride "
+							<< size.stride << ", quad " << n / (2 * CandidateSamples::kMaxSide)
+							<< ", side " << side << (fine ? ", fine" : "");
+						++compared;
+					}
 				}
 			}
 		});
 	}
 	EXPECT_GT(compared, 10000);
+}
+
+/* The fixed-point warp on known geometry: an outline 32 px a side starting
+ * half a sample before pixel (a, b) puts sample (i, j) on pixel
+ * (a + 2i, b + 2j), weights 0; shifted by half a pixel, every sample lies
+ * midway between two pixels: their mean rounded half up. */
+TEST(FixedWarp, PixelCentresAndHalfPixels)
+{
+	std::mt19937 rng(3);
+	const GuardedImage image(80, 60, 83, rng);
+	const ImageView v = image.view();
+	for (const float a : { 7.0f, 7.5f }) {
+		const float b = 5;
+		const std::array<Point2f, 4> q = { Point2f{ a - 1, b - 1 }, { a + 31, b - 1 }, { a + 31, b + 31 },
+						   { a - 1, b + 31 } };
+		const auto w = quantiseWarp(q, 16);
+		ASSERT_TRUE(w);
+		EXPECT_EQ(w->d.di, 0);
+		EXPECT_EQ(w->d.dj, 0);
+		detail::WarpedMarker out;
+		ASSERT_TRUE(detail::warpToGrid(v, q, 16, out));
+		for (int j = 0; j < 16; ++j) {
+			for (int i = 0; i < 16; ++i) {
+				const int l = v.at(7 + 2 * i, 5 + 2 * j), r = v.at(8 + 2 * i, 5 + 2 * j);
+				const int want = a == 7.0f ? l : (l + r + 1) / 2;
+				ASSERT_EQ(fixedWarpSample(v, *w, i, j), want) << a << ": " << i << "," << j;
+				ASSERT_EQ(out.at(i, j), static_cast<float>(want)) << a << ": " << i << "," << j;
+			}
+		}
+	}
+}
+
+TEST(FixedWarp, RefusesWhatTheFixedPointCannotHoldAndSaysWhy)
+{
+	const char *why = nullptr;
+	const std::array<Point2f, 4> line = { Point2f{ 0, 0 }, { 10, 0 }, { 20, 0 }, { 30, 0 } };
+	EXPECT_FALSE(quantiseWarp(line, 16, &why));
+	EXPECT_STREQ(why, "degenerate quad");
+	const std::array<Point2f, 4> huge = { Point2f{ 0, 0 }, { 3000, 0 }, { 3000, 3000 }, { 0, 3000 } };
+	EXPECT_FALSE(quantiseWarp(huge, 16, &why));
+	EXPECT_STREQ(why, "quad wider than 2046 pixels");
+	const std::array<Point2f, 4> fine = { Point2f{ 0, 0 }, { 2000, 0 }, { 2000, 2000 }, { 0, 2000 } };
+	for (int side : { 1, 16, 20 })
+		EXPECT_TRUE(quantiseWarp(fine, side)) << side;
+	EXPECT_FALSE(quantiseWarp(fine, 21, &why));
+	EXPECT_STREQ(why, "grid side out of range");
+	EXPECT_FALSE(quantiseWarp(fine, 0, &why));
+	/* A bow tie: the line at infinity crosses the sample grid. */
+	const std::array<Point2f, 4> bowtie = { Point2f{ 0, 0 }, { 100, 0 }, { 0, 100 }, { 100, 100 } };
+	EXPECT_FALSE(quantiseWarp(bowtie, 16, &why));
+	EXPECT_STREQ(why, "the sample grid reaches the horizon");
+	/* Refused quads still warp, in float: exactly the float sampler. */
+	const std::array<Point2f, 4> big = { Point2f{ -900, -900 }, { 1700, -1000 }, { 1800, 1500 }, { -1000, 1400 } };
+	EXPECT_FALSE(quantiseWarp(big, 16));
+	Image img(120, 90, 0);
+	for (int y = 0; y < 90; ++y)
+		for (int x = 0; x < 120; ++x)
+			img.at(x, y) = static_cast<std::uint8_t>((7 * x + 13 * y) % 251);
+	detail::WarpedMarker got, want;
+	ASSERT_TRUE(detail::warpToGrid(img.view(), big, 16, got));
+	want.side = 16;
+	detail::warpSamplesScalar(img.view(), *Homography::fromUnitSquare(big), 16, false, want.samples.data());
+	EXPECT_EQ(0, std::memcmp(got.samples.data(), want.samples.data(), 256 * sizeof(float)));
+}
+
+/* The scalar form (double divisions) against the definition (64-bit integer
+ * divisions) on every quad the fixed point takes and every grid side. */
+TEST(FixedWarp, ScalarFormIsTheIntegerDefinition)
+{
+	std::mt19937 rng(17);
+	int compared = 0;
+	for (const auto &[width, height, stride] : { std::array{ 2, 2, 2 }, { 3, 7, 3 }, { 101, 67, 103 },
+						     { 640, 480, 672 }, { 1900, 1200, 1900 } }) {
+		const GuardedImage image(width, height, stride, rng);
+		const ImageView view = image.view();
+		for (const Quad &q : makeQuads(width, height, rng)) {
+			for (int side = 1; side <= CandidateSamples::kMaxSide; ++side) {
+				const auto w = quantiseWarp(q, side);
+				if (!w)
+					continue;
+				std::array<float, CandidateSamples::kMaxSide * CandidateSamples::kMaxSide> got, fine;
+				detail::warpFixedSamplesScalar(view, *w, false, got.data());
+				detail::warpFixedSamplesScalar(view, *w, true, fine.data());
+				for (int j = 0; j < side; ++j) {
+					for (int i = 0; i < side; ++i) {
+						const auto k = static_cast<std::size_t>(j * side + i);
+						ASSERT_EQ(got[k], static_cast<float>(fixedWarpSample(view, *w, i, j)))
+							<< width << "x" << height << " side " << side << " (" << i << "," << j << ")";
+						const std::uint32_t v = fixedWarpValue(view, *w, i, j);
+						ASSERT_EQ(got[k], static_cast<float>((v + (1u << 19)) >> 20));
+						ASSERT_EQ(fine[k], static_cast<float>(v) / 1048576.0f);
+					}
+				}
+				++compared;
+			}
+		}
+	}
+	EXPECT_GT(compared, 2000);
 }

@@ -37,7 +37,11 @@ public:
 			  std::span<CandidateSamples> out, std::span<std::uint8_t> ok) = 0;
 };
 
-/// The CPU's warp (double-precision homography, bilinear samples in float).
+/// The CPU's warp: frappe/fixed_warp.h's samples where quantiseWarp() holds
+/// the quad, else the float fallback (double-precision homography, bilinear
+/// samples in float). Every warper must give its samples bit for bit: a
+/// backend's own warp implements fixed_warp.h exactly and sends the quads
+/// it cannot take here.
 FRAPPE_EXPORT std::unique_ptr<CandidateWarper> makeCpuWarper();
 
 } // namespace frappe

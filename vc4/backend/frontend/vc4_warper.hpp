@@ -2,11 +2,12 @@
 // frappe::CandidateWarper on the VideoCore IV QPUs: PERSPECTIVE_WARP of a frame's
 // candidates, up to 32 a launch (kernels/warp.hpp), on the real GPU or the emulator.
 //
-// The kernel is exact integer arithmetic (kernels/warp_reference.hpp), not frappe-core's
-// float warp: samples differ from the CPU's by at most 0.8 grey levels, so a cell whose
-// mean lies that close to the binarisation threshold can read differently. Candidates the
-// fixed point cannot hold (warpParams() refuses them) and codes wider than 6x6 (more than
-// 16 samples a side) are warped on the CPU.
+// The kernel implements frappe-core's fixed-point warp (frappe/fixed_warp.h) exactly, so
+// its samples are the CPU warper's bit for bit. Candidates it cannot take (the fixed
+// point refuses them, or their forms leave its ranges on the kernel's 16 x 16 grid: see
+// kernels::warpParams()) and codes wider than 6x6 (more than 16 samples a side) go to
+// frappe::makeCpuWarper(), which warps them by the same definition or its one float
+// fallback.
 #pragma once
 
 #include <memory>
