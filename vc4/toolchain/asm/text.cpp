@@ -4,6 +4,7 @@
 #include <array>
 #include <bit>
 #include <cctype>
+#include <cerrno>
 #include <cstdlib>
 #include <map>
 #include <optional>
@@ -516,12 +517,30 @@ uint64_t parseAlu(const Line &line, const std::vector<std::string> &segments)
 	return encode(alu);
 }
 
+// 32-bit units of one value of a data directive: ".int" 1, ".long" 2, not data 0.
+int dataUnits(const std::string &line)
+{
+	const std::string head = line.substr(0, line.find_first_of(" \t"));
+	return head == ".int" ? 1 : head == ".long" ? 2 : 0;
+}
+
+uint64_t parseData(const Line &line, const std::string &s, int units)
+{
+	char *end = nullptr;
+	errno = 0;
+	const unsigned long long v = std::strtoull(s.c_str(), &end, 0);
+	if (s.empty() || *end != '\0' || s[0] == '-' || errno || (units == 1 && v > 0xffffffffull))
+		line.fail("bad " + std::string(units == 1 ? ".int" : ".long") + " value '" + s + "'");
+	return v;
+}
+
 } // namespace
 
 std::vector<uint64_t> assembleText(const std::string &text)
 {
-	// Two passes: labels first. Addresses count 32-bit units so that ".long" data can
-	// hold any number of words; instructions and labels must sit on 64-bit boundaries.
+	// Two passes: labels first. Addresses count 32-bit units so that data (".int" 32
+	// bits, ".long" 64 bits as in vc4asm) can hold any number of words; instructions and
+	// labels must sit on 64-bit boundaries.
 	struct Entry {
 		int number;
 		std::string text;
@@ -540,18 +559,18 @@ std::vector<uint64_t> assembleText(const std::string &text)
 			const std::string l = trim(raw);
 			if (l.empty())
 				continue;
-			const bool data = l.rfind(".long", 0) == 0;
+			const int data = dataUnits(l);
 			if (!data && units % 2)
-				Line(number).fail("instruction or label after an odd number of .long words");
+				Line(number).fail("instruction or label after an odd number of .int words");
 			if (l[0] == ':') {
 				labels[l.substr(1)] = units * 4;
 				continue;
 			}
-			units += data ? static_cast<uint32_t>(split(l.substr(5), ',').size()) : 2;
+			units += data ? static_cast<uint32_t>(data * split(l.substr(l.find_first_of(" \t") + 1), ',').size()) : 2;
 			lines.push_back({number, l});
 		}
 		if (units % 2)
-			Line(number).fail("odd number of .long words at the end");
+			Line(number).fail("odd number of .int words at the end");
 	}
 	std::vector<uint64_t> code;
 	std::vector<uint32_t> data;
@@ -562,9 +581,13 @@ std::vector<uint64_t> assembleText(const std::string &text)
 		const std::string op = dotted(head)[0];
 		const auto address = static_cast<uint32_t>(code.size() * 8);
 		const std::string rest = space == std::string::npos ? "" : trim(l.substr(space + 1));
-		if (head == ".long") {
-			for (const auto &v : split(rest, ','))
-				data.push_back(parseNumber(line, v));
+		if (const int units = dataUnits(l)) {
+			for (const auto &v : split(rest, ',')) {
+				const uint64_t value = parseData(line, v, units);
+				data.push_back(static_cast<uint32_t>(value));
+				if (units == 2)
+					data.push_back(static_cast<uint32_t>(value >> 32));
+			}
 			for (; data.size() >= 2; data.erase(data.begin(), data.begin() + 2))
 				code.push_back(uint64_t{data[0]} | uint64_t{data[1]} << 32);
 		} else if (op == "bra" || op == "brr") {

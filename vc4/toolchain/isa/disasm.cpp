@@ -439,9 +439,11 @@ std::string instructionText(const Instr &instr, const std::string &label)
 	return branchText(std::get<Branch>(instr), label);
 }
 
-std::string longText(uint64_t word)
+// Two 32-bit data words, low first: ".int" is 32 bits in every vc4asm version, while
+// ".long" became 64 bits (directive table of Parser.tables.cpp).
+std::string dataText(uint64_t word)
 {
-	return format(".long 0x%08x, 0x%08x", static_cast<uint32_t>(word),
+	return format(".int 0x%08x, 0x%08x", static_cast<uint32_t>(word),
 	              static_cast<uint32_t>(word >> 32));
 }
 
@@ -472,7 +474,7 @@ bool printsAsInstruction(uint64_t word)
 std::string disassemble(uint64_t word)
 {
 	if (!printsAsInstruction(word))
-		return longText(word);
+		return dataText(word);
 	return instructionText(decode(word), {});
 }
 
@@ -505,7 +507,7 @@ std::string disassembleProgram(std::span<const uint64_t> words, bool with_commen
 				label = "r:" + it->second;
 		}
 		const bool as_instruction = printsAsInstruction(words[n]);
-		const std::string text = as_instruction ? instructionText(instr, label) : longText(words[n]);
+		const std::string text = as_instruction ? instructionText(instr, label) : dataText(words[n]);
 		if (!with_comments) {
 			out << '\t' << text << '\n';
 			continue;

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// The disassembler on hand-built words of real binaries: data words stay ".long", both
+// The disassembler on hand-built words of real binaries: data words stay data (".int"), both
 // link registers of a branch are printed, register reads no ALU input uses are kept
 // ("read"), the ADD ALU's v8adds/v8subs are "av8adds"/"av8subs", and forms vc4asm would
 // rewrite are kept as data. Every listing reads back to the same words.
@@ -8,6 +8,7 @@
 #include <random>
 #include <vector>
 
+#include "asm/assembler.hpp"
 #include "asm/text.hpp"
 #include "isa/disasm.hpp"
 #include "isa/instr.hpp"
@@ -32,20 +33,24 @@ std::string listing(const std::vector<uint64_t> &code) { return isa::disassemble
 
 } // namespace
 
-TEST(DisassemblerData, WordsThatAreNotInstructionsPrintAsLong)
+TEST(DisassemblerData, WordsThatAreNotInstructionsPrintAsData)
 {
 	// The start of a shader's data: counts and float constants, which decode as
-	// instructions whose fields the text cannot carry (waddr 0 of an idle ADD ALU, a
-	// reserved op code, a branch with its unused bits set).
+	// instructions whose fields the text cannot carry (an idle ADD ALU writing ra0, a
+	// MUL pack vc4asm cannot encode, a branch with its unused bits set).
 	const std::vector<uint64_t> code = {
-		word(0x00000025, 0x00000000), word(0x3f800000, 0x40000000),
+		word(0x00000025, 0x00000000), word(0x3f800000, 0x3f800000),
 		word(0xdeadbeef, 0xf1234567), isa::kNopWord,
 	};
 	EXPECT_EQ(listing(code),
-	          "\t.long 0x00000025, 0x00000000\n"
-	          "\t.long 0x3f800000, 0x40000000\n"
-	          "\t.long 0xdeadbeef, 0xf1234567\n"
+	          "\t.int 0x00000025, 0x00000000\n"
+	          "\t.int 0x3f800000, 0x3f800000\n"
+	          "\t.int 0xdeadbeef, 0xf1234567\n"
 	          "\tnop\n");
+	// Data that happens to be an instruction vc4asm re-creates prints as that
+	// instruction: the words are the same either way.
+	EXPECT_EQ(isa::disassemble(word(0x3f800000, 0x40000000)),
+	          "av8subs.never ra0, r0, r0; fmul.never rb0, r0, r0; read ra32; read rb0; sbwait");
 	EXPECT_EQ(qasm::assembleText(listing(code)), code);
 	// With comments a data word still shows what its bits would mean.
 	const std::string commented = isa::disassembleProgram(code, true);
@@ -62,14 +67,15 @@ TEST(DisassemblerData, LabelsAfterDataKeepTheirAddresses)
 		word(1, 2), word(3, 4), word(5, 6), isa::encode(b), isa::kNopWord, isa::kNopWord, isa::kNopWord,
 	};
 	EXPECT_EQ(listing(code),
-	          "\t.long 0x00000001, 0x00000002\n\t.long 0x00000003, 0x00000004\n"
-	          "\t.long 0x00000005, 0x00000006\n:L18\n\tbrr -, r:L18\n\tnop\n\tnop\n\tnop\n");
+	          "\t.int 0x00000001, 0x00000002\n\t.int 0x00000003, 0x00000004\n"
+	          "\t.int 0x00000005, 0x00000006\n:L18\n\tbrr -, r:L18\n\tnop\n\tnop\n\tnop\n");
 	EXPECT_EQ(qasm::assembleText(listing(code)), code);
-	// vc4asm's other spellings of data: single words, several a line.
-	EXPECT_EQ(qasm::assembleText(".long 1\n.long 2\n.long 3, 4, 5, 6\nnop\n"),
-	          (std::vector<uint64_t>{word(1, 2), word(3, 4), word(5, 6), isa::kNopWord}));
-	EXPECT_THROW(qasm::assembleText(".long 1\nnop\n"), qasm::AsmError);
-	EXPECT_THROW(qasm::assembleText("nop\n.long 7\n"), qasm::AsmError);
+	// vc4asm's other spellings of data: single words, several a line, 64-bit ".long".
+	EXPECT_EQ(qasm::assembleText(".int 1\n.int 2\n.int 3, 4, 5, 6\n.long 0x800000070000000a\nnop\n"),
+	          (std::vector<uint64_t>{word(1, 2), word(3, 4), word(5, 6), word(10, 0x80000007), isa::kNopWord}));
+	EXPECT_THROW(qasm::assembleText(".int 1\nnop\n"), qasm::AsmError);
+	EXPECT_THROW(qasm::assembleText("nop\n.int 7\n"), qasm::AsmError);
+	EXPECT_THROW(qasm::assembleText(".int 0x100000000, 0\n"), qasm::AsmError);
 }
 
 TEST(DisassemblerBranch, BothLinkRegistersArePrinted)
@@ -184,19 +190,19 @@ TEST(DisassemblerOps, AddAndMulOpsWithTheSameNameAreDistinguished)
 TEST(DisassemblerCanonical, FormsVc4asmRewritesStayData)
 {
 	// "sub r0, r1, r1" alone: vc4asm stores "ldi r0, 0".
-	EXPECT_EQ(isa::disassemble(word(0x0d9e7240, 0x10020827)), ".long 0x0d9e7240, 0x10020827");
+	EXPECT_EQ(isa::disassemble(word(0x0d9e7240, 0x10020827)), ".int 0x0d9e7240, 0x10020827");
 	// The same reading a register (vc4asm keeps it): printed.
 	EXPECT_EQ(isa::disassemble(word(0x0d0e7d80, 0x10020827)), "sub r0, ra3, ra3");
 	// A destination "-" with cond always and no setf: vc4asm writes cond never.
-	EXPECT_EQ(isa::disassemble(word(0x159e7000, 0x100209e7)), ".long 0x159e7000, 0x100209e7");
+	EXPECT_EQ(isa::disassemble(word(0x159e7000, 0x100209e7)), ".int 0x159e7000, 0x100209e7");
 	EXPECT_EQ(isa::disassemble(word(0x159e7000, 0x100009e7)), "or.never -, r0, r0");
 	// A unary op's unused second input other than r0.
-	EXPECT_EQ(isa::disassemble(word(0x179e7240, 0x10020827)), ".long 0x179e7240, 0x10020827");
+	EXPECT_EQ(isa::disassemble(word(0x179e7240, 0x10020827)), ".int 0x179e7240, 0x10020827");
 	EXPECT_EQ(isa::disassemble(word(0x179e7200, 0x10020827)), "not r0, r1");
 	// An idle MUL ALU with inputs, a reserved ADD op, a MUL pack vc4asm cannot encode.
-	EXPECT_EQ(isa::disassemble(word(0x009e7001, 0x100009e7)), ".long 0x009e7001, 0x100009e7");
-	EXPECT_EQ(isa::disassemble(word(0x099e7240, 0x10020827)), ".long 0x099e7240, 0x10020827");
-	EXPECT_EQ(isa::disassemble(word(0x209e7009, 0x118049e0)), ".long 0x209e7009, 0x118049e0");
+	EXPECT_EQ(isa::disassemble(word(0x009e7001, 0x100009e7)), ".int 0x009e7001, 0x100009e7");
+	EXPECT_EQ(isa::disassemble(word(0x099e7240, 0x10020827)), ".int 0x099e7240, 0x10020827");
+	EXPECT_EQ(isa::disassemble(word(0x209e7009, 0x118049e0)), ".int 0x209e7009, 0x118049e0");
 	EXPECT_EQ(isa::disassemble(word(0x209e7009, 0x117049e0)), "nop; fmul r0.8d, r1, r1");
 }
 
