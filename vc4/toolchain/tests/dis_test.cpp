@@ -156,33 +156,31 @@ TEST(DisassemblerReads, PeripheralReadsNoInputUsesAreKept)
 
 TEST(DisassemblerOps, AddAndMulOpsWithTheSameNameAreDistinguished)
 {
-	isa::Alu alu;
-	alu.cond_add = isa::Cond::Always;
-	alu.waddr_add = isa::waddr::r0;
-	alu.add_a = Mux::R1;
-	alu.add_b = Mux::R2;
-	alu.op_add = isa::AddOp::V8Adds;
-	EXPECT_EQ(isa::disassemble(isa::encode(alu)), "av8adds r0, r1, r2");
-	alu.op_add = isa::AddOp::V8Subs;
-	EXPECT_EQ(isa::disassemble(isa::encode(alu)), "av8subs r0, r1, r2");
-	isa::Alu mul;
-	mul.cond_mul = isa::Cond::Always;
-	mul.waddr_mul = isa::waddr::r3;
-	mul.mul_a = Mux::R1;
-	mul.mul_b = Mux::R2;
-	mul.op_mul = isa::MulOp::V8Adds;
-	EXPECT_EQ(isa::disassemble(isa::encode(mul)), "nop; v8adds r3, r1, r2");
-	mul.op_mul = isa::MulOp::V8Subs;
-	EXPECT_EQ(isa::disassemble(isa::encode(mul)), "nop; v8subs r3, r1, r2");
+	// "op r0, r1, r2" on the ADD ALU, "op r3, r1, r2" on the MUL ALU.
+	auto with = [](isa::Alu alu, bool mul, unsigned op) {
+		if (mul)
+			alu.op_mul = static_cast<isa::MulOp>(op);
+		else
+			alu.op_add = static_cast<isa::AddOp>(op);
+		(mul ? alu.cond_mul : alu.cond_add) = isa::Cond::Always;
+		(mul ? alu.waddr_mul : alu.waddr_add) = mul ? isa::waddr::r3 : isa::waddr::r0;
+		(mul ? alu.mul_a : alu.add_a) = Mux::R1;
+		(mul ? alu.mul_b : alu.add_b) = Mux::R2;
+		return alu;
+	};
+	auto withAdd = [&](isa::Alu alu, isa::AddOp op) { return with(alu, false, static_cast<unsigned>(op)); };
+	auto withMul = [&](isa::Alu alu, isa::MulOp op) { return with(alu, true, static_cast<unsigned>(op)); };
+	EXPECT_EQ(isa::disassemble(isa::encode(withAdd({}, isa::AddOp::V8Adds))), "av8adds r0, r1, r2");
+	EXPECT_EQ(isa::disassemble(isa::encode(withAdd({}, isa::AddOp::V8Subs))), "av8subs r0, r1, r2");
+	EXPECT_EQ(isa::disassemble(isa::encode(withMul({}, isa::MulOp::V8Adds))), "nop; v8adds r3, r1, r2");
+	EXPECT_EQ(isa::disassemble(isa::encode(withMul({}, isa::MulOp::V8Subs))), "nop; v8subs r3, r1, r2");
 	// Both at once: ADD first, MUL second.
-	alu.cond_mul = mul.cond_mul;
-	alu.waddr_mul = mul.waddr_mul;
-	alu.mul_a = Mux::R1;
-	alu.mul_b = Mux::R2;
-	alu.op_mul = isa::MulOp::V8Subs;
-	EXPECT_EQ(isa::disassemble(isa::encode(alu)), "av8subs r0, r1, r2; v8subs r3, r1, r2");
-	for (uint64_t w : {isa::encode(alu), isa::encode(mul)})
+	const isa::Alu both = withMul(withAdd({}, isa::AddOp::V8Subs), isa::MulOp::V8Subs);
+	EXPECT_EQ(isa::disassemble(isa::encode(both)), "av8subs r0, r1, r2; v8subs r3, r1, r2");
+	for (const auto &alu : {both, withMul({}, isa::MulOp::V8Adds), withAdd({}, isa::AddOp::V8Adds)}) {
+		const uint64_t w = isa::encode(alu);
 		EXPECT_EQ(qasm::assembleText(isa::disassemble(w)), std::vector<uint64_t>{w});
+	}
 	// A plain v8adds alone is the MUL's, as vc4asm reads it.
 	EXPECT_EQ(qasm::assembleText("v8adds r3, r1, r2\n"), qasm::assembleText("nop; v8adds r3, r1, r2\n"));
 }
