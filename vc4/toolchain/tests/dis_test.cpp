@@ -251,3 +251,21 @@ TEST(DisassemblerRoundTrip, EveryWordReadsBack)
 	EXPECT_GT(printed, 4000);
 	EXPECT_EQ(qasm::assembleText(isa::disassembleProgram(code, false)), code);
 }
+
+TEST(DisassemblerGpuFft, WordsOfTheGpuFftShaders)
+{
+	// Words of GPU_FFT's shader_256/512 (hello_fft/hex): the VDW wait written as a
+	// never-taken "mov", a rotation, a relative branch with a link register, and
+	// "mov r0, 64" encoded as ftoi of the small immediate 64.0 on both inputs, which
+	// "ftoi r0, 64.0" (second input r0) cannot re-create.
+	const std::vector<uint64_t> code = {
+		word(0x159f2fc0, 0x100009e7), word(0x959f8492, 0xd002c3e2),
+		word(0x000001b0, 0xf0f80227), word(0x87726ff6, 0xd0024831),
+	};
+	EXPECT_EQ(listing(code),
+	          "\tor.never -, vw_wait, vw_wait\n"
+	          "\tor ra15, r2, r2; v8min.ifnz.rot 8, r2, r2, r2\n"
+	          "\tbrr ra8, +432\n"
+	          "\t.int 0x87726ff6, 0xd0024831\n");
+	EXPECT_EQ(qasm::assembleText(listing(code)), code);
+}
