@@ -4,6 +4,7 @@
 #include <array>
 #include <bit>
 #include <cctype>
+#include <cerrno>
 #include <cstdlib>
 #include <map>
 #include <optional>
@@ -166,10 +167,15 @@ uint32_t parseNumber(const Line &line, const std::string &s)
 void parseDestinations(const Line &line, const std::vector<std::string> &dests, Writes &w,
                        bool allow_suffix)
 {
-	if (dests.size() == 1 && dests[0] == "-")
-		return;
+	if (dests.size() > 2)
+		line.fail("more than two destinations");
 	bool first = true;
 	for (const auto &d : dests) {
+		if (d == "-") {
+			// No write: the fields keep their defaults (waddr nop, cond never).
+			first = false;
+			continue;
+		}
 		auto parts = dotted(d);
 		const auto reg = writeReg(parts[0]);
 		if (!reg)
@@ -258,21 +264,26 @@ uint64_t parseBranch(const Line &line, const std::string &head, const std::vecto
 			line.fail("unknown branch condition '" + parts[1] + "'");
 		b.cond = static_cast<BranchCond>(c);
 	}
-	// Trailing operands: [raN,] target; everything before is destinations.
-	size_t n = args.size();
-	std::string target = args[n - 1];
-	std::optional<uint8_t> reg;
+	// vc4asm's operand counts: "dest, target", "dest, raN", "dest, raN, target", and
+	// with a MUL link register "destA, destM, raN|-, target".
 	auto isRegA = [](const std::string &s) { return s.size() > 2 && s[0] == 'r' && s[1] == 'a' && std::isdigit(static_cast<unsigned char>(s[2])); };
-	if (isRegA(target) && n >= 2) {
-		reg = static_cast<uint8_t>(std::atoi(target.c_str() + 2));
-		target.clear();
-		n -= 1;
-	} else if (n >= 3 && isRegA(args[n - 2])) {
-		reg = static_cast<uint8_t>(std::atoi(args[n - 2].c_str() + 2));
-		n -= 2;
-	} else {
-		n -= 1;
+	size_t n = args.size();
+	if (n < 2 || n > 4)
+		line.fail("a branch takes 2 to 4 operands");
+	std::string source, target;
+	if (n == 2)
+		(isRegA(args[1]) ? source : target) = args[1];
+	else {
+		source = args[n - 2];
+		target = args[n - 1];
 	}
+	std::optional<uint8_t> reg;
+	if (!source.empty() && source != "-") {
+		if (!isRegA(source))
+			line.fail("branch register must be ra0..ra31, got '" + source + "'");
+		reg = static_cast<uint8_t>(std::atoi(source.c_str() + 2));
+	}
+	n = n == 4 ? 2 : 1;
 	Writes w;
 	parseDestinations(line, std::vector<std::string>(args.begin(), args.begin() + static_cast<long>(n)), w, false);
 	b.ws = w.ws;
@@ -339,20 +350,51 @@ AluSide parseSide(const Line &line, const std::string &text)
 	return s;
 }
 
+constexpr std::array<const char *, 32> kAddOps = {
+	"nop", "fadd", "fsub", "fmin", "fmax", "fminabs", "fmaxabs", "ftoi",
+	"itof", "", "", "", "add", "sub", "shr", "asr",
+	"ror", "shl", "min", "max", "and", "or", "xor", "not",
+	"clz", "", "", "", "", "", "av8adds", "av8subs"};
+constexpr std::array<const char *, 8> kMulOps = {
+	"nop", "fmul", "mul24", "v8muld", "v8min", "v8max", "v8adds", "v8subs"};
+
 uint64_t parseAlu(const Line &line, const std::vector<std::string> &segments)
 {
+	// Segments in vc4asm's order: ops ("nop" takes the ADD slot first, MUL names the
+	// MUL slot, as vc4asm assigns them), "read X" for register reads no input uses,
+	// then a signal.
 	Alu alu;
-	AluSide add = parseSide(line, segments[0]), mul;
-	size_t next = 1;
-	if (next < segments.size() && indexOf(kSignals, segments[next]) < 0) {
-		mul = parseSide(line, segments[next]);
-		++next;
-	}
-	if (next < segments.size()) {
-		const int sig = indexOf(kSignals, segments[next]);
-		if (sig < 0)
-			line.fail("unknown signal '" + segments[next] + "'");
-		alu.sig = static_cast<Sig>(sig);
+	AluSide add, mul;
+	bool add_taken = false, mul_taken = false;
+	std::vector<std::string> read_sources;
+	for (const auto &segment : segments) {
+		if (const int sig = indexOf(kSignals, segment); sig >= 0) {
+			if (alu.sig != Sig::None)
+				line.fail("second signal '" + segment + "'");
+			alu.sig = static_cast<Sig>(sig);
+			continue;
+		}
+		if (segment.rfind("read ", 0) == 0) {
+			read_sources.push_back(trim(segment.substr(5)));
+			continue;
+		}
+		if (alu.sig != Sig::None || !read_sources.empty())
+			line.fail("op '" + segment + "' after a read or signal");
+		AluSide side = parseSide(line, segment);
+		const bool is_mul = indexOf(kMulOps, side.op) > 0;
+		if (!is_mul && indexOf(kAddOps, side.op) < 0 && side.op != "nop")
+			line.fail("unknown op '" + side.op + "'");
+		if (side.op == "nop" ? !add_taken : !is_mul) {
+			if (add_taken)
+				line.fail("second ADD op '" + side.op + "'");
+			add = side;
+			add_taken = true;
+		} else {
+			if (mul_taken)
+				line.fail("second MUL op '" + side.op + "'");
+			mul = side;
+			mul_taken = true;
+		}
 	}
 	bool a_used = false, b_used = false, smi = false;
 	auto source = [&](const std::string &text, bool consumer_is_mul) {
@@ -405,11 +447,7 @@ uint64_t parseAlu(const Line &line, const std::vector<std::string> &segments)
 	int add_file = -1, mul_file = -1;
 	Pack add_pack = Pack::None, mul_pack = Pack::None;
 	if (add.used) {
-		const int op = indexOf(std::array<const char *, 32>{
-			"nop", "fadd", "fsub", "fmin", "fmax", "fminabs", "fmaxabs", "ftoi",
-			"itof", "", "", "", "add", "sub", "shr", "asr",
-			"ror", "shl", "min", "max", "and", "or", "xor", "not",
-			"clz", "", "", "", "", "", "v8adds", "v8subs"}, add.op);
+		const int op = indexOf(kAddOps, add.op);
 		if (op < 0)
 			line.fail("unknown ADD op '" + add.op + "'");
 		alu.op_add = static_cast<isa::AddOp>(op);
@@ -424,12 +462,16 @@ uint64_t parseAlu(const Line &line, const std::vector<std::string> &segments)
 			add_pack = static_cast<Pack>(std::max(0, indexOf(kPacks, tail)));
 		if (add.srcs.empty())
 			line.fail("missing ADD operands");
+		// A unary op has one operand; vc4asm leaves add_b at r0.
+		const size_t operands = isUnary(alu.op_add) ? 1 : 2;
+		if (add.srcs.size() != operands)
+			line.fail(add.op + " takes " + std::to_string(operands) + " operand(s)");
 		alu.add_a = source(add.srcs[0], false);
-		alu.add_b = add.srcs.size() > 1 ? source(add.srcs[1], false) : alu.add_a;
+		if (operands == 2)
+			alu.add_b = source(add.srcs[1], false);
 	}
 	if (mul.used) {
-		const int op = indexOf(std::array<const char *, 8>{"nop", "fmul", "mul24", "v8muld", "v8min",
-		                                                   "v8max", "v8adds", "v8subs"}, mul.op);
+		const int op = indexOf(kMulOps, mul.op);
 		if (op < 0)
 			line.fail("unknown MUL op '" + mul.op + "'");
 		alu.op_mul = static_cast<isa::MulOp>(op);
@@ -453,6 +495,11 @@ uint64_t parseAlu(const Line &line, const std::vector<std::string> &segments)
 			alu.raddr_b = static_cast<uint8_t>(mul.rotate);
 		}
 	}
+	for (const auto &text : read_sources) {
+		const Mux m = source(text, false);
+		if (m != Mux::A && m != Mux::B)
+			line.fail("read needs a register file or small immediate, got '" + text + "'");
+	}
 	if (smi) {
 		if (alu.sig != Sig::None)
 			line.fail("signal with a small immediate");
@@ -470,17 +517,41 @@ uint64_t parseAlu(const Line &line, const std::vector<std::string> &segments)
 	return encode(alu);
 }
 
+// 32-bit units of one value of a data directive: ".int" 1, ".long" 2, not data 0.
+int dataUnits(const std::string &line)
+{
+	const std::string head = line.substr(0, line.find_first_of(" \t"));
+	return head == ".int" ? 1 : head == ".long" ? 2 : 0;
+}
+
+uint64_t parseData(const Line &line, const std::string &s, int units)
+{
+	char *end = nullptr;
+	errno = 0;
+	const unsigned long long v = std::strtoull(s.c_str(), &end, 0);
+	if (s.empty() || *end != '\0' || s[0] == '-' || errno || (units == 1 && v > 0xffffffffull))
+		line.fail("bad " + std::string(units == 1 ? ".int" : ".long") + " value '" + s + "'");
+	return v;
+}
+
 } // namespace
 
 std::vector<uint64_t> assembleText(const std::string &text)
 {
-	// Two passes: labels first (addresses are byte offsets from the start).
-	std::vector<std::pair<int, std::string>> lines;
+	// Two passes: labels first. Addresses count 32-bit units so that data (".int" 32
+	// bits, ".long" 64 bits as in vc4asm) can hold any number of words; instructions and
+	// labels must sit on 64-bit boundaries.
+	struct Entry {
+		int number;
+		std::string text;
+	};
+	std::vector<Entry> lines;
 	std::map<std::string, uint32_t> labels;
 	{
 		std::istringstream in(text);
 		std::string raw;
 		int number = 0;
+		uint32_t units = 0;
 		while (std::getline(in, raw)) {
 			++number;
 			if (auto c = raw.find('#'); c != std::string::npos)
@@ -488,24 +559,41 @@ std::vector<uint64_t> assembleText(const std::string &text)
 			const std::string l = trim(raw);
 			if (l.empty())
 				continue;
+			const int data = dataUnits(l);
+			if (!data && units % 2)
+				Line(number).fail("instruction or label after an odd number of .int words");
 			if (l[0] == ':') {
-				labels[l.substr(1)] = static_cast<uint32_t>(lines.size() * 8);
+				labels[l.substr(1)] = units * 4;
 				continue;
 			}
-			lines.emplace_back(number, l);
+			units += data ? static_cast<uint32_t>(data * split(l.substr(l.find_first_of(" \t") + 1), ',').size()) : 2;
+			lines.push_back({number, l});
 		}
+		if (units % 2)
+			Line(number).fail("odd number of .int words at the end");
 	}
 	std::vector<uint64_t> code;
+	std::vector<uint32_t> data;
 	for (const auto &[number, l] : lines) {
 		const Line line(number);
-		const auto space = l.find(' ');
+		const auto space = l.find_first_of(" \t");
 		const std::string head = l.substr(0, space);
 		const std::string op = dotted(head)[0];
 		const auto address = static_cast<uint32_t>(code.size() * 8);
-		if (op == "bra" || op == "brr") {
-			code.push_back(parseBranch(line, head, split(trim(l.substr(space + 1)), ','), address, labels));
+		const std::string rest = space == std::string::npos ? "" : trim(l.substr(space + 1));
+		if (const int units = dataUnits(l)) {
+			for (const auto &v : split(rest, ',')) {
+				const uint64_t value = parseData(line, v, units);
+				data.push_back(static_cast<uint32_t>(value));
+				if (units == 2)
+					data.push_back(static_cast<uint32_t>(value >> 32));
+			}
+			for (; data.size() >= 2; data.erase(data.begin(), data.begin() + 2))
+				code.push_back(uint64_t{data[0]} | uint64_t{data[1]} << 32);
+		} else if (op == "bra" || op == "brr") {
+			code.push_back(parseBranch(line, head, split(rest, ','), address, labels));
 		} else if (op == "ldi" || op == "ldipes" || op == "ldipeu" || op == "sacq" || op == "srel") {
-			code.push_back(parseLoad(line, head, split(trim(l.substr(space + 1)), ',')));
+			code.push_back(parseLoad(line, head, split(rest, ',')));
 		} else {
 			code.push_back(parseAlu(line, split(l, ';')));
 		}

@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: MIT
 // Reads back listings in the vc4asm syntax our disassembler prints (one instruction per
-// line, ":label" lines, "#" comments). A self-check of the disassembler: every word our
-// assembler produces must survive disassemble -> assembleText unchanged.
+// line, ":label" lines, "#" comments, ".int" 32-bit and ".long" 64-bit data, "read"
+// operands, four-operand branches). A self-check of the disassembler: every word must
+// survive disassemble -> assembleText unchanged.
 #pragma once
 
 #include <cstdint>

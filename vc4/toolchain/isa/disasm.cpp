@@ -47,8 +47,9 @@ constexpr std::array<const char *, 32> kAddOps = {
 	"nop", "fadd", "fsub", "fmin", "fmax", "fminabs", "fmaxabs", "ftoi",
 	"itof", "addop9?", "addop10?", "addop11?", "add", "sub", "shr", "asr",
 	"ror", "shl", "min", "max", "and", "or", "xor", "not",
-	"clz", "addop25?", "addop26?", "addop27?", "addop28?", "addop29?", "v8adds", "v8subs",
+	"clz", "addop25?", "addop26?", "addop27?", "addop28?", "addop29?", "av8adds", "av8subs",
 };
+// vc4asm names the ADD ALU's v8adds/v8subs "av8adds"/"av8subs"; plain names are MUL ops.
 constexpr std::array<const char *, 8> kMulOps = {
 	"nop", "fmul", "mul24", "v8muld", "v8min", "v8max", "v8adds", "v8subs",
 };
@@ -107,6 +108,11 @@ std::string pinnedReadName(uint8_t raddr, bool fileB)
 	return readRegisterName(raddr, fileB);
 }
 
+std::string smallImmediateText(uint8_t code)
+{
+	return code < 48 ? kSmallImm[code] : format("%d", static_cast<int>(code) - 64);
+}
+
 std::string sourceName(const Alu &i, Mux mux)
 {
 	std::string s;
@@ -115,11 +121,8 @@ std::string sourceName(const Alu &i, Mux mux)
 		s = pinnedReadName(i.raddr_a, false);
 		break;
 	case Mux::B:
-		if (i.sig == Sig::SmallImmediate)
-			s = i.raddr_b < 48 ? kSmallImm[i.raddr_b]
-			                   : format("%d", static_cast<int>(i.raddr_b) - 64);
-		else
-			s = pinnedReadName(i.raddr_b, true);
+		s = i.sig == Sig::SmallImmediate ? smallImmediateText(i.raddr_b)
+		                                 : pinnedReadName(i.raddr_b, true);
 		break;
 	default:
 		s = format("r%u", static_cast<unsigned>(mux));
@@ -129,31 +132,162 @@ std::string sourceName(const Alu &i, Mux mux)
 	return s;
 }
 
-// Destination names of the ADD and MUL writes. When ws = 1 and both names are shared
-// between the files, the ADD name is pinned so that vc4asm sets ws again.
+// Destination names of the ADD and MUL writes. vc4asm takes ws from the first name that
+// belongs to one file only; when every printed name is shared (r0, tmu0_s, "-") and
+// ws = 1, the first printed one is pinned (rb32, ra39) so that vc4asm sets ws again.
 std::array<std::string, 2> destNames(bool ws, uint8_t waddr_add, uint8_t waddr_mul,
-                                     bool add_used, bool mul_used)
+                                     bool add_printed, bool mul_printed)
 {
 	std::string add = writeRegisterName(waddr_add, ws);
 	std::string mul = writeRegisterName(waddr_mul, !ws);
-	const bool add_decides = add_used && !writeNameIsShared(waddr_add);
-	const bool mul_decides = mul_used && !writeNameIsShared(waddr_mul);
+	const bool add_decides = add_printed && !writeNameIsShared(waddr_add);
+	const bool mul_decides = mul_printed && !writeNameIsShared(waddr_mul);
 	if (ws && !add_decides && !mul_decides) {
-		if (add_used)
+		if (add_printed)
 			add = format("rb%u", waddr_add);
-		else if (mul_used)
+		else if (mul_printed)
 			mul = format("ra%u", waddr_mul);
 	}
 	return {add, mul};
 }
 
-std::string disassembleAlu(const Alu &i)
+// Which ALU inputs a used op reads (a unary ADD op reads add_a only).
+bool addReads(const Alu &i, Mux m)
 {
-	const bool add_used = i.op_add != AddOp::Nop;
-	const bool mul_used = i.op_mul != MulOp::Nop;
-	const auto dst = destNames(i.ws, i.waddr_add, i.waddr_mul, add_used, mul_used);
+	return i.op_add != AddOp::Nop && (i.add_a == m || (!isUnary(i.op_add) && i.add_b == m));
+}
+
+bool mulReads(const Alu &i, Mux m)
+{
+	return i.op_mul != MulOp::Nop && (i.mul_a == m || i.mul_b == m);
+}
+
+bool reads(const Alu &i, Mux m) { return addReads(i, m) || mulReads(i, m); }
+
+// vc4asm writes cond = never for a destination "-" (AssembleInst::optimize) and can only
+// set ws through a printed destination.
+bool writesExpressible(const Writes &w, bool add_printed, bool mul_printed)
+{
+	if (w.waddr_add == waddr::nop && w.cond_add != Cond::Never && !w.sf)
+		return false;
+	if (w.waddr_mul == waddr::nop && w.cond_mul != Cond::Never &&
+	    (!w.sf || add_printed || !mul_printed))
+		return false;
+	return !w.ws || add_printed || mul_printed;
+}
+
+bool packExpressible(const Alu &i, bool add, bool mul)
+{
+	const auto pack = static_cast<unsigned>(i.pack);
+	if (i.pack != Pack::None) {
+		// Regfile A pack on an ADD write to file A (the saturating 8-bit modes are
+		// also MUL packs, vc4asm could move them), or a MUL 8-bit colour pack (only
+		// 3 bits of the field survive vc4asm's encoder when pm = 1).
+		const bool ok = i.pm ? mul && pack >= 3 && pack <= 7 && !(i.ws && i.waddr_mul < 32)
+		                     : add && !i.ws && i.waddr_add < 32 && pack <= 10;
+		if (!ok)
+			return false;
+	}
+	if (i.unpack != Unpack::None) {
+		// One ALU, reading the unpacked input (regfile A below 32, or r4 when pm = 1):
+		// vc4asm refuses an unpack that also changes the other ALU's operands.
+		if (add == mul || (!i.pm && i.raddr_a >= 32))
+			return false;
+		return reads(i, i.pm ? Mux::R4 : Mux::A);
+	}
+	return i.pack != Pack::None || !i.pm;
+}
+
+bool smallImmediateExpressible(const Alu &i, bool add, bool mul)
+{
+	if (i.raddr_b >= 48) {
+		// MUL rotation ".rot n," (n = 1..15); by r5 vc4asm's syntax differs between versions.
+		return mul && i.raddr_b != smallimm::rotate_by_r5 && !reads(i, Mux::B);
+	}
+	if (add && !isUnary(i.op_add) && i.add_b == Mux::B) {
+		// vc4asm rewrites "add x, 0, 0" into sub, and reads a shift's count as 5 bits.
+		if ((i.op_add == AddOp::Add || i.op_add == AddOp::Sub) && i.add_a == Mux::B && i.raddr_b == 0)
+			return false;
+		const bool shift = i.op_add == AddOp::Shr || i.op_add == AddOp::Asr ||
+		                   i.op_add == AddOp::Ror || i.op_add == AddOp::Shl;
+		if (shift && i.raddr_b >= 32)
+			return false;
+	}
+	// vc4asm turns a constant computed from the small immediate alone into ldi.
+	const bool whole_word = ((1u << static_cast<unsigned>(i.pack)) & 0x0909u) != 0;
+	if (whole_word && i.raddr_a == raddr::nop && !i.sf) {
+		if (!mul && i.add_a == Mux::B && i.add_b == Mux::B)
+			return false;
+		if (!add && i.mul_a == Mux::B && i.mul_b == Mux::B)
+			return false;
+	}
+	return true;
+}
+
+bool printable(const Alu &i)
+{
+	const bool add = i.op_add != AddOp::Nop, mul = i.op_mul != MulOp::Nop;
+	if (add && !isValid(i.op_add))
+		return false;
+	// An idle ALU keeps vc4asm's defaults: no destination, inputs r0, cond never.
+	if (!add && (i.waddr_add != waddr::nop || i.add_a != Mux::R0 || i.add_b != Mux::R0 ||
+	             i.cond_add != Cond::Never || i.sf))
+		return false;
+	if (!mul && (i.waddr_mul != waddr::nop || i.mul_a != Mux::R0 || i.mul_b != Mux::R0))
+		return false;
+	if (add && isUnary(i.op_add) && i.add_b != Mux::R0)
+		return false;
+	if (!writesExpressible(i, add, mul) || !packExpressible(i, add, mul))
+		return false;
+	if (i.sig == Sig::SmallImmediate)
+		return smallImmediateExpressible(i, add, mul);
+	// vc4asm turns "sub/xor x, a, a" and "v8subs x, a, a" alone into "ldi x, 0".
+	if (i.sig == Sig::None && i.raddr_a == raddr::nop && i.raddr_b == raddr::nop) {
+		if (add && (i.op_add == AddOp::Sub || i.op_add == AddOp::Xor) && i.add_a == i.add_b &&
+		    i.waddr_mul == waddr::nop)
+			return false;
+		if (mul && i.op_mul == MulOp::V8Subs && i.mul_a == i.mul_b && !i.sf &&
+		    i.waddr_add == waddr::nop)
+			return false;
+	}
+	return true;
+}
+
+bool loadWritesExpressible(const Writes &w)
+{
+	const bool add = w.waddr_add != waddr::nop, mul = w.waddr_mul != waddr::nop;
+	if (w.pm || w.pack != Pack::None || (w.sf && !add))
+		return false;
+	return writesExpressible(w, add, mul) && (add || w.cond_add == Cond::Never);
+}
+
+bool printable(const LoadImm &i)
+{
+	const auto mode = static_cast<LoadMode>(i.mode);
+	return (mode == LoadMode::Word || mode == LoadMode::PerElementSigned ||
+	        mode == LoadMode::PerElementUnsigned) &&
+	       loadWritesExpressible(i);
+}
+
+bool printable(const Semaphore &i) { return loadWritesExpressible(i); }
+
+bool printable(const Branch &i)
+{
+	const auto cond = static_cast<unsigned>(i.cond);
+	if (i.ignored || (cond > 11 && i.cond != BranchCond::Always))
+		return false;
+	// vc4asm writes raddr_a = 0 without a register; an odd register reads as ".setf".
+	if (i.reg ? (i.raddr_a & 1) : i.raddr_a != 0)
+		return false;
+	return !i.ws || i.waddr_add != waddr::nop || i.waddr_mul != waddr::nop;
+}
+
+std::string aluText(const Alu &i)
+{
+	const bool add = i.op_add != AddOp::Nop, mul = i.op_mul != MulOp::Nop;
+	const auto dst = destNames(i.ws, i.waddr_add, i.waddr_mul, add, mul);
 	std::string out;
-	if (!add_used) {
+	if (!add) {
 		out = "nop";
 	} else {
 		out = kAddOps[static_cast<unsigned>(i.op_add)];
@@ -164,14 +298,14 @@ std::string disassembleAlu(const Alu &i)
 		if (!i.pm && !i.ws)
 			out += kPackA[static_cast<unsigned>(i.pack)];
 		out += ", " + sourceName(i, i.add_a);
-		if (!isUnary(i.op_add) || i.add_b != i.add_a)
+		if (!isUnary(i.op_add))
 			out += ", " + sourceName(i, i.add_b);
 	}
-	if (mul_used) {
+	if (mul) {
 		out += "; ";
 		out += kMulOps[static_cast<unsigned>(i.op_mul)];
 		out += kConds[static_cast<unsigned>(i.cond_mul)];
-		if (i.sf && !add_used)
+		if (i.sf && !add)
 			out += ".setf";
 		if (i.sig == Sig::SmallImmediate && smallimm::isRotation(i.raddr_b)) {
 			if (i.raddr_b == smallimm::rotate_by_r5)
@@ -186,6 +320,13 @@ std::string disassembleAlu(const Alu &i)
 			out += kPackA[static_cast<unsigned>(i.pack)];
 		out += ", " + sourceName(i, i.mul_a) + ", " + sourceName(i, i.mul_b);
 	}
+	// A register read no input uses still happens (vw_wait stalls, unif pops a uniform):
+	// "read" keeps raddr_a/raddr_b.
+	if (i.raddr_a != raddr::nop && !reads(i, Mux::A))
+		out += "; read " + sourceName(i, Mux::A);
+	const bool b_read = i.sig == Sig::SmallImmediate ? i.raddr_b < 48 : i.raddr_b != raddr::nop;
+	if (b_read && !reads(i, Mux::B))
+		out += "; read " + sourceName(i, Mux::B);
 	out += kSignals[static_cast<unsigned>(i.sig) < kSignals.size() ? static_cast<unsigned>(i.sig) : 1];
 	return out;
 }
@@ -211,36 +352,30 @@ std::string perElementText(uint32_t v, bool is_signed)
 	return out;
 }
 
-// Destinations of ldi/semaphore/branch: each present one, with pack and condition.
+// Destinations of ldi/semaphore/branch, each with pack and condition when asked: "-"
+// for none, "-, M" when only the MUL write is present (the first name is the ADD's).
 std::string writeList(const Writes &w, bool with_pack_cond)
 {
-	const auto dst = destNames(w.ws, w.waddr_add, w.waddr_mul, w.waddr_add != waddr::nop,
-	                           w.waddr_mul != waddr::nop);
-	std::string out;
-	if (w.waddr_add != waddr::nop) {
-		out += dst[0];
-		if (with_pack_cond) {
-			if (!w.pm)
-				out += kPackA[static_cast<unsigned>(w.pack)];
-			out += kConds[static_cast<unsigned>(w.cond_add)];
-		}
-		out += ", ";
+	const bool add = w.waddr_add != waddr::nop, mul = w.waddr_mul != waddr::nop;
+	const auto dst = destNames(w.ws, w.waddr_add, w.waddr_mul, add, mul);
+	std::string out = add ? dst[0] : "-";
+	if (add && with_pack_cond) {
+		if (!w.pm)
+			out += kPackA[static_cast<unsigned>(w.pack)];
+		out += kConds[static_cast<unsigned>(w.cond_add)];
 	}
-	if (w.waddr_mul != waddr::nop) {
-		out += dst[1];
+	if (mul) {
+		out += ", " + dst[1];
 		if (with_pack_cond) {
 			if (w.pm)
 				out += kPackMul[static_cast<unsigned>(w.pack)];
 			out += kConds[static_cast<unsigned>(w.cond_mul)];
 		}
-		out += ", ";
 	}
-	if (out.empty())
-		out = "-, ";
-	return out;
+	return out + ", ";
 }
 
-std::string disassembleLoad(const LoadImm &i)
+std::string loadText(const LoadImm &i)
 {
 	static constexpr std::array<const char *, 8> names = {
 		"ldi", "ldipes", "ldi02?", "ldipeu", "s", "ldi05?", "ldi06?", "ldi07?",
@@ -258,7 +393,7 @@ std::string disassembleLoad(const LoadImm &i)
 	return out;
 }
 
-std::string disassembleSemaphore(const Semaphore &i)
+std::string semaphoreText(const Semaphore &i)
 {
 	std::string out = i.down ? "sacq" : "srel";
 	if (i.sf)
@@ -268,7 +403,9 @@ std::string disassembleSemaphore(const Semaphore &i)
 	return out;
 }
 
-std::string disassembleBranch(const Branch &i, const std::string &target)
+// "brr[.cond] dest, target", "brr dest, ra<N>[, target]"; with a MUL link register vc4asm
+// reads two destinations, then a register or "-", then the target.
+std::string branchText(const Branch &i, const std::string &label)
 {
 	std::string out = i.rel ? "brr" : "bra";
 	out += kBranchConds[static_cast<unsigned>(i.cond)];
@@ -277,16 +414,37 @@ std::string disassembleBranch(const Branch &i, const std::string &target)
 	w.waddr_add = i.waddr_add;
 	w.waddr_mul = i.waddr_mul;
 	out += ' '; out += writeList(w, false);
-	if (i.reg) {
-		out += readRegisterName(i.raddr_a, false);
-		if (i.offset != 0 || !target.empty())
-			out += ", ";
-	}
-	if (!target.empty())
-		out += target;
-	else if (i.offset != 0 || !i.reg)
-		out += i.rel ? format("%+d", i.offset) : format("0x%x", static_cast<uint32_t>(i.offset));
+	const std::string target = !label.empty() ? label
+	                           : i.rel       ? format("%+d", i.offset)
+	                                         : format("0x%x", static_cast<uint32_t>(i.offset));
+	const bool two_dests = i.waddr_mul != waddr::nop;
+	if (two_dests)
+		return out + (i.reg ? readRegisterName(i.raddr_a, false) : "-") + ", " + target;
+	if (!i.reg)
+		return out + target;
+	out += readRegisterName(i.raddr_a, false);
+	if (i.offset != 0 || !label.empty())
+		out += ", " + target;
 	return out;
+}
+
+std::string instructionText(const Instr &instr, const std::string &label)
+{
+	if (const auto *a = std::get_if<Alu>(&instr))
+		return aluText(*a);
+	if (const auto *l = std::get_if<LoadImm>(&instr))
+		return loadText(*l);
+	if (const auto *s = std::get_if<Semaphore>(&instr))
+		return semaphoreText(*s);
+	return branchText(std::get<Branch>(instr), label);
+}
+
+// Two 32-bit data words, low first: ".int" is 32 bits in every vc4asm version, while
+// ".long" became 64 bits (directive table of Parser.tables.cpp).
+std::string dataText(uint64_t word)
+{
+	return format(".int 0x%08x, 0x%08x", static_cast<uint32_t>(word),
+	              static_cast<uint32_t>(word >> 32));
 }
 
 } // namespace
@@ -308,28 +466,28 @@ std::string writeRegisterName(uint8_t waddr, bool fileB)
 	return kWriteSpecial[waddr - 32][fileB];
 }
 
+bool printsAsInstruction(uint64_t word)
+{
+	return std::visit([](const auto &i) { return printable(i); }, decode(word));
+}
+
 std::string disassemble(uint64_t word)
 {
-	const Instr instr = decode(word);
-	if (const auto *a = std::get_if<Alu>(&instr))
-		return disassembleAlu(*a);
-	if (const auto *l = std::get_if<LoadImm>(&instr))
-		return disassembleLoad(*l);
-	if (const auto *s = std::get_if<Semaphore>(&instr))
-		return disassembleSemaphore(*s);
-	return disassembleBranch(std::get<Branch>(instr), {});
+	if (!printsAsInstruction(word))
+		return dataText(word);
+	return instructionText(decode(word), {});
 }
 
 std::string disassembleProgram(std::span<const uint64_t> words, bool with_comments)
 {
 	// Relative targets count from the fourth instruction after the branch (section 3
-	// "Branches": PC + 4 instructions).
+	// "Branches": PC + 4 instructions). Only printed branches get labels.
 	std::map<uint32_t, std::string> labels;
 	const auto size = static_cast<uint32_t>(words.size() * 8);
 	for (size_t n = 0; n < words.size(); ++n) {
 		const Instr instr = decode(words[n]);
 		const auto *b = std::get_if<Branch>(&instr);
-		if (!b || !b->rel || b->reg)
+		if (!b || !b->rel || b->reg || !printable(*b))
 			continue;
 		const int64_t target = static_cast<int64_t>(n * 8 + 32) + b->offset;
 		if (target >= 0 && target <= size && target % 8 == 0)
@@ -340,20 +498,25 @@ std::string disassembleProgram(std::span<const uint64_t> words, bool with_commen
 		const auto address = static_cast<uint32_t>(n * 8);
 		if (auto it = labels.find(address); it != labels.end())
 			out << ':' << it->second << '\n';
-		std::string text;
 		const Instr instr = decode(words[n]);
+		std::string label;
 		if (const auto *b = std::get_if<Branch>(&instr); b && b->rel && !b->reg) {
 			const int64_t target = static_cast<int64_t>(address) + 32 + b->offset;
 			auto it = target >= 0 ? labels.find(static_cast<uint32_t>(target)) : labels.end();
-			text = disassembleBranch(*b, it != labels.end() ? "r:" + it->second : std::string{});
-		} else {
-			text = disassemble(words[n]);
+			if (it != labels.end())
+				label = "r:" + it->second;
 		}
-		if (with_comments)
-			out << '\t' << format("%-56s", text.c_str())
-			    << format(" # %04x: %016" PRIx64, address, words[n]) << '\n';
-		else
+		const bool as_instruction = printsAsInstruction(words[n]);
+		const std::string text = as_instruction ? instructionText(instr, label) : dataText(words[n]);
+		if (!with_comments) {
 			out << '\t' << text << '\n';
+			continue;
+		}
+		out << '\t' << format("%-56s", text.c_str())
+		    << format(" # %04x: %016" PRIx64, address, words[n]);
+		if (!as_instruction)
+			out << " (" << instructionText(instr, label) << ")";
+		out << '\n';
 	}
 	if (auto it = labels.find(size); it != labels.end())
 		out << ':' << it->second << '\n';

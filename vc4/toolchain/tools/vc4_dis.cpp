@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: MIT
-// vc4-dis FILE: prints a vc4asm-syntax listing of a QPU program (hex listing or binary).
+// vc4-dis FILE: prints a vc4asm-syntax listing of a QPU program (hex listing or binary);
+// words vc4asm would not re-create from an instruction's text print as ".int" data.
 #include <cstdio>
 #include <cstring>
 #include <exception>
@@ -14,6 +15,7 @@ void usage()
 	std::fprintf(stderr,
 	             "usage: vc4-dis [--fields] [--no-comments] FILE\n"
 	             "  FILE: vc4asm hex listing (0xLLLLLLLL, 0xHHHHHHHH, per line) or raw binary\n"
+	             "  Words an instruction's text cannot carry print as .int data.\n"
 	             "  --fields       print every instruction field after each line\n"
 	             "  --no-comments  plain listing without addresses and words\n");
 }
