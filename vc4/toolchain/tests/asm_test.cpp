@@ -348,18 +348,37 @@ TEST(Lint, TmuRequestCounting)
 	a.nop(Sig::LoadTmu0);
 	a.thrend();
 	EXPECT_TRUE(has(lintOf(a), Hazard::LdtmuWithoutRequest));
+	// Five requests in flight, split over both TMUs: the depth counts per QPU, so this
+	// fails at depth 4 (the default build) and passes at 8.
 	Assembler b;
 	for (int i = 0; i < 5; ++i)
-		b.emit(mov(reg::tmu0_s, r0));
+		b.emit(mov(i % 2 ? reg::tmu1_s : reg::tmu0_s, r0));
 	for (int i = 0; i < 5; ++i)
-		b.nop(Sig::LoadTmu0);
+		b.nop(i % 2 ? Sig::LoadTmu1 : Sig::LoadTmu0);
 	b.thrend();
-	EXPECT_TRUE(has(lintOf(b), Hazard::TmuTooManyOutstanding));
+	const auto code = b.finish(false).code;
+	const auto at4 = lint(code, 4);
+	ASSERT_EQ(at4.size(), 1u);
+	EXPECT_EQ(at4[0].hazard, Hazard::TmuTooManyOutstanding);
+	EXPECT_EQ(at4[0].index, 4u); // the fifth request
+	EXPECT_TRUE(lint(code, 8).empty());
+	EXPECT_EQ(lint(code).empty(), kTmuDepth >= 5);
+	// Four in flight pass at either depth; a pop makes room for the next request.
 	Assembler ok;
 	for (int i = 0; i < 4; ++i)
-		ok.emit(mov(reg::tmu0_s, r0));
+		ok.emit(mov(i % 2 ? reg::tmu1_s : reg::tmu0_s, r0));
+	ok.nop(Sig::LoadTmu0);
+	ok.emit(mov(reg::tmu0_s, r0));
 	for (int i = 0; i < 4; ++i)
-		ok.nop(Sig::LoadTmu0);
+		ok.nop(i % 2 ? Sig::LoadTmu0 : Sig::LoadTmu1);
 	ok.thrend();
-	EXPECT_TRUE(lintOf(ok).empty());
+	EXPECT_TRUE(lint(ok.finish(false).code, 4).empty());
+	// Nine in flight fail even at depth 8.
+	Assembler nine;
+	for (int i = 0; i < 9; ++i)
+		nine.emit(mov(i % 2 ? reg::tmu1_s : reg::tmu0_s, r0));
+	for (int i = 0; i < 9; ++i)
+		nine.nop(i % 2 ? Sig::LoadTmu1 : Sig::LoadTmu0);
+	nine.thrend();
+	EXPECT_TRUE(has(lint(nine.finish(false).code, 8), Hazard::TmuTooManyOutstanding));
 }
