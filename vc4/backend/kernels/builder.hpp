@@ -138,7 +138,9 @@ public:
 	/// stay pending (in flight or unconsumed) at the end, `keep` at most, oldest first out.
 	/// The caller guarantees that the consumers do not write what `compute` reads
 	/// (nor the reverse) and that the gathers' results may land anywhere in the stream.
-	void interleave(std::vector<Ins> compute, std::vector<Gather> gathers, size_t keep = 0,
+	/// No request pops before the first `hold` compute instructions ran (they may move
+	/// registers the results land in).
+	void interleave(std::vector<Ins> compute, std::vector<Gather> gathers, size_t keep = 0, size_t hold = 0,
 	                unsigned latency = 10)
 	{
 		size_t c = 0, g = 0;
@@ -173,28 +175,43 @@ public:
 				op(k.add, k.mul);
 				continue;
 			}
-			// 2. Pop the oldest request when it is ripe or room is needed.
-			if (!flight_.empty()) {
+			// 2. Pop the oldest request once it is ripe: on the next request's instruction
+			// while there is room for both, on a compute instruction that can carry the
+			// signal if one comes within a few, alone when nothing else is left.
+			if (!flight_.empty() && c >= hold) {
 				const Flight &f = flight_.front();
-				const bool ripe = at >= f.issued_at + latency;
-				const bool need = (g < gathers.size() && !room) || (c >= compute.size() && g >= gathers.size()) ||
-				                  (c >= compute.size() && !room);
-				if (ripe || need) {
-					const isa::Sig sig = f.tmu ? isa::Sig::LoadTmu1 : isa::Sig::LoadTmu0;
-					for (const Ins &k : f.consume)
-						consume_.push_back(k);
-					flight_.pop_front();
-					if (c < compute.size() && fits(compute[c].add, compute[c].mul, sig)) {
-						op(compute[c].add, compute[c].mul, sig);
-						++c;
-					} else {
-						op(AddOp{}, MulOp{}, sig);
+				const size_t age = at - f.issued_at;
+				const isa::Sig sig = f.tmu ? isa::Sig::LoadTmu1 : isa::Sig::LoadTmu0;
+				const bool idle = c >= compute.size() && !can_issue;
+				const bool rides = c < compute.size() && fits(compute[c].add, compute[c].mul, sig);
+				if (idle || age >= latency) {
+					enum { Alone, WithIssue, WithCompute, Wait } how = Wait;
+					if (can_issue && fits(gathers[g].issue, MulOp{}, sig))
+						how = WithIssue;
+					else if (rides)
+						how = WithCompute;
+					else if (idle || age >= latency + 3 || c >= compute.size())
+						how = Alone;
+					if (how != Wait) {
+						for (const Ins &k : f.consume)
+							consume_.push_back(k);
+						flight_.pop_front();
+						if (how == WithIssue) {
+							op(gathers[g].issue, MulOp{}, sig);
+							issued(gathers[g++], at);
+						} else if (how == WithCompute) {
+							op(compute[c].add, compute[c].mul, sig);
+							++c;
+						} else {
+							op(AddOp{}, MulOp{}, sig);
+						}
+						continue;
 					}
-					continue;
 				}
 			}
-			// 3. Issue the next request, beside a MUL-only compute instruction if one is next.
-			if (can_issue) {
+			// 3. Issue the next request while a slot stays free for an issue with a pop,
+			// beside a MUL-only compute instruction if one is next.
+			if (can_issue && flight_.size() + 1 < kTmuDepth) {
 				MulOp m;
 				if (c < compute.size() && !busy(compute[c].add) && fits(gathers[g].issue, compute[c].mul, isa::Sig::None))
 					m = compute[c++].mul;
@@ -210,6 +227,8 @@ public:
 				continue;
 			}
 			// Only waiting is left: a request not yet ripe that must go.
+			if (flight_.empty())
+				throw std::logic_error("interleave: nothing to pop");
 			const Flight &f = flight_.front();
 			for (const Ins &k : f.consume)
 				consume_.push_back(k);
@@ -218,7 +237,34 @@ public:
 		}
 	}
 
+	/// Puts `movs` (MUL-pipe ops, kept in order) beside ADD-only instructions of
+	/// `compute` from the start, inserting them alone where none fits; returns the index
+	/// after the last one.
+	static size_t mergeMul(std::vector<Ins> &compute, const std::vector<MulOp> &movs)
+	{
+		size_t at = 0;
+		for (const MulOp &m : movs) {
+			while (at < compute.size() && (compute[at].mul.op != isa::MulOp::Nop || !fitsNoSig(compute[at].add, m)))
+				++at;
+			if (at < compute.size())
+				compute[at].mul = m;
+			else
+				compute.insert(compute.begin() + static_cast<long>(at), ins(m));
+			++at;
+		}
+		return at;
+	}
+
 private:
+	static bool fitsNoSig(const AddOp &a, const MulOp &m)
+	{
+		try {
+			(void)assembleAlu(a, m, isa::Sig::None);
+			return true;
+		} catch (const AsmError &) {
+			return false;
+		}
+	}
 	struct Flight {
 		unsigned tmu;
 		size_t issued_at;

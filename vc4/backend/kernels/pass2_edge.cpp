@@ -55,17 +55,19 @@ constexpr Reg THR = B(21), CC = B(22), COLMASK = B(23), MASKACC = B(24), VDWS = 
 
 Dst tmuS(unsigned k) { return (k & 1) ? reg::tmu1_s : reg::tmu0_s; }
 
-// The gathers of column c for the row whose bases are in BASE (`next`: the row after it,
-// through the lane patterns that include a pitch), with their consumers.
-std::vector<Gather> column(int c, bool next)
+// The gathers of column c: plane 0 of rows `from` .. `from + n - 1` (bases BASE[from]..)
+// into the window rows `to` .., and the tensor planes of the row whose bases are in BASE
+// (or none), for the row of BASE (`next`: the row after it, through the lane patterns
+// that include a pitch), with their consumers.
+std::vector<Gather> column(int c, bool next, int from, int to, int n, bool tensor)
 {
 	std::vector<Gather> out;
 	const Reg off = next ? LANEOFFN[c] : LANEOFF[c];
-	for (int r = 0; r < 3; ++r)
-		out.push_back({add(tmuS(out.size()), BASE[r], off), static_cast<unsigned>(out.size() & 1),
-		               {ins(mmov(BV[r][c], r4))}});
+	for (int r = 0; r < n; ++r)
+		out.push_back({add(tmuS(out.size()), BASE[from + r], off), static_cast<unsigned>(out.size() & 1),
+		               {ins(mmov(BV[to + r][c], r4))}});
 	const Reg *sums[3] = {SX, SY, SZ};
-	for (int p = 0; p < 3; ++p) {
+	for (int p = 0; tensor && p < 3; ++p) {
 		Gather g{add(tmuS(out.size()), BASE[3 + p], off), static_cast<unsigned>(out.size() & 1), {}};
 		if (c <= 3)
 			g.consume.push_back(ins(mmov(sums[p][c], r4)));
@@ -76,13 +78,33 @@ std::vector<Gather> column(int c, bool next)
 	return out;
 }
 
+// In the row loop only the window's new row (D) of plane 0 is gathered.
 std::vector<Gather> columns(std::initializer_list<int> cs, bool next)
 {
 	std::vector<Gather> out;
 	for (int c : cs)
-		for (const Gather &g : column(c, next))
+		for (const Gather &g : column(c, next, 2, 2, 1, true))
 			out.push_back(g);
 	return out;
+}
+
+// The window moves down a row in columns `cs` (their last reader is done): U = C, C = D.
+std::vector<MulOp> shift(std::initializer_list<int> cs)
+{
+	std::vector<MulOp> out;
+	for (int c : cs) {
+		out.push_back(mmov(BV[0][c], BV[1][c]));
+		out.push_back(mmov(BV[1][c], BV[2][c]));
+	}
+	return out;
+}
+
+// One phase of the row: the decisions of a sub-pixel with the window's shift of `cs` at
+// its start (before any result lands) and the gathers `g`.
+void phase(Builder &b, std::vector<Ins> compute, std::initializer_list<int> cs, std::vector<Gather> g, size_t keep)
+{
+	const size_t hold = Builder::mergeMul(compute, shift(cs));
+	b.interleave(std::move(compute), std::move(g), keep, hold);
 }
 
 // Sub-pixel j: the edge and corner decisions, the byte packed into OUTW's byte j.
@@ -210,26 +232,31 @@ Built build()
 		b.op(mov(EDST, b.uniform("edge_dst", UniformKind::Address)));
 		b.op(mov(MDST, b.uniform("mask_dst", UniformKind::Address)));
 		b.op(mov(MASKACC, imm(0)));
-		// The first row's columns 0 .. 2.
-		b.interleave({}, columns({0, 1, 2}, false));
+		// The first row's window: rows y0-1 .. y0+1 of columns 0 .. 2 with their tensor
+		// sums, rows y0-1 and y0 of columns 3 .. 5 (in C and D: phase A moves them up).
+		std::vector<Gather> first;
+		for (int c = 0; c < 6; ++c)
+			for (const Gather &g : c < 3 ? column(c, false, 0, 0, 3, true) : column(c, false, 0, 1, 2, false))
+				first.push_back(g);
+		b.interleave({}, std::move(first));
 		b.ldi(GRPCNT, 4);
 		Label group = b.label();
 		{
+			// The VPM write setup advances a row a write: set once for four rows.
+			b.op(mov(reg::vw_setup, VPMROW));
 			b.ldi(ROWCNT, 4);
 			Label row = b.label();
 			{
-				b.interleave(decide(0), columns({3, 4}, false), 6);
-				b.interleave(decide(1), columns({5}, false), 6);
-				b.interleave(decide(2), columns({0, 1}, true), 12);
+				phase(b, decide(0), {3, 4, 5}, columns({3, 4}, false), 4);
+				phase(b, decide(1), {}, columns({5}, false), 4);
+				phase(b, decide(2), {0, 1}, columns({0, 1}, true), 8);
 				std::vector<Ins> tail = decide(3);
 				// The row's word: interior only; into the VPM and the tile mask.
 				tail.push_back(ins(band(r0, COLMASK, reg::unif)));
 				tail.push_back(ins(band(r0, OUTW, r0)));
-				tail.push_back(ins(mov(reg::vw_setup, VPMROW)));
 				tail.push_back(ins(mov(reg::vpm_write, r0)));
 				tail.push_back(ins(bor(MASKACC, MASKACC, r0)));
-				tail.push_back(ins(add(VPMROW, VPMROW, imm(1))));
-				b.interleave(std::move(tail), columns({2}, true), 0);
+				phase(b, std::move(tail), {2}, columns({2}, true), 0);
 				// The next row's bases.
 				for (int k = 0; k < 3; ++k)
 					b.op(add(BASE[k], BASE[k], PITCH));
@@ -237,7 +264,6 @@ Built build()
 			b.loopEnd(row, ROWCNT, {add(BASE[3], BASE[3], PITCH), add(BASE[4], BASE[4], PITCH),
 			                        add(BASE[5], BASE[5], PITCH)});
 			// Four rows out; flip to the other VPM half.
-			b.op(sub(VPMROW, VPMROW, imm(4)));
 			b.op(bxor(VPMROW, VPMROW, imm(4)));
 			b.op(mov(reg::nop, reg::vw_wait));
 			b.op(mov(reg::nop, reg::mutex_acq));
