@@ -5,15 +5,17 @@
 // Lane i holds pixels x0 + 4i + j, j = 0..3 (four sub-pixels), so the four result bytes
 // pack into the lane's word (regfile-A byte packs) and one 16-word VPM row is a 64-pixel
 // image row. The six columns c = 0..5 at x0 + 4i + c - 1 cover the 3x3 neighbourhoods
-// of all four sub-pixels, so a row needs 36 gathers for 64 pixels: plane 0 (B = m << 2 |
-// dir) of rows y-1, y, y+1 and the column sums Vxx, Vyy, Vxy of row y, per column. Their
-// per-lane addresses are a row base plus a lane pattern (kernels.hpp's interleaved layout),
-// and the tensor's horizontal sums are formed as the columns arrive:
+// of all four sub-pixels. Plane 0 (B = m << 2 | dir) of rows y-1, y, y+1 is a window in
+// registers that moves down a row at a time, so a row gathers 24 words a lane for 64
+// pixels: plane 0 of row y+1 and the column sums Vxx, Vyy, Vxy of row y, per column.
+// Their per-lane addresses are a row base plus a lane pattern (kernels.hpp's interleaved
+// layout), and the tensor's horizontal sums are formed as the columns arrive:
 //   S_j = V(c = j) + V(j + 1) + V(j + 2).
 // The gathers are software-pipelined across the sub-pixels (Builder::interleave, at most
 // kTmuDepth in flight): sub-pixel 0 computes while columns 3 and 4 arrive, 1 while column
 // 5 does, 2 and 3 while the next row's columns 0 .. 2 land where sub-pixels 0 .. 2 no
-// longer look. The decisions are those of frappe-core's edgeSpan/isCorner:
+// longer look (a column's window moves once its last reader is done).
+// The decisions are those of frappe-core's edgeSpan/isCorner:
 //   edge   : B > thr << 2 | 3, m > m(prev), m >= m(next)
 //            (B(prev) < B & ~3 and B(next) < (B & ~3) + 4: no unpacking of m)
 //   corner : c = (Sxx + Syy - 2T) >> 9, a = |Sxx - Syy| >> 9, b = |Sxy| >> 8,
