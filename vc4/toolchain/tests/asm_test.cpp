@@ -348,15 +348,19 @@ TEST(Lint, TmuRequestCounting)
 	a.nop(Sig::LoadTmu0);
 	a.thrend();
 	EXPECT_TRUE(has(lintOf(a), Hazard::LdtmuWithoutRequest));
-	// Five requests in flight, split over both TMUs: the depth counts per QPU, so this
-	// fails at depth 4 (the default build) and passes at 8.
-	Assembler b;
-	for (int i = 0; i < 5; ++i)
-		b.emit(mov(i % 2 ? reg::tmu1_s : reg::tmu0_s, r0));
-	for (int i = 0; i < 5; ++i)
-		b.nop(i % 2 ? Sig::LoadTmu1 : Sig::LoadTmu0);
-	b.thrend();
-	const auto code = b.finish(false).code;
+	// n requests alternating over the TMUs, then their pops.
+	auto inFlight = [](int n) {
+		Assembler b;
+		for (int i = 0; i < n; ++i)
+			b.emit(mov(i % 2 ? reg::tmu1_s : reg::tmu0_s, r0));
+		for (int i = 0; i < n; ++i)
+			b.nop(i % 2 ? Sig::LoadTmu1 : Sig::LoadTmu0);
+		b.thrend();
+		return b.finish(false).code;
+	};
+	// Five in flight, split over both TMUs: the depth counts per QPU, so this fails at
+	// depth 4 (the default build) and passes at 8.
+	const auto code = inFlight(5);
 	const auto at4 = lint(code, 4);
 	ASSERT_EQ(at4.size(), 1u);
 	EXPECT_EQ(at4[0].hazard, Hazard::TmuTooManyOutstanding);
@@ -374,11 +378,5 @@ TEST(Lint, TmuRequestCounting)
 	ok.thrend();
 	EXPECT_TRUE(lint(ok.finish(false).code, 4).empty());
 	// Nine in flight fail even at depth 8.
-	Assembler nine;
-	for (int i = 0; i < 9; ++i)
-		nine.emit(mov(i % 2 ? reg::tmu1_s : reg::tmu0_s, r0));
-	for (int i = 0; i < 9; ++i)
-		nine.nop(i % 2 ? Sig::LoadTmu1 : Sig::LoadTmu0);
-	nine.thrend();
-	EXPECT_TRUE(has(lint(nine.finish(false).code, 8), Hazard::TmuTooManyOutstanding));
+	EXPECT_TRUE(has(lint(inFlight(9), 8), Hazard::TmuTooManyOutstanding));
 }
