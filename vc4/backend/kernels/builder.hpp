@@ -175,9 +175,10 @@ public:
 				op(k.add, k.mul);
 				continue;
 			}
-			// 2. Pop the oldest request once it is ripe: on the next request's instruction
-			// while there is room for both, on a compute instruction that can carry the
-			// signal if one comes within a few, alone when nothing else is left.
+			// 2. Pop the oldest request once it is ripe: on a compute instruction that can
+			// carry the signal if one comes within a few, alone when nothing else is left.
+			// Never on a TMU request: the guide does not say that a request and a pop may
+			// share an instruction (it would save 2% of pass 2; try it on hardware first).
 			if (!flight_.empty() && c >= hold) {
 				const Flight &f = flight_.front();
 				const size_t age = at - f.issued_at;
@@ -185,10 +186,8 @@ public:
 				const bool idle = c >= compute.size() && !can_issue;
 				const bool rides = c < compute.size() && fits(compute[c].add, compute[c].mul, sig);
 				if (idle || age >= latency) {
-					enum { Alone, WithIssue, WithCompute, Wait } how = Wait;
-					if (can_issue && fits(gathers[g].issue, MulOp{}, sig))
-						how = WithIssue;
-					else if (rides)
+					enum { Alone, WithCompute, Wait } how = Wait;
+					if (rides)
 						how = WithCompute;
 					else if (idle || age >= latency + 3 || c >= compute.size())
 						how = Alone;
@@ -196,10 +195,7 @@ public:
 						for (const Ins &k : f.consume)
 							consume_.push_back(k);
 						flight_.pop_front();
-						if (how == WithIssue) {
-							op(gathers[g].issue, MulOp{}, sig);
-							issued(gathers[g++], at);
-						} else if (how == WithCompute) {
+						if (how == WithCompute) {
 							op(compute[c].add, compute[c].mul, sig);
 							++c;
 						} else {
@@ -209,9 +205,8 @@ public:
 					}
 				}
 			}
-			// 3. Issue the next request while a slot stays free for an issue with a pop,
-			// beside a MUL-only compute instruction if one is next.
-			if (can_issue && flight_.size() + 1 < kTmuDepth) {
+			// 3. Issue the next request, beside a MUL-only compute instruction if one is next.
+			if (can_issue) {
 				MulOp m;
 				if (c < compute.size() && !busy(compute[c].add) && fits(gathers[g].issue, compute[c].mul, isa::Sig::None))
 					m = compute[c++].mul;
