@@ -54,7 +54,8 @@ struct Geometry {
 	{
 		uint32_t best = 1;
 		uint64_t best_cost = ~uint64_t{0};
-		for (uint32_t nb = 1; nb <= std::max(1, h / 16); ++nb) {
+		const uint32_t most = static_cast<uint32_t>(std::max(1, h / 16));
+		for (uint32_t nb = 1; nb <= most; ++nb) {
 			const uint64_t per = (uint64_t{strips()} * nb + kPrograms - 1) / kPrograms;
 			const uint64_t cost = per * ((static_cast<uint32_t>(h) + nb - 1) / nb + 7);
 			if (cost < best_cost) {

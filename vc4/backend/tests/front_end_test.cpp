@@ -273,8 +273,9 @@ TEST(Vc4Kernels, ListingsRoundTrip)
 	// Both programs keep to the build's TMU depth, and the safe one always.
 	for (const auto &built : {k::gradientPass(), k::edgePass()}) {
 		EXPECT_TRUE(vc4::qasm::lint(built.program.code, vc4::kTmuDepth).empty()) << built.program.name;
-		if (vc4::kTmuDepth == 4)
+		if (vc4::kTmuDepth == 4) {
 			EXPECT_TRUE(vc4::qasm::lint(built.program.code, 4).empty()) << built.program.name;
+		}
 	}
 	for (const auto &built : {vc4::kernels::gradientPass(), vc4::kernels::edgePass()}) {
 		EXPECT_EQ(vc4::qasm::assembleText(vc4::isa::disassembleProgram(built.program.code)), built.program.code)
