@@ -15,12 +15,12 @@
 namespace frappe::vc4 {
 
 /// An emulated V3D with at least `bytes` of memory (plus 1 MiB for code and uniforms),
-/// strict hazard checks as `options` asks, and the hardware's reliable TMU FIFO depth.
+/// strict hazard checks as `options` asks, and the build's TMU depth.
 inline std::unique_ptr<emu::Device> openEmulator(const FrontEndOptions &options, uint32_t bytes)
 {
 	emu::Config config;
 	config.strict = options.strict;
-	config.tmu_fifo_limit = 4; // what the hardware does reliably (vc4asm addendum)
+	config.tmu_fifo_limit = kTmuDepth; // the build's depth, per QPU (tmu_depth.hpp)
 	const uint32_t mib = 1u << 20;
 	return std::make_unique<emu::Device>(config, (bytes + mib + mib - 1) / mib * mib);
 }

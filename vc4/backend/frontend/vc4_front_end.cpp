@@ -42,12 +42,41 @@ struct Geometry {
 	uint32_t gradPitch() const { return 16 * paddedW(); }
 	uint32_t gradBytes() const { return gradPitch() * paddedH(); }
 	/// Pass 2 reads border pixels' neighbours unclamped: a margin of a row and more.
-	uint32_t gradMargin() const { return gradPitch() + 64; }
+	uint32_t gradMargin() const { return kernels::gradMargin(gradPitch()); }
 	uint32_t edgeBytes() const { return paddedW() * paddedH(); }
 	uint32_t maskBytes() const { return 128 * tiles(); }
-	uint32_t uniformWords(unsigned per_tile) const
+
+	/// Pass 1: four strips a 64-pixel group, over the bands that balance the QPUs best
+	/// (a band pays 6 rows to fill the window and about one for its setup).
+	uint32_t strips() const { return 4 * tilesX(); }
+	uint32_t bands() const
 	{
-		return (per_tile + 1) * ((tiles() + kPrograms - 1) / kPrograms);
+		uint32_t best = 1;
+		uint64_t best_cost = ~uint64_t{0};
+		const uint32_t most = static_cast<uint32_t>(std::max(1, h / 16));
+		for (uint32_t nb = 1; nb <= most; ++nb) {
+			const uint64_t per = (uint64_t{strips()} * nb + kPrograms - 1) / kPrograms;
+			const uint64_t cost = per * ((static_cast<uint32_t>(h) + nb - 1) / nb + 7);
+			if (cost < best_cost) {
+				best_cost = cost;
+				best = nb;
+			}
+		}
+		return best;
+	}
+	uint32_t gradientUnits() const { return strips() * bands(); }
+	/// Pass 2: half tiles.
+	uint32_t edgeUnits() const { return tilesX() * (paddedH() / kernels::kEdgeRows); }
+	uint32_t gradientUniformBytes() const
+	{
+		const uint32_t rows = (static_cast<uint32_t>(h) + bands() - 1) / bands();
+		const uint32_t per = kernels::kGradientUnitUniforms + kernels::gradientRowUniformCount(static_cast<int>(rows)) + 1;
+		return 4 * (kernels::kGradientUniforms + per * ((gradientUnits() + kPrograms - 1) / kPrograms));
+	}
+	uint32_t edgeUniformBytes() const
+	{
+		const uint32_t per = kernels::kEdgeUnitUniforms + kernels::kEdgeRows + 1;
+		return 4 * (kernels::kEdgeUniforms + per * ((edgeUnits() + kPrograms - 1) / kPrograms));
 	}
 };
 
@@ -88,6 +117,8 @@ struct SharedBackend {
 			const emu::LaunchStats s = runOnEmulator(context->device(), jobs, context->options());
 			c.instructions = s.instructions;
 			c.slowest_cycles = s.cycles;
+			c.dram_read = s.traffic.read();
+			c.dram_written = s.traffic.vdw_written;
 		} else {
 			context->device().wait(context->device().launch(jobs));
 		}
@@ -147,43 +178,58 @@ public:
 		const uint32_t cornerC = 2u * static_cast<uint32_t>(static_cast<int32_t>(params.corner_threshold));
 		const uint32_t pitch = g.gradPitch(), pw = g.paddedW();
 		const uint32_t grad = buf_.grad.bus + g.gradMargin();
-
 		const unsigned tiles = g.tiles();
-		const unsigned programs = std::min(kPrograms, tiles);
+
 		// Uniform streams straight into the device buffers (no allocation per frame).
-		for (unsigned p = 0; p < programs; ++p) {
-			uint8_t *p1 = buf_.unif[0][p].cpu.data(), *p2 = buf_.unif[1][p].cpu.data();
-			for (unsigned t = p; t < tiles; t += kPrograms) {
-				const uint32_t x0 = (t % g.tilesX()) * kTileW, y0 = (t / g.tilesX()) * kTileH;
-				const kernels::GradientUniforms u1{
-					static_cast<uint32_t>(g.src_w - 1), stepX, static_cast<uint32_t>(g.w - 1), x0,
-					grad + y0 * pitch + 4 * x0, pitch,
-					isa::VdwStride{.stride = static_cast<uint16_t>(pitch / 4 - 64)}.word()};
-				const kernels::EdgeUniforms u2{
-					grad, pitch, pitch / 4, static_cast<uint32_t>(g.w - 2), static_cast<uint32_t>(g.h - 2),
-					x0, y0, edgeThr, cornerC, buf_.edge.bus + y0 * pw + x0,
-					isa::VdwStride{.stride = static_cast<uint16_t>(pw - 64)}.word(), 4 * pw,
-					buf_.mask.bus + 128 * t};
-				std::memcpy(p1, &u1, sizeof(u1));
-				p1 += sizeof(u1);
-				for (int strip = 0; strip < 4; ++strip) {
-					uint32_t rows[kernels::kGradientRowUniforms];
-					kernels::gradientRowUniforms(rows, src.bus, stride, g.src_h, stepY, g.h, static_cast<int>(y0));
-					std::memcpy(p1, rows, sizeof(rows));
-					p1 += sizeof(rows);
+		// Pass 1: strip k of band b is unit b * strips + k, on program unit % 12.
+		const unsigned units[2] = {g.gradientUnits(), g.edgeUnits()};
+		const unsigned programs[2] = {std::min(kPrograms, units[0]), std::min(kPrograms, units[1])};
+		const uint32_t bands = g.bands(), strips = g.strips();
+		for (unsigned p = 0; p < programs[0]; ++p) {
+			const kernels::GradientUniforms head{static_cast<uint32_t>(g.src_w - 1), stepX,
+				static_cast<uint32_t>(g.w - 1), pitch,
+				isa::VdwStride{.stride = static_cast<uint16_t>(pitch / 4 - 64)}.word()};
+			uint8_t *at = put(buf_.unif[0][p].cpu.data(), &head, sizeof(head));
+			for (unsigned u = p; u < units[0]; u += kPrograms) {
+				const uint32_t band = u / strips, strip = u % strips;
+				const int y0 = static_cast<int>(band * static_cast<uint32_t>(g.h) / bands);
+				const int y1 = static_cast<int>((band + 1) * static_cast<uint32_t>(g.h) / bands);
+				const uint32_t x = strip / 4 * kTileW + strip % 4;
+				const kernels::GradientUnit unit{x, grad + static_cast<uint32_t>(y0) * pitch + 4 * kernels::gradWord(x),
+				                                 static_cast<uint32_t>(y1 - y0)};
+				at = put(at, &unit, sizeof(unit));
+				at = reinterpret_cast<uint8_t *>(kernels::gradientRowUniforms(reinterpret_cast<uint32_t *>(at),
+					src.bus, stride, g.src_h, stepY, g.h, y0, y1 - y0));
+				at = more(at, u + kPrograms < units[0]);
+			}
+		}
+		// Pass 2: half tiles in raster order, unit u on program u % 12.
+		for (unsigned p = 0; p < programs[1]; ++p) {
+			const kernels::EdgeUniforms head{pitch, edgeThr, cornerC,
+				isa::VdwStride{.stride = static_cast<uint16_t>(pw - 64)}.word(), 4 * pw};
+			uint8_t *at = put(buf_.unif[1][p].cpu.data(), &head, sizeof(head));
+			for (unsigned u = p; u < units[1]; u += kPrograms) {
+				const uint32_t x0 = (u % g.tilesX()) * kTileW, y0 = (u / g.tilesX()) * kernels::kEdgeRows;
+				const uint32_t t = (u / g.tilesX() / 2) * g.tilesX() + u % g.tilesX();
+				const kernels::EdgeUnit unit{x0, static_cast<uint32_t>(g.w - 2), grad + (y0 - 1) * pitch + 4 * x0,
+				                             pitch / 4, buf_.edge.bus + y0 * pw + x0,
+				                             buf_.mask.bus + 128 * t + 64 * (u / g.tilesX() % 2)};
+				at = put(at, &unit, sizeof(unit));
+				for (int r = 0; r < kernels::kEdgeRows; ++r) {
+					const int y = static_cast<int>(y0) + r;
+					const uint32_t m = y >= 1 && y <= g.h - 2 ? 0xffffffffu : 0u;
+					at = put(at, &m, 4);
 				}
-				const uint32_t more = t + kPrograms < tiles ? 1u : 0u;
-				std::memcpy(p1, &more, 4);
-				p1 += 4;
-				p2 = append(p2, &u2, sizeof(u2), t + kPrograms < tiles);
+				at = more(at, u + kPrograms < units[1]);
 			}
 		}
 		for (int pass = 0; pass < 2; ++pass) {
 			std::array<JobType, kPrograms> jobs;
-			for (unsigned p = 0; p < programs; ++p)
+			for (unsigned p = 0; p < programs[pass]; ++p)
 				jobs[p] = {buf_.unif[pass][p].bus, buf_.code[pass].bus};
 			counts_.pass[pass].tiles = tiles;
-			backend_.template run<JobType>(std::span<const JobType>(jobs.data(), programs), counts_.pass[pass]);
+			counts_.pass[pass].units = units[pass];
+			backend_.template run<JobType>(std::span<const JobType>(jobs.data(), programs[pass]), counts_.pass[pass]);
 		}
 		runRegions(RegionSource{src.bus, stride, g.src_w, g.src_h, stepX, stepY}, params, out);
 		counted_ = true;
@@ -246,12 +292,15 @@ private:
 		region_.run(src, params.region_contrast, out.scale, launch, counts_.region, out.regions);
 	}
 
-	static uint8_t *append(uint8_t *at, const void *block, size_t bytes, bool more)
+	static uint8_t *put(uint8_t *at, const void *words, size_t bytes)
 	{
-		const uint32_t m = more ? 1u : 0u;
-		std::memcpy(at, block, bytes);
-		std::memcpy(at + bytes, &m, 4);
-		return at + bytes + 4;
+		std::memcpy(at, words, bytes);
+		return at + bytes;
+	}
+	static uint8_t *more(uint8_t *at, bool another)
+	{
+		const uint32_t m = another ? 1u : 0u;
+		return put(at, &m, 4);
 	}
 
 	// Device buffers for this geometry; kept while the geometry does not change.
@@ -259,8 +308,8 @@ private:
 	{
 		if (device_ && g == geometry_)
 			return;
-		const uint32_t u1 = 4 * g.uniformWords(kernels::kGradientUniforms + 4 * kernels::kGradientRowUniforms);
-		const uint32_t u2 = 4 * g.uniformWords(kernels::kEdgeUniforms);
+		const uint32_t u1 = g.gradientUniformBytes();
+		const uint32_t u2 = g.edgeUniformBytes();
 		if (device_)
 			region_.release(*device_);
 		device_ = &backend_.open(buf_);

@@ -35,7 +35,10 @@ struct PassCounts {
 	uint64_t instructions = 0;    // all QPUs
 	uint64_t slowest_cycles = 0;  // the slowest QPU of the launch
 	unsigned tiles = 0;           // 64x32 tiles
+	unsigned units = 0;           // work units (pass 1: strips of a band; pass 2: half tiles)
 	unsigned programs = 0;        // QPUs used
+	uint64_t dram_read = 0;       // bytes the QPUs read: TMU gathers, VDR, uniforms
+	uint64_t dram_written = 0;    // bytes the QPUs wrote (VDW)
 };
 struct FrameCounts {
 	PassCounts pass[2];

@@ -2,23 +2,26 @@
 // The QPU kernels of Frappe's front end (issue 6), reproducing frappe-core's CPU front end
 // (frappe-core/src/front_end_cpu.cpp) byte for byte.
 //
-// Two passes over 64x32-pixel tiles of the scaled frame. A program invocation takes a list
-// of tiles: its uniform stream is one block per tile (the structs below, in order), each
-// followed by a `more` word, non-zero when another block follows. One launch of 12 programs
-// covers a frame (tile t goes to program t % 12).
+// Two passes over the scaled frame, one launch of 12 programs each. A program invocation
+// takes a list of work units: its uniform stream is a header (the first struct below) then
+// one block per unit, each followed by a `more` word, non-zero when another block follows.
 //
-//  pass 1, gradientPass(): nearest-neighbour scaled fetch (per-lane TMU gathers whose
-//    addresses implement scaleNearest's fixed-point mapping and the edge replication),
-//    binomial smoothing, separable Sobel, squared magnitude, the four-way direction, and
-//    the structure tensor's products summed over the three rows y-1 .. y+1.
-//  pass 2, edgePass(): non-maximum suppression and the edge threshold, the Shi-Tomasi
-//    minimum-eigenvalue test and corner threshold, and the 16x16 empty-tile mask.
+//  pass 1, gradientPass(): units are strips of 16 lanes (pixels x + 4i of a 64-pixel
+//    group) over a band of rows. Nearest-neighbour scaled fetch (per-lane TMU gathers
+//    whose addresses implement scaleNearest's fixed-point mapping and the edge
+//    replication), binomial smoothing, separable Sobel, squared magnitude, the four-way
+//    direction, and the structure tensor's products summed over the rows y-1 .. y+1.
+//  pass 2, edgePass(): units are 64x16 half tiles. Non-maximum suppression and the edge
+//    threshold, the Shi-Tomasi minimum-eigenvalue test and corner threshold, and the
+//    16x16 empty-tile mask.
 //
-// Gradient buffer (pass 1 -> pass 2): four 32-bit planes per pixel of the scaled frame,
-// rows interleaved so that one 4-row VDW stores one image row of a 16-pixel strip:
-//   byte offset of plane k at (x, y) = y * gradPitch + k * gradPitch / 4 + 4 x
-//   gradPitch = 16 * paddedWidth (paddedWidth = width rounded up to 64), rows up to the
-//   height rounded up to 32.
+// Gradient buffer (pass 1 -> pass 2): four 32-bit planes per pixel of the scaled frame.
+// A row of a plane is paddedWidth words (width rounded up to 64), interleaved within each
+// 64-pixel group so that the 16 pixels x0 + 4i + j (i = 0..15) are one 16-word run: word
+// gradWord(x) = (x & ~63) + 16 (x & 3) + (x & 63) / 4. Rows interleave the planes, so one
+// 4-row VDW stores one image row of a pass-1 strip:
+//   byte offset of plane k at (x, y) = y * gradPitch + k * gradPitch / 4 + 4 gradWord(x)
+//   gradPitch = 16 * paddedWidth; rows 0 .. height-1 are written.
 //   plane 0: B = m << 2 | dir      m = gx^2 + gy^2 < 2^21
 //   plane 1..3: Vxx, Vyy, Vxy = sum over rows y-1 .. y+1 of gx^2, gy^2, gx*gy (signed)
 //   dir: 0 horizontal (compare left/right), 1 vertical (up/down),
@@ -26,15 +29,18 @@
 // gx = gy = 0 on the outermost rows and columns, as in the CPU's gradient rows. B keeps the
 // direction beside m: B > thr << 2 | 3 decides m > thr without unpacking. Products go
 // through mul24 on |gx|, |gy| (24-bit unsigned operands) with the sign put back, so every
-// value is exact.
+// value is exact. Pass 2 reads a row above and below every row and a word left and right
+// of every group: the buffer needs a margin (gradMargin()) on both sides.
 //
 // Edge output: one byte per pixel (EdgeMap::kEdge | kCorner), rows of paddedWidth bytes.
-// Pass 2 lanes hold pixels 4i + j (j = 0..3 in four sub-passes), so four bytes pack into the
-// lane's word and a 16-word VPM row is a 64-pixel image row.
+// Pass 2 lanes hold pixels 4i + j (j = 0..3), so four bytes pack into the lane's word and
+// a 16-word VPM row is a 64-pixel image row.
 // Mask output: per tile two rows of 16 words (rows 0-15 and 16-31 of the tile); word 4t+3
 // of a row is non-zero when the 16x16 block t of those rows holds an edge pixel (it is
 // the OR of the block's edge bytes; the other words are partial ORs, ignored).
 //
+// TMU: at most kTmuDepth (tmu_depth.hpp, meson option vc4_tmu_depth) requests in flight
+// per QPU, both TMUs together; the lint and the emulator's strict mode hold both passes to it.
 // VPM: each QPU uses the 8 rows starting at 8 * qpu_num (96 of the 192 rows), so twelve
 // invocations run at once with no locking of VPM space; VDW setup and start are done under
 // the hardware mutex, as GPU_FFT does, because the guide does not say that the VCD's setup
@@ -50,28 +56,42 @@ namespace frappe::vc4::kernels {
 inline constexpr int kTileW = 64;
 inline constexpr int kTileH = 32;
 inline constexpr int kMaxWidth = 2048;
+/// Rows of a pass-2 unit (half a tile: one mask row).
+inline constexpr int kEdgeRows = 16;
 
-/// Pass 1 uniforms of one tile, in stream order; then for each of the four 16-pixel
-/// strips the kGradientRowUniforms words of gradientRowUniforms(); then `more`.
+/// The word of pixel x in a gradient-buffer row (the interleaved 64-pixel groups).
+inline constexpr uint32_t gradWord(uint32_t x) { return (x & ~63u) + 16 * (x & 3u) + ((x & 63u) >> 2); }
+/// Bytes before and after the gradient rows that pass 2 may read: a row above the first,
+/// two below the last (a unit's last row gathers the next row's first columns), and a
+/// group's worth of words beside them.
+inline constexpr uint32_t gradMargin(uint32_t grad_pitch) { return 2 * grad_pitch + 256; }
+
+/// Pass 1 uniforms: the header, once per program.
 struct GradientUniforms {
 	uint32_t src_wmax;   ///< full width - 1
 	uint32_t step_x;     ///< round(65536 * full width / scaled width), as scaleNearest
 	uint32_t wmax;       ///< scaled width - 1
-	uint32_t x0;         ///< tile origin in the scaled frame
-	uint32_t dst;        ///< bus address of plane 0 at (x0, y0) in the gradient buffer
 	uint32_t dst_pitch;  ///< gradPitch
 	uint32_t vdw_stride; ///< VdwStride word: gradPitch / 4 - 64
 };
 inline constexpr unsigned kGradientUniforms = sizeof(GradientUniforms) / 4;
-/// Per strip: the source-row address of input row y0-3, then for i = 0 .. 37 the address
-/// of input row y0-2+i and the interior mask of gradient row y0-5+i (-1 for rows 1 .. h-2,
-/// else 0). A row address is src + stride * min(H-1, ((2 clamp(r, 0, h-1) + 1) step_y) >> 17)
-/// (scaleNearest's row, edge replicated); src and stride must be multiples of 4.
-inline constexpr unsigned kGradientRowUniforms = 1 + 2 * 38;
+/// Pass 1 unit: a strip over a band of rows; then gradientRowUniforms(rows) words, `more`.
+struct GradientUnit {
+	uint32_t x;    ///< lane i holds pixel x + 4i (x = x0 + strip, x0 a multiple of 64)
+	uint32_t dst;  ///< bus address of plane 0 at (x, y0): the strip's 16-word run
+	uint32_t rows; ///< rows of the band, y0 .. y0 + rows - 1
+};
+inline constexpr unsigned kGradientUnitUniforms = sizeof(GradientUnit) / 4;
+/// Row words of a band of `rows` rows.
+inline constexpr unsigned gradientRowUniformCount(int rows) { return 1 + 2 * (static_cast<unsigned>(rows) + 6); }
 
-/// Writes one strip's kGradientRowUniforms words for the tile at y0.
+/// Writes a band's row words: the source-row address of input row y0-3, then for
+/// i = 0 .. rows+5 the address of input row y0-2+i and the interior mask of gradient row
+/// y0-5+i (-1 for rows 1 .. h-2, else 0). A row address is
+/// src + stride * min(H-1, ((2 clamp(r, 0, h-1) + 1) step_y) >> 17) (scaleNearest's row,
+/// edge replicated); src and stride must be multiples of 4.
 inline uint32_t *gradientRowUniforms(uint32_t *out, uint32_t src, uint32_t stride, int src_h, uint32_t step_y,
-                                     int h, int y0)
+                                     int h, int y0, int rows)
 {
 	auto row = [&](int r) {
 		const int y = r < 0 ? 0 : r > h - 1 ? h - 1 : r;
@@ -79,7 +99,7 @@ inline uint32_t *gradientRowUniforms(uint32_t *out, uint32_t src, uint32_t strid
 		return src + stride * static_cast<uint32_t>(sy < static_cast<uint64_t>(src_h - 1) ? sy : src_h - 1);
 	};
 	*out++ = row(y0 - 3);
-	for (int i = 0; i < 38; ++i) {
+	for (int i = 0; i < rows + 6; ++i) {
 		const int g = y0 - 5 + i;
 		*out++ = row(y0 - 2 + i);
 		*out++ = g >= 1 && g <= h - 2 ? 0xffffffffu : 0u;
@@ -87,23 +107,26 @@ inline uint32_t *gradientRowUniforms(uint32_t *out, uint32_t src, uint32_t strid
 	return out;
 }
 
-/// Pass 2 uniforms of one tile, in stream order (then `more`).
+/// Pass 2 uniforms: the header, once per program.
 struct EdgeUniforms {
-	uint32_t grad;       ///< bus address of the gradient buffer (plane 0 at (0, 0))
 	uint32_t grad_pitch; ///< gradPitch
-	uint32_t plane;      ///< gradPitch / 4
-	uint32_t wm2;        ///< scaled width - 2
-	uint32_t hm2;        ///< scaled height - 2
-	uint32_t x0;
-	uint32_t y0;
 	uint32_t edge_thr;   ///< clamp(edge_threshold_sq, -1, 2^22) << 2 | 3
 	uint32_t corner_c;   ///< 2 * corner_threshold (int32 arithmetic, as the CPU)
-	uint32_t edge_dst;   ///< bus address of byte (x0, y0) of the edge buffer
 	uint32_t vdw_stride; ///< VdwStride word: edge pitch - 64
 	uint32_t edge_pitch4;///< 4 * edge pitch: one block of four rows
-	uint32_t mask_dst;   ///< bus address of this tile's 2 x 16 mask words
 };
 inline constexpr unsigned kEdgeUniforms = sizeof(EdgeUniforms) / 4;
+/// Pass 2 unit: 64 x kEdgeRows pixels at (x0, y0); then the kEdgeRows rows' interior
+/// masks (-1 for rows 1 .. h-2, else 0), then `more`.
+struct EdgeUnit {
+	uint32_t x0;         ///< a multiple of 64
+	uint32_t wm2;        ///< scaled width - 2
+	uint32_t grad;       ///< bus address of plane 0 at (x0, y0 - 1) in the gradient buffer
+	uint32_t plane;      ///< gradPitch / 4
+	uint32_t edge_dst;   ///< bus address of byte (x0, y0) of the edge buffer
+	uint32_t mask_dst;   ///< bus address of the unit's 16 mask words
+};
+inline constexpr unsigned kEdgeUnitUniforms = sizeof(EdgeUnit) / 4;
 
 struct Built {
 	qasm::Program program;

@@ -2,13 +2,15 @@
 // Pass 1: scaled fetch, smoothing, Sobel, magnitude, direction and the vertical sums of the
 // structure tensor's products over one 64x32 tile (layout: kernels.hpp).
 //
-// Lanes hold 16 horizontally adjacent pixels; the tile is four 16-pixel strips, each
-// swept top to bottom with a sliding window. For input row R of a strip every lane
-// gathers the five source pixels at scaled columns x-2 .. x+2 through the TMUs (one
-// request per column, 16 per-lane addresses: this is where nearest scaling and edge
-// replication happen, so both are free; the source row's address and the row's interior
-// mask come from the uniform stream, kGradientRowUniforms a strip), and the window turns
-// them into:
+// A work unit is a strip of 16 lanes over a band of rows: lane i holds pixel x + 4i, so a
+// 64-pixel group is four strips (x = x0 .. x0+3) and each strip's output row is one
+// 16-word run of the gradient buffer (layout: kernels.hpp). The host cuts the frame into
+// bands that balance the 12 QPUs (each band pays 6 rows to fill the window). A strip is
+// swept top to bottom with a sliding window. For input row R every lane gathers the five
+// source pixels at scaled columns x-2 .. x+2 through the TMUs (one request per column,
+// 16 per-lane addresses: this is where nearest scaling and edge replication happen, so
+// both are free; the source row's address and the row's interior mask come from the
+// uniform stream, kernels::gradientRowUniforms()), and the window turns them into:
 //   t_k(R-1) = I_k(R-2) + 2 I_k(R-1) + I_k(R)            vertical binomial, k = -2..2
 //   p_j(R-1) = (t_{j-1} + 2 t_j + t_{j+1} + 8) >> 4        smoothed, j = -1..1
 //   hs = p_-1 + 2 p_0 + p_1,  hd = p_1 - p_-1              horizontal Sobel parts
@@ -17,10 +19,10 @@
 // the sums does not matter). The running sums keep two generations only (q = I + I',
 // G = hd + hd', F = hs - hs'), so the window needs no register rotation. The tensor's
 // vertical sums lag one more row: V(g-1) = S' + P(g), S = P' + P, P' = P.
-// The next row's gathers are issued as soon as this row's are popped: a whole row of
-// work hides the TMU latency, with at most 3 requests per TMU outstanding (the addendum's
-// limit is 4). Each output row (4 planes) leaves by one VDW, double-buffered in the QPU's
-// 8 VPM rows.
+// The next row's gathers are issued as soon as this row's are popped, so a whole row of
+// work hides the TMU latency: 4 in flight at most (kTmuDepth 4: row R's last column goes
+// out after its first is popped), or 5 with the 8-deep build. Each output row (4 planes)
+// leaves by one VDW, double-buffered in the QPU's 8 VPM rows.
 #include "isa/setup_words.hpp"
 #include "kernels/builder.hpp"
 #include "kernels/kernels.hpp"
@@ -33,8 +35,8 @@ namespace {
 // immediate takes B's), and ADD and MUL results of one instruction go to different files.
 constexpr Reg SWMAX = A(1), STEPX = A(2), WMAX = A(3), ROWADDR = A(5), DSTS = A(6),
 	      VPMW = A(7), C106 = A(8), HS = A(22), FP = A(23), COLMASK = A(25), PXX = A(26),
-	      SYY = A(27), PXY = A(28), CNT = A(29), STRIPCNT = A(30), VDWTOG = A(31);
-constexpr Reg DPITCH = B(4), DSTBASE = B(7), HD = B(20), GP = B(21), SXX = B(22),
+	      SYY = A(27), PXY = A(28), CNT = A(29), ELEM4 = A(30), VDWTOG = A(31);
+constexpr Reg DPITCH = B(4), ROWS = B(7), HD = B(20), GP = B(21), SXX = B(22),
 	      PYY = B(23), SXY = B(24), BPREV = B(25), VDWSTRIDE = B(26), VDWS = B(27),
 	      TMPB = B(29), XS = B(30);
 constexpr Reg COLOFF[5] = {B(8), B(9), B(10), B(11), B(12)};
@@ -42,6 +44,9 @@ constexpr Reg COLSH[5] = {A(9), A(10), A(11), A(12), A(13)};
 constexpr Reg T[5] = {A(14), B(13), A(15), B(14), A(16)};
 constexpr Reg Q[5] = {B(15), A(17), B(16), A(18), B(17)};
 constexpr Reg I[5] = {A(19), B(18), A(20), B(19), A(21)};
+
+// With 4 requests in flight a row's fifth column goes out only after its first is popped.
+constexpr bool kDeep = kTmuDepth >= 5;
 
 Dst tmuS(int k) { return (k & 1) ? reg::tmu1_s : reg::tmu0_s; }
 
@@ -53,10 +58,14 @@ Dst tmuS(int k) { return (k & 1) ? reg::tmu1_s : reg::tmu0_s; }
 void rowBody(Builder &b)
 {
 	for (int k = 0; k < 5; ++k) {
+		// The next row's address; r1 keeps this row's for its last column (4 deep).
 		if (k == 0)
-			b.ldtmu(0, mov(ROWADDR, reg::unif)); // the next row's address
+			b.ldtmu(0, mov(ROWADDR, rb(isa::raddr::uniform)), mmov(r1, ROWADDR));
 		b.op(shr(r2, r4, COLSH[k]));
-		b.op(add(tmuS(k), ROWADDR, COLOFF[k]), v8min(r2, r2, r5)); // r5 = 0xff: byte mask
+		// Issue column k of row R+1 (deep), or row R's column 4 then row R+1's k-1.
+		const int col = kDeep ? k : k == 0 ? 4 : k - 1;
+		const Src base = !kDeep && k == 0 ? Src(r1) : Src(ROWADDR);
+		b.op(add(tmuS(col), base, COLOFF[col]), v8min(r2, r2, r5)); // r5 = 0xff: byte mask
 		b.op(add(r3, I[k], r2), mmov(I[k], r2));                  // q = I(R-1) + I(R)
 		if (k < 4)
 			b.ldtmu((k + 1) & 1, add(T[k], Q[k], r3), mmov(Q[k], r3)); // t = q' + q
@@ -130,6 +139,7 @@ void rowOutput(Builder &b)
 
 // Store the finished row: wait for the previous row's VDW (it had a whole row of compute
 // to finish), then start this one and flip to the other VPM half.
+// (The next row's address and VPM halves are set in the loop's delay slots.)
 void storeRow(Builder &b)
 {
 	b.op(mov(reg::nop, reg::vw_wait));
@@ -138,9 +148,6 @@ void storeRow(Builder &b)
 	b.op(mov(reg::vw_setup, VDWS));
 	b.op(mov(reg::vw_addr, DSTS));
 	b.op(mov(reg::mutex_rel, imm(1)));
-	b.op(add(DSTS, DSTS, DPITCH));
-	b.op(bxor(VDWS, VDWS, VDWTOG));
-	b.op(bxor(VPMW, VPMW, imm(4)));
 }
 
 Built build()
@@ -158,22 +165,22 @@ Built build()
 	b.ldi(r2, isa::VdwSetup{.units = 4, .depth = 16, .horizontal = true, .vpm_base = 0, .modew = 0}.word());
 	b.op(shl(r1, r0, imm(10))); // Y = 8q at bit 7
 	b.op(add(VDWS, r2, r1));
-
-	Label tile = b.label();
+	b.op(mov(r0, reg::elem_num));
+	b.op(shl(ELEM4, r0, imm(2)));
 	b.op(mov(SWMAX, b.uniform("src_wmax")));
 	b.op(mov(STEPX, b.uniform("step_x")));
 	b.op(mov(WMAX, b.uniform("wmax")));
-	b.op(mov(XS, b.uniform("x0")));
-	b.op(mov(DSTBASE, b.uniform("dst", UniformKind::Address)));
 	b.op(mov(DPITCH, b.uniform("dst_pitch")));
 	b.op(mov(VDWSTRIDE, b.uniform("vdw_stride")));
-	b.ldi(STRIPCNT, 4);
 
-	Label strip = b.label();
+	Label unit = b.label();
 	{
+		b.op(mov(XS, b.uniform("x")));
+		b.op(mov(DSTS, b.uniform("dst", UniformKind::Address)));
+		b.op(mov(ROWS, b.uniform("rows")));
 		// Per-lane source columns of x-2 .. x+2 (clamped to the scaled frame, then
 		// mapped like scaleNearest) and the interior-column term (x-1) | (w-2-x).
-		b.op(add(r0, XS, reg::elem_num));
+		b.op(add(r0, XS, ELEM4));
 		for (int k = 0; k < 5; ++k) {
 			b.op(add(r1, r0, imm(k - 2)));
 			b.op(max(r1, r1, imm(0)));
@@ -193,10 +200,9 @@ Built build()
 		b.op(bor(r1, r1, r2));
 		b.op(asr(r1, r1, imm(-1)));   // -1 off the interior columns
 		b.op(bnot(COLMASK, r1));
-		b.op(mov(DSTS, DSTBASE));
-		// Prefetch row y0-3.
+		// Prefetch the first input row (its fifth column waits for room when 4 deep).
 		b.op(mov(ROWADDR, reg::unif));
-		for (int k = 0; k < 5; ++k)
+		for (int k = 0; k < (kDeep ? 5 : 4); ++k)
 			b.op(add(tmuS(k), ROWADDR, COLOFF[k]));
 		// Prologue: rows y0-3 .. y0+2 fill the window (gradient rows y0-1 and y0 are the
 		// first needed: by row y0's tensor sum).
@@ -206,26 +212,17 @@ Built build()
 		rowOutput(b);
 		b.loopEnd(pro, CNT);
 		// Main loop: one output row and one VDW per trip.
-		b.ldi(CNT, kTileH);
+		b.op(mov(CNT, ROWS));
 		Label main = b.label();
 		rowBody(b);
 		rowOutput(b);
 		storeRow(b);
-		b.loopEnd(main, CNT);
+		b.loopEnd(main, CNT, {add(DSTS, DSTS, DPITCH), bxor(VDWS, VDWS, VDWTOG), bxor(VPMW, VPMW, imm(4))});
 		// The last trip gathered one row beyond the window: drain it.
-		b.ldtmu(0);
-		b.ldtmu(1);
-		b.ldtmu(0);
-		b.ldtmu(1);
-		b.ldtmu(0);
-		// Next strip: 16 columns to the right.
-		b.ldi(r0, 64);
-		b.op(add(DSTBASE, DSTBASE, r0));
-		b.ldi(r1, 16);
-		b.op(add(XS, XS, r1));
+		for (int k = 0; k < (kDeep ? 5 : 4); ++k)
+			b.ldtmu(k & 1);
 	}
-	b.loopEnd(strip, STRIPCNT);
-	b.nextTileOrEnd(tile);
+	b.nextTileOrEnd(unit);
 	Built out;
 	out.nops = b.nops();
 	out.program = b.finish();

@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <random>
 
+#include "asm/lint.hpp"
 #include "asm/text.hpp"
 #include "frappe/detector.h"
 #include "frappe/edge_map.h"
@@ -171,7 +172,7 @@ void comparePass1(const Img &img, float scale, unsigned seed, const std::string 
 	for (int y = 0; y < ref.h; ++y)
 		for (int x = 0; x < ref.w; ++x) {
 			const size_t i = static_cast<size_t>(y) * ref.w + x;
-			const uint32_t *p = buf.data() + static_cast<size_t>(y) * pitch + x;
+			const uint32_t *p = buf.data() + static_cast<size_t>(y) * pitch + vc4::kernels::gradWord(x);
 			const uint32_t want[4] = {ref.b[i], ref.xx[i], ref.yy[i], ref.xy[i]};
 			for (int k = 0; k < 4; ++k)
 				if (p[k * pitch / 4] != want[k] && bad++ == 0)
@@ -210,11 +211,12 @@ void comparePass2(const Img &img, const FrontEndParams &p, unsigned seed, const 
 	namespace k = vc4::kernels;
 	const Planes ref = referencePlanes(img, 1.0f);
 	const int w = ref.w, h = ref.h;
-	const uint32_t pw = (w + 63) / 64 * 64, ph = (h + 31) / 32 * 32, pitch = 16 * pw, margin = pitch + 64;
-	const unsigned tx = pw / 64, tiles = tx * (ph / 32), programs = std::min(12u, tiles);
+	const uint32_t pw = (w + 63) / 64 * 64, ph = (h + 31) / 32 * 32, pitch = 16 * pw, margin = k::gradMargin(pitch);
+	const unsigned tx = pw / 64, tiles = tx * (ph / 32), units = tx * (ph / k::kEdgeRows);
+	const unsigned programs = std::min(12u, units);
 	vc4::emu::Config config;
 	config.strict = true;
-	config.tmu_fifo_limit = 4;
+	config.tmu_fifo_limit = vc4::kTmuDepth;
 	vc4::emu::Device dev(config, 16u << 20);
 	auto grad = dev.alloc(pitch * ph + 2 * margin), edge = dev.alloc(pw * ph), mask = dev.alloc(128 * tiles);
 	std::fill(edge.cpu.begin(), edge.cpu.end(), uint8_t{0xEE});
@@ -223,23 +225,26 @@ void comparePass2(const Img &img, const FrontEndParams &p, unsigned seed, const 
 			const size_t i = static_cast<size_t>(y) * w + x;
 			const uint32_t v[4] = {ref.b[i], ref.xx[i], ref.yy[i], ref.xy[i]};
 			for (int q = 0; q < 4; ++q)
-				std::memcpy(grad.cpu.data() + margin + y * pitch + q * pitch / 4 + 4 * x, &v[q], 4);
+				std::memcpy(grad.cpu.data() + margin + y * pitch + q * pitch / 4 + 4 * k::gradWord(x), &v[q], 4);
 		}
 	const auto code = dev.upload(k::edgePass().program.code);
 	const int64_t thr = std::clamp<int64_t>(p.edge_threshold_sq, -1, int64_t{1} << 22);
 	std::vector<vc4::emu::Job> jobs;
 	for (unsigned prog = 0; prog < programs; ++prog) {
-		std::vector<uint32_t> u;
-		for (unsigned t = prog; t < tiles; t += 12) {
-			const uint32_t x0 = t % tx * 64, y0 = t / tx * 32;
-			const k::EdgeUniforms e{grad.bus + margin, pitch, pitch / 4, uint32_t(w - 2), uint32_t(h - 2), x0, y0,
-			                        static_cast<uint32_t>(thr) << 2 | 3u,
-			                        2u * static_cast<uint32_t>(static_cast<int32_t>(p.corner_threshold)),
-			                        edge.bus + y0 * pw + x0, vc4::isa::VdwStride{.stride = uint16_t(pw - 64)}.word(),
-			                        4 * pw, mask.bus + 128 * t};
-			const auto *words = reinterpret_cast<const uint32_t *>(&e);
-			u.insert(u.end(), words, words + k::kEdgeUniforms);
-			u.push_back(t + 12 < tiles ? 1 : 0);
+		const k::EdgeUniforms e{pitch, static_cast<uint32_t>(thr) << 2 | 3u,
+		                        2u * static_cast<uint32_t>(static_cast<int32_t>(p.corner_threshold)),
+		                        vc4::isa::VdwStride{.stride = uint16_t(pw - 64)}.word(), 4 * pw};
+		const auto *words = reinterpret_cast<const uint32_t *>(&e);
+		std::vector<uint32_t> u(words, words + k::kEdgeUniforms);
+		for (unsigned n = prog; n < units; n += 12) {
+			const uint32_t x0 = n % tx * 64, y0 = n / tx * k::kEdgeRows, t = n / tx / 2 * tx + n % tx;
+			const k::EdgeUnit unit{x0, uint32_t(w - 2), grad.bus + margin + (y0 - 1) * pitch + 4 * x0, pitch / 4,
+			                       edge.bus + y0 * pw + x0, mask.bus + 128 * t + 64 * (n / tx % 2)};
+			const auto *uw = reinterpret_cast<const uint32_t *>(&unit);
+			u.insert(u.end(), uw, uw + k::kEdgeUnitUniforms);
+			for (int r = 0; r < k::kEdgeRows; ++r)
+				u.push_back(int(y0) + r >= 1 && int(y0) + r <= h - 2 ? 0xffffffffu : 0u);
+			u.push_back(n + 12 < units ? 1 : 0);
 		}
 		jobs.push_back({dev.upload(u).bus, code.bus});
 	}
@@ -345,15 +350,24 @@ TEST(Vc4Kernels, RegionMeansPassMatchesCore)
 TEST(Vc4Kernels, ListingsRoundTrip)
 {
 	// The uniform structs of kernels.hpp are the programs' streams, in order, then `more`.
-	EXPECT_EQ(vc4::kernels::gradientPass().program.uniforms.size(), vc4::kernels::kGradientUniforms + 1);
-	EXPECT_EQ(vc4::kernels::edgePass().program.uniforms.size(), vc4::kernels::kEdgeUniforms + 1);
-	EXPECT_EQ(vc4::kernels::gradientPass().program.uniformIndex("vdw_stride"), 6u);
-	EXPECT_EQ(vc4::kernels::edgePass().program.uniformIndex("mask_dst"), 12u);
-	EXPECT_EQ(vc4::kernels::regionMeansPass().program.uniforms.size(), vc4::kernels::kRegionMeansUniforms + 1);
-	EXPECT_EQ(vc4::kernels::regionDarkPass().program.uniforms.size(), vc4::kernels::kRegionDarkUniforms + 1);
-	EXPECT_EQ(vc4::kernels::regionDarkPass().program.uniformIndex("mask_dst"), 7u);
-	for (const auto &built : {vc4::kernels::gradientPass(), vc4::kernels::edgePass(), vc4::kernels::regionMeansPass(),
-	                          vc4::kernels::regionDarkPass()}) {
+	namespace k = vc4::kernels;
+	EXPECT_EQ(k::gradientPass().program.uniforms.size(), k::kGradientUniforms + k::kGradientUnitUniforms + 1);
+	EXPECT_EQ(k::edgePass().program.uniforms.size(), k::kEdgeUniforms + k::kEdgeUnitUniforms + 1);
+	EXPECT_EQ(k::gradientPass().program.uniformIndex("vdw_stride"), k::kGradientUniforms - 1);
+	EXPECT_EQ(k::gradientPass().program.uniformIndex("rows"), k::kGradientUniforms + k::kGradientUnitUniforms - 1);
+	EXPECT_EQ(k::edgePass().program.uniformIndex("edge_pitch4"), k::kEdgeUniforms - 1);
+	EXPECT_EQ(k::edgePass().program.uniformIndex("mask_dst"), k::kEdgeUniforms + k::kEdgeUnitUniforms - 1);
+	EXPECT_EQ(k::regionMeansPass().program.uniforms.size(), k::kRegionMeansUniforms + 1);
+	EXPECT_EQ(k::regionDarkPass().program.uniforms.size(), k::kRegionDarkUniforms + 1);
+	EXPECT_EQ(k::regionDarkPass().program.uniformIndex("mask_dst"), 7u);
+	// Every program keeps to the build's TMU depth, and the safe one always.
+	for (const auto &built : {k::gradientPass(), k::edgePass(), k::regionMeansPass(), k::regionDarkPass()}) {
+		EXPECT_TRUE(vc4::qasm::lint(built.program.code, vc4::kTmuDepth).empty()) << built.program.name;
+		if (vc4::kTmuDepth == 4) {
+			EXPECT_TRUE(vc4::qasm::lint(built.program.code, 4).empty()) << built.program.name;
+		}
+	}
+	for (const auto &built : {k::gradientPass(), k::edgePass(), k::regionMeansPass(), k::regionDarkPass()}) {
 		EXPECT_EQ(vc4::qasm::assembleText(vc4::isa::disassembleProgram(built.program.code)), built.program.code)
 			<< built.program.name;
 		EXPECT_EQ(built.program.uniforms.back().name, "more");
@@ -400,16 +414,23 @@ TEST(Vc4Kernels, FrameCounts)
 	expectSame(got, want, "640x480");
 	vc4::FrameCounts c;
 	ASSERT_TRUE(vc4::lastFrameCounts(*fe, c));
+	EXPECT_EQ(c.pass[0].tiles, 150u);
+	EXPECT_EQ(c.pass[1].units, 300u); // half tiles: 25 a QPU
+	std::printf("TMU depth %u\n", vc4::kTmuDepth);
 	for (int pass = 0; pass < 2; ++pass) {
 		const auto &p = c.pass[pass];
-		const unsigned perQpu = (p.tiles + p.programs - 1) / p.programs;
-		std::printf("pass %d: %u tiles on %u QPUs; %.0f instructions/tile; slowest QPU %llu cycles "
-		            "(%u tiles, %.0f cycles/tile) = %.3f ms at 250 MHz, %.3f ms at 300 MHz\n",
-		            pass + 1, p.tiles, p.programs, double(p.instructions) / p.tiles,
-		            static_cast<unsigned long long>(p.slowest_cycles), perQpu, double(p.slowest_cycles) / perQpu,
-		            p.slowest_cycles / 250e3, p.slowest_cycles / 300e3);
+		std::printf("pass %d: %u units on %u QPUs; %.0f instructions/tile; slowest QPU %llu cycles "
+		            "= %.3f ms at 250 MHz, %.3f ms at 300 MHz; DRAM read %.2f MB, written %.2f MB\n",
+		            pass + 1, p.units, p.programs, double(p.instructions) / p.tiles,
+		            static_cast<unsigned long long>(p.slowest_cycles), p.slowest_cycles / 250e3,
+		            p.slowest_cycles / 300e3, p.dram_read / 1e6, p.dram_written / 1e6);
 		EXPECT_GT(p.instructions, 0u);
+		EXPECT_GT(p.dram_read, 0u);
 	}
+	// Pass 1 writes the four planes of every pixel (one VDW a row a strip); pass 2 the
+	// edge bytes and two mask rows a tile.
+	EXPECT_EQ(c.pass[0].dram_written, 640u * 480u * 16u);
+	EXPECT_EQ(c.pass[1].dram_written, 640u * 480u + 150u * 128u);
 	// The region map: 64x16 blocks of the 320x240 map. DRAM: the means pass reads 4 source
 	// bytes a map pixel (4 B gathered words) and writes r and the tile words; the dark pass
 	// gathers 9 tile words a lane and tile row and one word of r a lane and row, and writes

@@ -137,7 +137,7 @@ bool complementary(Cond a, Cond b)
 
 } // namespace
 
-std::vector<Diagnostic> lint(std::span<const uint64_t> code)
+std::vector<Diagnostic> lint(std::span<const uint64_t> code, unsigned tmu_depth)
 {
 	std::vector<Diagnostic> out;
 	std::vector<Access> acc;
@@ -170,11 +170,13 @@ std::vector<Diagnostic> lint(std::span<const uint64_t> code)
 		read_setup_seen |= vr_setup;
 		write_setup_seen |= vw_setup;
 		// TMU requests retire on the S register; ldtmu pops one (program order only).
+		// The depth is per QPU: the requests of both TMUs count together.
 		for (const auto &w : cur.writes)
 			if (w.waddr == waddr::tmu0_s || w.waddr == waddr::tmu1_s) {
 				const int t = w.waddr == waddr::tmu1_s;
-				if (++tmu_outstanding[t] > 4)
-					report(i, Hazard::TmuTooManyOutstanding, "more than 4 TMU requests outstanding");
+				if (++tmu_outstanding[t] + tmu_outstanding[1 - t] > static_cast<int>(tmu_depth))
+					report(i, Hazard::TmuTooManyOutstanding,
+					       "more than " + std::to_string(tmu_depth) + " TMU requests outstanding on the QPU");
 			}
 		if (cur.sig == Sig::LoadTmu0 || cur.sig == Sig::LoadTmu1) {
 			int &n = tmu_outstanding[cur.sig == Sig::LoadTmu1];

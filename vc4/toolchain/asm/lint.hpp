@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "tmu_depth.hpp"
+
 namespace frappe::vc4::qasm {
 
 enum class Hazard {
@@ -30,7 +32,7 @@ enum class Hazard {
 	VpmReadWithoutSetup,     // VPM read with no read setup earlier in the program
 	DmaWithoutSetup,         // VDR/VDW address write with no setup earlier in the program
 	LdtmuWithoutRequest,     // ldtmu with no TMU request outstanding (program order)
-	TmuTooManyOutstanding,   // more than 4 TMU requests outstanding (addendum: unreliable)
+	TmuTooManyOutstanding,   // more than tmu_depth TMU requests outstanding on one QPU
 };
 
 struct Diagnostic {
@@ -41,6 +43,8 @@ struct Diagnostic {
 	std::string text() const;
 };
 
-std::vector<Diagnostic> lint(std::span<const uint64_t> code);
+// `tmu_depth`: TMU requests allowed in flight per QPU, both TMUs together (the count is
+// static, in program order, so a loop must balance its requests and pops).
+std::vector<Diagnostic> lint(std::span<const uint64_t> code, unsigned tmu_depth = kTmuDepth);
 
 } // namespace frappe::vc4::qasm

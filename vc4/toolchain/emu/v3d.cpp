@@ -104,6 +104,7 @@ LaunchStats V3d::launch(std::span<const Job> jobs, LaunchOptions options)
 		stats.instructions += q.instructions;
 		stats.cycles = std::max(stats.cycles, q.cycles);
 		stats.host_interrupts += q.host_interrupts;
+		stats.traffic += q.traffic;
 	}
 	return stats;
 }
@@ -158,6 +159,7 @@ uint32_t Qpu::popUniform()
 		fault("uniform read within 2 instructions of a uniforms-address write");
 	const uint32_t v = v3d_->memory_.read32(uniforms_);
 	uniforms_ += 4;
+	stats_.traffic.uniform_read += 4;
 	return v;
 }
 
@@ -328,9 +330,13 @@ void Qpu::tmuWrite(unsigned tmu, unsigned reg, const Vec &v)
 		return;
 	}
 	auto &fifo = tmu_fifo_[tmu];
-	if (fifo.size() >= (v3d_->config_.strict ? v3d_->config_.tmu_fifo_limit : 8u))
-		fault("more than " + std::to_string(fifo.size()) + " TMU requests outstanding");
+	const size_t in_flight = fifo.size() + tmu_fifo_[1 - tmu].size();
+	if (v3d_->config_.strict && in_flight >= v3d_->config_.tmu_fifo_limit)
+		fault("more than " + std::to_string(in_flight) + " TMU requests outstanding on the QPU");
+	if (fifo.size() >= 8)
+		fault("more than 8 requests outstanding on TMU" + std::to_string(tmu));
 	TmuResult result{{}, clock() + v3d_->config_.timing.tmu_latency};
+	stats_.traffic.tmu_read += 4 * kLanes;
 	if (!req.coords_written) {
 		for (unsigned i = 0; i < kLanes; ++i)
 			result.value[i] = v3d_->memory_.read32(v[i] & ~3u);
@@ -506,6 +512,7 @@ void Qpu::dmaStart(bool store, uint32_t address)
 					vpmAt(y + w, x + r * vpitch) = value;
 			}
 	}
+	(store ? stats_.traffic.vdw_written : stats_.traffic.vdr_read) += 4ull * rows * words;
 	uint64_t &done = store ? vdw_done_ : vdr_done_;
 	done = std::max(done, clock()) + t.dma_setup + rows * t.dma_per_row + rows * words * t.dma_per_word;
 }

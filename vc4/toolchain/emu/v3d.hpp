@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "emu/memory.hpp"
+#include "tmu_depth.hpp"
 
 namespace frappe::vc4::emu {
 
@@ -42,9 +43,9 @@ struct Config {
 	Timing timing;
 	unsigned bilinear_fraction_bits = 8; // TMU bilinear weight precision (not documented)
 	unsigned vpm_rows = 192;             // 12 KiB, 16 words per row
-	// Outstanding TMU requests per QPU and TMU. The FIFO has 8 slots; the vc4asm addendum
-	// found more than 4 unreliable, set 4 to enforce that.
-	unsigned tmu_fifo_limit = 8;
+	// Outstanding TMU requests per QPU, both TMUs together, that strict mode allows: the
+	// build's depth (tmu_depth.hpp). Lenient mode only keeps each TMU's FIFO to its 8 slots.
+	unsigned tmu_fifo_limit = kTmuDepth;
 	bool strict = true;                  // turn documented hazards into faults
 	uint64_t max_instructions = 100'000'000;
 };
@@ -62,11 +63,31 @@ struct LaunchOptions {
 	uint64_t seed = 0;
 };
 
+// Memory traffic, in bytes: what the QPU's requests move between memory and the QPU or
+// VPM (a general TMU gather counts 64 bytes, 4 a lane; caches are not modelled).
+struct Traffic {
+	uint64_t tmu_read = 0;     // TMU gathers and texture fetches
+	uint64_t vdr_read = 0;     // VPM DMA loads
+	uint64_t vdw_written = 0;  // VPM DMA stores
+	uint64_t uniform_read = 0; // the uniform stream
+
+	uint64_t read() const { return tmu_read + vdr_read + uniform_read; }
+	Traffic &operator+=(const Traffic &o)
+	{
+		tmu_read += o.tmu_read;
+		vdr_read += o.vdr_read;
+		vdw_written += o.vdw_written;
+		uniform_read += o.uniform_read;
+		return *this;
+	}
+};
+
 struct QpuStats {
 	uint64_t instructions = 0;
 	uint64_t cycles = 0;
 	uint64_t stall_cycles = 0;
 	unsigned host_interrupts = 0;
+	Traffic traffic;
 };
 
 struct LaunchStats {
@@ -74,6 +95,7 @@ struct LaunchStats {
 	uint64_t instructions = 0; // all QPUs
 	uint64_t cycles = 0;       // the slowest QPU
 	unsigned host_interrupts = 0;
+	Traffic traffic;           // all QPUs
 };
 
 class Qpu;

@@ -351,18 +351,35 @@ TEST(Lint, TmuRequestCounting)
 	a.nop(Sig::LoadTmu0);
 	a.thrend();
 	EXPECT_TRUE(has(lintOf(a), Hazard::LdtmuWithoutRequest));
-	Assembler b;
-	for (int i = 0; i < 5; ++i)
-		b.emit(mov(reg::tmu0_s, r0));
-	for (int i = 0; i < 5; ++i)
-		b.nop(Sig::LoadTmu0);
-	b.thrend();
-	EXPECT_TRUE(has(lintOf(b), Hazard::TmuTooManyOutstanding));
+	// n requests alternating over the TMUs, then their pops.
+	auto inFlight = [](int n) {
+		Assembler b;
+		for (int i = 0; i < n; ++i)
+			b.emit(mov(i % 2 ? reg::tmu1_s : reg::tmu0_s, r0));
+		for (int i = 0; i < n; ++i)
+			b.nop(i % 2 ? Sig::LoadTmu1 : Sig::LoadTmu0);
+		b.thrend();
+		return b.finish(false).code;
+	};
+	// Five in flight, split over both TMUs: the depth counts per QPU, so this fails at
+	// depth 4 (the default build) and passes at 8.
+	const auto code = inFlight(5);
+	const auto at4 = lint(code, 4);
+	ASSERT_EQ(at4.size(), 1u);
+	EXPECT_EQ(at4[0].hazard, Hazard::TmuTooManyOutstanding);
+	EXPECT_EQ(at4[0].index, 4u); // the fifth request
+	EXPECT_TRUE(lint(code, 8).empty());
+	EXPECT_EQ(lint(code).empty(), kTmuDepth >= 5);
+	// Four in flight pass at either depth; a pop makes room for the next request.
 	Assembler ok;
 	for (int i = 0; i < 4; ++i)
-		ok.emit(mov(reg::tmu0_s, r0));
+		ok.emit(mov(i % 2 ? reg::tmu1_s : reg::tmu0_s, r0));
+	ok.nop(Sig::LoadTmu0);
+	ok.emit(mov(reg::tmu0_s, r0));
 	for (int i = 0; i < 4; ++i)
-		ok.nop(Sig::LoadTmu0);
+		ok.nop(i % 2 ? Sig::LoadTmu0 : Sig::LoadTmu1);
 	ok.thrend();
-	EXPECT_TRUE(lintOf(ok).empty());
+	EXPECT_TRUE(lint(ok.finish(false).code, 4).empty());
+	// Nine in flight fail even at depth 8.
+	EXPECT_TRUE(has(lint(inFlight(9), 8), Hazard::TmuTooManyOutstanding));
 }

@@ -215,29 +215,43 @@ TEST(EmuTmu, DirectLookupsComeBackInOrder)
 
 TEST(EmuTmu, OutstandingRequestLimit)
 {
-	// Section 4: 8 FIFO slots; the addendum's reliable limit of 4 is a configuration.
-	auto program = [](int requests) {
+	// Strict mode holds a QPU to the configured depth, both TMUs together (the build's
+	// kTmuDepth by default); lenient mode only to each TMU's 8 FIFO slots (section 4).
+	auto program = [](int tmu0, int tmu1) {
 		Assembler a;
 		a.emit(mov(wa(0), a.uniform("buf")));
 		a.nop();
-		for (int i = 0; i < requests; ++i)
-			a.emit(mov(reg::tmu0_s, ra(0)));
+		for (int i = 0; i < tmu0 + tmu1; ++i)
+			a.emit(mov(i < tmu0 ? reg::tmu0_s : reg::tmu1_s, ra(0)));
 		a.thrend();
-		return a.finish(false); // the lint rejects more than 4 already
+		return a.finish(false); // the lint would reject these already
 	};
 	auto launch = [](const Program &p, emu::Config c) {
 		test::Run r(c);
 		const uint32_t buf = r.memory.load(counting(16));
 		const uint32_t code = r.memory.load(p.code);
 		const emu::Job job{r.memory.load(std::vector<uint32_t>{buf}), code};
-		r.v3d.launch(std::span(&job, 1));
+		return r.v3d.launch(std::span(&job, 1));
 	};
-	EXPECT_NO_THROW(launch(program(8), {}));
-	EXPECT_THROW(launch(program(9), {}), emu::Fault);
-	emu::Config reliable;
-	reliable.tmu_fifo_limit = 4;
-	EXPECT_NO_THROW(launch(program(4), reliable));
-	EXPECT_THROW(launch(program(5), reliable), emu::Fault);
+	EXPECT_EQ(emu::Config{}.tmu_fifo_limit, kTmuDepth);
+	emu::Config four, eight, lenient;
+	four.tmu_fifo_limit = 4;
+	eight.tmu_fifo_limit = 8;
+	lenient.strict = false;
+	EXPECT_NO_THROW(launch(program(4, 0), four));
+	EXPECT_NO_THROW(launch(program(2, 2), four));
+	EXPECT_THROW(launch(program(5, 0), four), emu::Fault);
+	EXPECT_THROW(launch(program(3, 2), four), emu::Fault); // per QPU, not per TMU
+	EXPECT_NO_THROW(launch(program(3, 2), eight));
+	EXPECT_NO_THROW(launch(program(4, 4), eight));
+	EXPECT_THROW(launch(program(5, 4), eight), emu::Fault);
+	EXPECT_NO_THROW(launch(program(8, 8), lenient));
+	EXPECT_THROW(launch(program(9, 0), lenient), emu::Fault);
+	// Each general gather reads 16 words; the program read one uniform.
+	const emu::LaunchStats s = launch(program(2, 1), four);
+	EXPECT_EQ(s.traffic.tmu_read, 3u * 64u);
+	EXPECT_EQ(s.traffic.uniform_read, 4u);
+	EXPECT_EQ(s.traffic.vdw_written, 0u);
 }
 
 TEST(EmuTmu, LdtmuWithoutRequestFaults)
