@@ -1,6 +1,6 @@
 #!/bin/sh
 # A small Debian bookworm armel sysroot for scripts/arm-count.sh: libstdc++/libc
-# headers, OpenCV core/imgproc/calib3d (for the aruco reference), libpng and
+# headers, Eigen (frappe-core's pose, header-only), OpenCV core/imgproc/calib3d (for the aruco reference), libpng and
 # libjpeg (the counting driver decodes the images on the guest), plus
 # libopencv_aruco taken alone from libopencv-contrib406 (the package itself
 # would pull Qt, HDF5, Tesseract, VTK ...). Adapted from the team's
@@ -18,7 +18,7 @@ uris=$( { grep -h '^URIs:' /etc/apt/sources.list.d/*.sources 2>/dev/null | awk '
 MIRROR=${MIRROR:-$(echo "$uris" | grep -v security | head -1)}
 MIRROR=${MIRROR:-http://deb.debian.org/debian}
 PKGS="libstdc++-12-dev libc6-dev libopencv-core-dev libopencv-imgproc-dev libopencv-calib3d-dev
-libpng-dev libjpeg62-turbo-dev zlib1g-dev"
+libpng-dev libjpeg62-turbo-dev zlib1g-dev libeigen3-dev"
 mkdir -p "$DEST"
 # armel is not in bookworm-security any more: main + updates only.
 mmdebstrap --mode=auto --variant=extract --architectures=armel \
