@@ -233,19 +233,124 @@ void warpSamplesScalar(const ImageView &image, const Homography &H, int side, bo
 	}
 }
 
+namespace {
+
+/* One axis of the contract's position, for a 32-bit core: 0 < d < 2^20 on
+ * the grid, so the clamped numerator is below 2^31 and the quotient below
+ * 2^21, and both go between int32 and double, one VFP instruction each on
+ * a Pi Zero (int64 conversions are libgcc calls there). The quotient is the
+ * contract's: nc 2^10 is exact in double and the division correctly rounded.
+ * `origin` is the origin times 2^10, below 2^30 in magnitude (the caller
+ * checks), so origin + q cannot overflow. */
+inline std::int32_t fixedAxis(std::int64_t n, std::int32_t d, std::int32_t origin, std::int32_t max)
+{
+	const std::int64_t limit = (std::int64_t{ d } << kFixedWarpIntBits) - 1;
+	const auto nc = static_cast<std::int32_t>(n < 0 ? 0 : (n > limit ? limit : n));
+	const auto q = static_cast<std::int32_t>(static_cast<double>(nc) * (1 << kFixedWarpFracBits) /
+						 static_cast<double>(d));
+	const std::int32_t p = origin + q;
+	return p < 0 ? 0 : (p > max ? max : p);
+}
+
+/* Whether none of the contract's clamps acts on any sample of the grid. Each
+ * clamp is the sign of a linear form over (i, j): with a = 2^10 n and d > 0,
+ * 0 <= n <= 2^11 d - 1 for the numerator, and for the position
+ * origin + floor(a / d) >= 0  <=>  a + origin d >= 0 and
+ * origin + floor(a / d) <= max  <=>  a + origin d < (max + 1) d,
+ * so the grid's four corners decide for all its samples. */
+bool clampsIdle(const FixedWarp &w, int width, int height)
+{
+	const int last = w.side - 1;
+	const std::int64_t ox = std::int64_t{ w.ox } << kFixedWarpFracBits;
+	const std::int64_t oy = std::int64_t{ w.oy } << kFixedWarpFracBits;
+	const std::int64_t xMax = std::int64_t{ width - 1 } << kFixedWarpFracBits;
+	const std::int64_t yMax = std::int64_t{ height - 1 } << kFixedWarpFracBits;
+	auto idle = [](std::int64_t n, std::int64_t d, std::int64_t origin, std::int64_t max) {
+		if (n < 0 || n > (d << kFixedWarpIntBits) - 1)
+			return false;
+		const std::int64_t a = (n << kFixedWarpFracBits) + origin * d;
+		return a >= 0 && a < (max + 1) * d;
+	};
+	for (int j : { 0, last })
+		for (int i : { 0, last }) {
+			const std::int64_t d = w.d.at(i, j);
+			if (!idle(w.x.at(i, j), d, ox, xMax) || !idle(w.y.at(i, j), d, oy, yMax))
+				return false;
+		}
+	return true;
+}
+
+/* The grid when no clamp acts: 2^10 n and d stepped along each row in
+ * double (integers below 2^48, so exact), one correctly rounded division a
+ * position, whose truncation is the contract's floor (a >= 0, and a
+ * quotient below 2^21 that is not an integer is at least 2^-20 below the
+ * next one, far more than its rounding). */
+template <bool Fine>
+void warpFixedInside(const ImageView &image, const FixedWarp &w, float *out)
+{
+	const auto ox = static_cast<std::int32_t>(w.ox * (1 << kFixedWarpFracBits));
+	const auto oy = static_cast<std::int32_t>(w.oy * (1 << kFixedWarpFracBits));
+	constexpr double kUnit = 1 << kFixedWarpFracBits;
+	const double sx = kUnit * w.x.di, sy = kUnit * w.y.di, sd = w.d.di;
+	/* Each row's start from the int32 coefficients (int64 to double is a
+	 * libgcc call on a Pi Zero, int32 to double one instruction). */
+	auto start = [](const FixedWarpForm &f, int j) {
+		return static_cast<double>(f.at00) + static_cast<double>(f.dj) * j;
+	};
+	for (int j = 0; j < w.side; ++j) {
+		double ax = kUnit * start(w.x, j);
+		double ay = kUnit * start(w.y, j);
+		double d = start(w.d, j);
+		float *row = out + static_cast<std::size_t>(j) * w.side;
+		for (int i = 0; i < w.side; ++i) {
+			const std::int32_t X = ox + static_cast<std::int32_t>(ax / d);
+			const std::int32_t Y = oy + static_cast<std::int32_t>(ay / d);
+			row[i] = fixedSample(fixedBilinear(image, X, Y), Fine);
+			ax += sx;
+			ay += sy;
+			d += sd;
+		}
+	}
+}
+
+} // namespace
+
 void warpFixedSamplesScalar(const ImageView &image, const FixedWarp &w, bool fine, float *out)
 {
+	if (clampsIdle(w, image.width, image.height)) {
+		/* Most candidates: inside the frame, nowhere near the ranges. */
+		if (fine)
+			warpFixedInside<true>(image, w, out);
+		else
+			warpFixedInside<false>(image, w, out);
+		return;
+	}
+	const std::int64_t ox = std::int64_t{ w.ox } << kFixedWarpFracBits;
+	const std::int64_t oy = std::int64_t{ w.oy } << kFixedWarpFracBits;
+	constexpr std::int64_t kOriginLimit = std::int64_t{ 1 } << 30;
+	if (ox <= -kOriginLimit || ox >= kOriginLimit || oy <= -kOriginLimit || oy >= kOriginLimit) {
+		/* An origin a million pixels away: the contract verbatim. */
+		for (int j = 0; j < w.side; ++j)
+			for (int i = 0; i < w.side; ++i)
+				out[static_cast<std::size_t>(j) * w.side + i] =
+					fixedSample(fixedWarpValue(image, w, i, j), fine);
+		return;
+	}
+	const auto xMax = static_cast<std::int32_t>((image.width - 1) << kFixedWarpFracBits);
+	const auto yMax = static_cast<std::int32_t>((image.height - 1) << kFixedWarpFracBits);
+	/* The forms stepped along each row: the same integers as at(i, j). */
 	for (int j = 0; j < w.side; ++j) {
+		std::int64_t nx = w.x.at(0, j), ny = w.y.at(0, j);
+		std::int64_t d = w.d.at(0, j); /* in (0, 2^20) at every sample, not past the row */
+		float *row = out + static_cast<std::size_t>(j) * w.side;
 		for (int i = 0; i < w.side; ++i) {
-			const std::int64_t d = w.d.at(i, j);
-			auto quotient = [d](std::int64_t n) {
-				const std::int64_t nc = std::clamp<std::int64_t>(n, 0, (d << kFixedWarpIntBits) - 1);
-				return static_cast<std::int64_t>(static_cast<double>(nc << kFixedWarpFracBits) /
-								 static_cast<double>(d));
-			};
-			const std::int32_t X = fixedPosition(quotient(w.x.at(i, j)), w.ox, image.width);
-			const std::int32_t Y = fixedPosition(quotient(w.y.at(i, j)), w.oy, image.height);
-			out[static_cast<std::size_t>(j) * w.side + i] = fixedSample(fixedBilinear(image, X, Y), fine);
+			const auto d32 = static_cast<std::int32_t>(d);
+			const std::int32_t X = fixedAxis(nx, d32, static_cast<std::int32_t>(ox), xMax);
+			const std::int32_t Y = fixedAxis(ny, d32, static_cast<std::int32_t>(oy), yMax);
+			row[i] = fixedSample(fixedBilinear(image, X, Y), fine);
+			nx += w.x.di;
+			ny += w.y.di;
+			d += w.d.di;
 		}
 	}
 }

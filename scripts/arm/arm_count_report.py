@@ -129,7 +129,7 @@ def stage_of(obj, name):
         if "warpMarker" in name:
             return "warp"
         return "decode"
-    if base == "homography" or base.startswith("warp_kernels"):
+    if base in ("homography", "fixed_warp") or base.startswith("warp_kernels"):
         return "warp"
     if base in ("dictionary", "dictionaries"):
         return "decode"
