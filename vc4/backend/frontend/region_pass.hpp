@@ -63,15 +63,13 @@ public:
 	/// Gives the data buffers back before the geometry changes.
 	void release(Device &device)
 	{
-		if constexpr (requires(Device &d, const Buffer &b) { d.release(b); }) {
-			for (Buffer *b : {&buffer_, &out_, &mask_})
-				if (b->bus)
-					device.release(*b);
-			for (auto &pass : unif_)
-				for (Buffer &b : pass)
-					if (b.bus)
-						device.release(b);
-		}
+		for (Buffer *b : {&buffer_, &out_, &mask_})
+			if (b->bus)
+				device.release(*b);
+		for (auto &pass : unif_)
+			for (Buffer &b : pass)
+				if (b.bus)
+					device.release(b);
 		buffer_ = out_ = mask_ = {};
 		for (auto &pass : unif_)
 			std::fill(std::begin(pass), std::end(pass), Buffer{});
