@@ -248,21 +248,23 @@ void halveImage(const ImageView &src, std::uint8_t *out)
 		decimateRow(src.row(2 * y), src.row(2 * y + 1), w, out + static_cast<std::size_t>(y) * w);
 }
 
-void regionMap(const ImageView &src, float srcScale, int minContrast, TraceMap &out, RegionScratch &s)
+void regionMap(const ImageView &src, float srcScale, const FrontEndParams &params, TraceMap &out,
+	       RegionScratch &s)
 {
-	if (!makesRegionMap(src.width, src.height, minContrast)) {
+	if (!makesRegionMap(src.width, src.height, params.region_contrast)) {
 		out.resize(0, 0);
 		return;
 	}
 	s.decimated.resize(static_cast<std::size_t>(src.width / 2) * (src.height / 2));
 	halveImage(src, s.decimated.data());
-	regionMapFromMeans(src.width, src.height, srcScale, minContrast, out, s);
+	regionMapFromMeans(src.width, src.height, srcScale, params, out, s);
 }
 
-void regionMapFromMeans(int width, int height, float srcScale, int minContrast, TraceMap &out, RegionScratch &s)
+void regionMapFromMeans(int width, int height, float srcScale, const FrontEndParams &params, TraceMap &out,
+			RegionScratch &s)
 {
 	const int w = width / 2, h = height / 2;
-	if (!makesRegionMap(width, height, minContrast)) {
+	if (!makesRegionMap(width, height, params.region_contrast)) {
 		out.resize(0, 0);
 		return;
 	}
@@ -348,7 +350,9 @@ void regionMapFromMeans(int width, int height, float srcScale, int minContrast, 
 		const std::uint8_t *tmax = s.tileMax.data() + static_cast<std::size_t>(j) * tx;
 		for (int i = 0; i < tx; ++i) {
 			const int lo = tmin[i], hi = tmax[i];
-			const std::uint32_t m = hi - lo >= minContrast ? static_cast<std::uint32_t>((lo + hi + 1) >> 1) : 0u;
+			const std::uint32_t m = hi - lo >= params.relativeRegionContrast(lo, hi)
+							? static_cast<std::uint32_t>((lo + hi + 1) >> 1)
+							: 0u;
 			const std::uint32_t word = m * 0x01010101u;
 			std::memcpy(mid + i * T, &word, 4); /* mid has room for whole tiles */
 		}

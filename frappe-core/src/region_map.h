@@ -28,7 +28,8 @@ struct RegionScratch {
 /// Fills `out` with the dark pixels of `src` at half its resolution;
 /// out.scale = srcScale / 2. Leaves `out` empty (0 x 0) when minContrast is
 /// 0 or `src` is too small for a 3 x 3 map.
-void regionMap(const ImageView &src, float srcScale, int minContrast, TraceMap &out, RegionScratch &scratch);
+void regionMap(const ImageView &src, float srcScale, const FrontEndParams &params, TraceMap &out,
+	       RegionScratch &scratch);
 
 /// Whether regionMap() makes a map of a src.width x src.height frame.
 inline bool makesRegionMap(int width, int height, int minContrast)
@@ -39,7 +40,7 @@ inline bool makesRegionMap(int width, int height, int minContrast)
 /// regionMap() from the frame's 2x2 means already made (scratch.decimated,
 /// width / 2 x height / 2, as decimateRow makes them): the CPU front end
 /// makes them as it reads the frame's rows.
-void regionMapFromMeans(int width, int height, float srcScale, int minContrast, TraceMap &out,
+void regionMapFromMeans(int width, int height, float srcScale, const FrontEndParams &params, TraceMap &out,
 			RegionScratch &scratch);
 
 /// out, (src.width / 2) x (src.height / 2) = decimateRow() of each pair of

@@ -393,7 +393,7 @@ void checkLabels(std::size_t n, int misalign)
 }
 
 /* The documented rule of the region map, pixel by pixel. */
-std::vector<std::uint8_t> slowRegionMap(const Gray &g, int minContrast, int &w, int &h)
+std::vector<std::uint8_t> slowRegionMap(const Gray &g, int minContrast, int lightFloor, int &w, int &h)
 {
 	w = g.w / 2;
 	h = g.h / 2;
@@ -417,20 +417,24 @@ std::vector<std::uint8_t> slowRegionMap(const Gray &g, int minContrast, int &w, 
 							hi = std::max(hi, r[static_cast<std::size_t>(yy) * w + xx]);
 						}
 			out[static_cast<std::size_t>(y) * w + x] =
-				hi - lo >= minContrast && r[static_cast<std::size_t>(y) * w + x] < ((lo + hi + 1) >> 1);
+				hi - lo >= ((minContrast * std::min(lo + hi + 2 * lightFloor, 256) + 255) >> 8) &&
+				r[static_cast<std::size_t>(y) * w + x] < ((lo + hi + 1) >> 1);
 		}
 	return out;
 }
 
 /* The whole region map (this build's: the ARMv6 kernels) against the rule,
  * pixels and tile mask; the number of dark pixels. */
-std::size_t compareRegionMap(const Gray &g, int contrast, const char *what)
+std::size_t compareRegionMap(const Gray &g, int contrast, const char *what, int lightFloor = 16)
 {
 	int w, h;
-	const auto want = slowRegionMap(g, contrast, w, h);
+	const auto want = slowRegionMap(g, contrast, lightFloor, w, h);
 	TraceMap map;
 	RegionScratch scratch;
-	regionMap(ImageView(g.px.data(), g.w, g.h, g.w), 1.0f, contrast, map, scratch);
+	frappe::FrontEndParams params;
+	params.region_contrast = contrast;
+	params.light_floor = lightFloor;
+	regionMap(ImageView(g.px.data(), g.w, g.h, g.w), 1.0f, params, map, scratch);
 	if (w < 3 || h < 3) {
 		CHECK(map.width == 0, "%s: a map of a frame too small", what);
 		return 0;

@@ -32,7 +32,7 @@ std::vector<std::uint8_t> randomBytes(std::size_t n, std::mt19937 &rng)
 }
 
 /* The documented rule, pixel by pixel. */
-std::vector<std::uint8_t> slowRegionMap(const Image &img, int minContrast, int &w, int &h)
+std::vector<std::uint8_t> slowRegionMap(const Image &img, int minContrast, int lightFloor, int &w, int &h)
 {
 	w = img.width / 2;
 	h = img.height / 2;
@@ -56,7 +56,9 @@ std::vector<std::uint8_t> slowRegionMap(const Image &img, int minContrast, int &
 							lo = std::min(lo, r[yy * w + xx]);
 							hi = std::max(hi, r[yy * w + xx]);
 						}
-			out[y * w + x] = hi - lo >= minContrast && r[y * w + x] < ((lo + hi + 1) >> 1) ? 1 : 0;
+			/* The contrast follows the light below mid-grey. */
+			const int need = (minContrast * std::min(lo + hi + 2 * lightFloor, 256) + 255) >> 8;
+			out[y * w + x] = hi - lo >= need && r[y * w + x] < ((lo + hi + 1) >> 1) ? 1 : 0;
 		}
 	return out;
 }
@@ -153,15 +155,19 @@ TEST(RegionMap, FollowsTheDocumentedRuleAtOddSizesAndStrides)
 			for (int y = 0; y < H; ++y)
 				for (int x = 0; x < W; ++x)
 					img.at(x, y) = static_cast<std::uint8_t>(((x / 7 + y / 5) * 53 + rng() % 40) & 0xFF);
-			for (int contrast : { 1, 40, 200 }) {
+			for (auto [contrast, lightFloor] : { std::pair{ 1, 128 }, { 40, 128 }, { 200, 128 }, { 40, 16 }, { 200, 0 }, { 41, 16 } }) {
 				int w, h;
-				const auto want = slowRegionMap(img, contrast, w, h);
+				const auto want = slowRegionMap(img, contrast, lightFloor, w, h);
 				TraceMap map;
 				detail::RegionScratch scratch;
-				detail::regionMap(img.view(), 1.0f, contrast, map, scratch);
+				FrontEndParams params;
+				params.region_contrast = contrast;
+				params.light_floor = lightFloor;
+				detail::regionMap(img.view(), 1.0f, params, map, scratch);
 				ASSERT_EQ(map.width, w);
 				ASSERT_EQ(map.height, h);
-				EXPECT_EQ(map.pixels, want) << target << " " << W << "x" << H << " contrast " << contrast;
+				EXPECT_EQ(map.pixels, want) << target << " " << W << "x" << H << " contrast " << contrast
+							    << " light floor " << lightFloor;
 				EXPECT_FLOAT_EQ(map.scale, 0.5f);
 				for (int ty = 0; ty < map.tiles_y; ++ty)
 					for (int tx = 0; tx < map.tiles_x; ++tx) {
@@ -191,6 +197,7 @@ TEST(RegionMap, FrontEndBandsMakeTheSameMap)
 			for (float scale : { 1.0f, 0.6f }) {
 				FrontEndParams params;
 				params.region_contrast = 40;
+				params.light_floor = 16;
 				EdgeMap edges;
 				makeCpuFrontEnd(threads)->run(img.view(), scale, params, edges);
 				/* The reference, from the frame the front end traced. */
@@ -201,7 +208,7 @@ TEST(RegionMap, FrontEndBandsMakeTheSameMap)
 					src = img;
 				TraceMap want;
 				detail::RegionScratch scratch;
-				detail::regionMap(src.view(), edges.scale, 40, want, scratch);
+				detail::regionMap(src.view(), edges.scale, params, want, scratch);
 				EXPECT_EQ(edges.regions.width, want.width) << W << "x" << H;
 				EXPECT_EQ(edges.regions.pixels, want.pixels)
 					<< W << "x" << H << " threads " << threads << " scale " << scale;
@@ -216,10 +223,13 @@ TEST(RegionMap, EmptyWhenOffOrTooSmall)
 	Image img(5, 100, 0);
 	TraceMap map;
 	detail::RegionScratch scratch;
-	detail::regionMap(img.view(), 1.0f, 40, map, scratch);
+	FrontEndParams params;
+	params.region_contrast = 40;
+	detail::regionMap(img.view(), 1.0f, params, map, scratch);
 	EXPECT_EQ(map.width, 0);
 	Image big(64, 64, 0);
-	detail::regionMap(big.view(), 1.0f, 0, map, scratch);
+	params.region_contrast = 0;
+	detail::regionMap(big.view(), 1.0f, params, map, scratch);
 	EXPECT_EQ(map.width, 0);
 }
 

@@ -5,6 +5,7 @@
 
 #include "frappe/export.h"
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -27,6 +28,32 @@ struct FrontEndParams {
 	/// around it differ by at least this much (8-bit grey levels) and it
 	/// lies below their midpoint; 0: no region map.
 	int region_contrast = 0;
+	/// Below mid-grey the three thresholds above scale with the local
+	/// brightness (relativeThreshold(), the contract at the top of
+	/// front_end_cpu.cpp): the grey level added to a brightness before it
+	/// is compared with kLightReference. kLightReference or more: the
+	/// thresholds are absolute, as in the paper.
+	int light_floor = kLightReference;
+
+	/// The brightness (8-bit grey level) at and above which the
+	/// thresholds are the absolute ones.
+	static constexpr int kLightReference = 128;
+	/// A squared-gradient threshold `t` (edge or corner, 0 <= t < 2^23) at
+	/// a pixel of smoothed brightness `p`: t ((p + light_floor) / 128)^2,
+	/// capped at t, in two exact 32-bit steps (the QPU multiplies 24 x 24
+	/// bits).
+	std::int32_t relativeThreshold(std::int32_t t, int p) const
+	{
+		const std::int32_t q = std::min(p + light_floor, kLightReference);
+		return (((t * q) >> 7) * q) >> 7;
+	}
+	/// The region map's contrast for tile extremes lo and hi: region_contrast
+	/// scaled by (lo + hi + 2 light_floor) / 256, capped at it, rounded up.
+	int relativeRegionContrast(int lo, int hi) const
+	{
+		const int sum = std::min(lo + hi + 2 * light_floor, 2 * kLightReference);
+		return (region_contrast * sum + 255) >> 8;
+	}
 };
 
 /// A byte map the contour tracer follows: foreground pixels have bit 0
