@@ -42,6 +42,9 @@
 //   outermost row and column of the map, where the contrast follows the
 //   light as the thresholds do: C = (region_contrast *
 //   min(lo + hi + 2 light_floor, 256) + 255) >> 8.
+// The shade map (EdgeMap::shades), when light_floor < 128: the same map
+// but for the midpoint, dark where hi - lo >= C(lo, hi) and
+// (r + 4)^2 < (lo + 4)(hi + 4).
 #include <algorithm>
 #include <cstdlib>
 #include <thread>
@@ -120,6 +123,7 @@ void CpuFrontEnd::run(const ImageView &image, float scale, const FrontEndParams 
 	if (w < 3 || h < 3) {
 		std::fill(out.pixels.begin(), out.pixels.end(), 0);
 		out.regions.resize(0, 0);
+		out.shades.resize(0, 0);
 		return;
 	}
 
@@ -157,7 +161,7 @@ void CpuFrontEnd::run(const ImageView &image, float scale, const FrontEndParams 
 		band(0);
 	else
 		pool_.run(bands, band);
-	detail::regionMapFromMeans(w, h, out.scale, params, out.regions, regionScratch_);
+	detail::regionMapFromMeans(w, h, out.scale, params, out.regions, out.shades, regionScratch_);
 }
 
 /* Edge rows y0 .. y1-1 (1 <= y0, y1 <= h-1), and the means rows of the job. */

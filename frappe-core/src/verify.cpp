@@ -28,6 +28,12 @@ constexpr int kAmbiguityGap = 2;
  * take back what a blur of about a cell spreads into the neighbours. */
 constexpr float kSharpening = 0.25f;
 
+/* On the log scale a light grey beside black ink reads as white: a quiet
+ * zone read there must also hold a cell at least half as light, in grey
+ * levels, as the code's lightest (paper under the same light within a
+ * factor of two; a panel on a mid-grey wall is no marker). */
+constexpr float kPaperWhite = 0.5f;
+
 /* A candidate's payload must span at least this many grey levels (the
  * detector's rule for every read). */
 constexpr float kMinContrast = 10.0f;
@@ -56,6 +62,14 @@ double clearCellsChance(const Dictionary &dict, int clear, int errors)
 }
 
 } // namespace
+
+bool quietZoneIsPaper(const QuietZone &q, const Binarised &b, Tone tone)
+{
+	if (tone.linear() || q.seen < 8)
+		return true;
+	const float white = tone.invert(b.threshold + 0.5f * b.contrast);
+	return q.brightest >= kPaperWhite * white;
+}
 
 CellRead readCells(const WarpedMarker &w, int bits, const Binarised &b, float weakMargin)
 {
@@ -101,7 +115,7 @@ int clearErrors(const Dictionary &dict, std::uint64_t code, std::uint64_t weak, 
 }
 
 QuietZone readQuietZone(const ImageView &image, const std::array<Point2f, 4> &corners, int bits,
-			const Binarised &b)
+			const Binarised &b, Tone tone)
 {
 	const float threshold = b.threshold, black = b.threshold - kStraddle * b.contrast;
 	QuietZone out;
@@ -116,7 +130,9 @@ QuietZone readQuietZone(const ImageView &image, const std::array<Point2f, 4> &co
 		if (!(p.x >= 0.0f && p.y >= 0.0f && p.x <= maxX && p.y <= maxY))
 			return;
 		++out.seen;
-		const float v = sampleBilinear(image, p.x, p.y);
+		const float grey = sampleBilinear(image, p.x, p.y);
+		out.brightest = std::max(out.brightest, grey);
+		const float v = tone.apply(grey);
 		out.light += v > threshold;
 		out.dark += v < black;
 	};
@@ -283,7 +299,7 @@ MarkerRead readMarker(const ImageView &image, const std::array<Point2f, 4> &corn
 		 * that chance reads often must still sit on real cells, as judged
 		 * by samples a quarter cell from their edges. */
 		WarpedMarker quarters;
-		if (!warpMarker(image, corners, dict.bits, quarters)) {
+		if (!warpMarker(image, corners, dict.bits, quarters, policy.tone)) {
 			out.rejection = Rejection::CellsDisagree;
 			return out;
 		}
@@ -293,7 +309,8 @@ MarkerRead readMarker(const ImageView &image, const std::array<Point2f, 4> &corn
 		out.rejection = Rejection::CellsDisagree;
 		return out;
 	}
-	if (!quietZoneIsLight(readQuietZone(image, corners, dict.bits, b), scrutiny)) {
+	const QuietZone quiet = readQuietZone(image, corners, dict.bits, b, policy.tone);
+	if (!quietZoneIsLight(quiet, scrutiny) || !quietZoneIsPaper(quiet, b, policy.tone)) {
 		out.rejection = Rejection::NoQuietZone;
 		return out;
 	}
@@ -306,7 +323,7 @@ MarkerRead readCellCentres(const ImageView &image, const std::array<Point2f, 4> 
 {
 	const int bits = codes.dictionary().bits;
 	float reference = 0.0f;
-	if (!warpCellCentres(image, corners, bits, kSharpening, scratch, &reference))
+	if (!warpCellCentres(image, corners, bits, kSharpening, scratch, &reference, policy.tone))
 		return {};
 	const Binarised b = binarise(scratch, bits);
 	const float lo = b.threshold - 0.5f * b.contrast, hi = b.threshold + 0.5f * b.contrast;

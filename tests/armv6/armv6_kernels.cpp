@@ -393,7 +393,8 @@ void checkLabels(std::size_t n, int misalign)
 }
 
 /* The documented rule of the region map, pixel by pixel. */
-std::vector<std::uint8_t> slowRegionMap(const Gray &g, int minContrast, int lightFloor, int &w, int &h)
+std::vector<std::uint8_t> slowRegionMap(const Gray &g, int minContrast, int lightFloor, int &w, int &h,
+					bool shade = false)
 {
 	w = g.w / 2;
 	h = g.h / 2;
@@ -418,7 +419,9 @@ std::vector<std::uint8_t> slowRegionMap(const Gray &g, int minContrast, int ligh
 						}
 			out[static_cast<std::size_t>(y) * w + x] =
 				hi - lo >= ((minContrast * std::min(lo + hi + 2 * lightFloor, 256) + 255) >> 8) &&
-				r[static_cast<std::size_t>(y) * w + x] < ((lo + hi + 1) >> 1);
+				(shade ? (r[static_cast<std::size_t>(y) * w + x] + 4) * (r[static_cast<std::size_t>(y) * w + x] + 4) <
+						 (lo + 4) * (hi + 4)
+				       : r[static_cast<std::size_t>(y) * w + x] < ((lo + hi + 1) >> 1));
 		}
 	return out;
 }
@@ -429,12 +432,24 @@ std::size_t compareRegionMap(const Gray &g, int contrast, const char *what, int 
 {
 	int w, h;
 	const auto want = slowRegionMap(g, contrast, lightFloor, w, h);
-	TraceMap map;
+	const auto wantShades = slowRegionMap(g, contrast, lightFloor, w, h, true);
+	TraceMap map, shades;
 	RegionScratch scratch;
 	frappe::FrontEndParams params;
 	params.region_contrast = contrast;
 	params.light_floor = lightFloor;
-	regionMap(ImageView(g.px.data(), g.w, g.h, g.w), 1.0f, params, map, scratch);
+	regionMap(ImageView(g.px.data(), g.w, g.h, g.w), 1.0f, params, map, shades, scratch);
+	if (w >= 3 && h >= 3 && lightFloor < 128) {
+		CHECK(shades.pixels == wantShades, "%s: shade map pixels", what);
+		for (int ty = 0; ty < shades.tiles_y; ++ty)
+			for (int tx = 0; tx < shades.tiles_x; ++tx) {
+				bool any = false;
+				for (int y = ty * 16; y < std::min(h, ty * 16 + 16); ++y)
+					for (int x = tx * 16; x < std::min(w, tx * 16 + 16); ++x)
+						any = any || wantShades[static_cast<std::size_t>(y) * w + x];
+				CHECK(!shades.tileEmpty(tx, ty) == any, "%s: shade tile %d,%d", what, tx, ty);
+			}
+	}
 	if (w < 3 || h < 3) {
 		CHECK(map.width == 0, "%s: a map of a frame too small", what);
 		return 0;
