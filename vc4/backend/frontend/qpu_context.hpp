@@ -43,6 +43,7 @@ struct ContextInfo {
 	std::size_t copy_bytes = 0;      // bytes of the last frame copied (front end + warp)
 	std::string_view copy_reason;    // why they were copied; empty when read in place
 	uint64_t total_copy_bytes = 0;   // bytes of all frames copied since the context opened
+	uint64_t device_bytes = 0;       // GPU memory the device holds (its buffers, not imports)
 };
 template <class Device>
 class QpuContext {
@@ -113,7 +114,10 @@ public:
 	// the QPUs read the frame in place).
 	std::size_t copyBytes() const { return copy_bytes_; }
 	std::string_view copyReason() const { return copy_bytes_ ? std::string_view(reason_) : std::string_view(); }
-	ContextInfo info() const { return {this, imports(), copyBytes(), copyReason(), total_copy_bytes_}; }
+	ContextInfo info() const
+	{
+		return {this, imports(), copyBytes(), copyReason(), total_copy_bytes_, device_->allocatedBytes()};
+	}
 	std::size_t imports() const
 	{
 		if constexpr (kEmulated)
