@@ -5,6 +5,7 @@
 #include <deque>
 #include <functional>
 #include <list>
+#include <map>
 #include <memory>
 #include <stdexcept>
 
@@ -111,9 +112,22 @@ public:
 		enter(std::prev(flows_.end()));
 	}
 
+	/* Calls `what` at time `when` (not before now). */
+	void at(double when, Done what) { timers_.emplace(std::max(when, now_), std::move(what)); }
+
 	void run()
 	{
-		while (!flows_.empty()) {
+		while (!flows_.empty() || !timers_.empty()) {
+			if (flows_.empty() || (!timers_.empty() && timers_.begin()->first <= now_)) {
+				/* Nothing runs until the next timer, or one is due. */
+				auto next = timers_.begin();
+				if (next->first > now_)
+					now_ = next->first;
+				Done what = std::move(next->second);
+				timers_.erase(next);
+				what();
+				continue;
+			}
 			int cpu = 0;
 			double step = -1;
 			for (auto it = flows_.begin(); it != flows_.end(); ++it)
@@ -129,6 +143,8 @@ public:
 				step = step < 0 ? gpuQueue_.front()->left : std::min(step, gpuQueue_.front()->left);
 			if (step < 0)
 				throw std::logic_error("model: flows without work");
+			if (!timers_.empty())
+				step = std::min(step, timers_.begin()->first - now_);
 			now_ += step;
 			if (cpu > 0)
 				cpuBusy_ += step;
@@ -190,12 +206,13 @@ private:
 
 	std::list<Flow> flows_;
 	std::deque<It> gpuQueue_;
+	std::multimap<double, Done> timers_;
 	double now_ = 0, cpuBusy_ = 0, gpuBusy_ = 0;
 };
 
 } // namespace
 
-Timeline simulate(const std::vector<FrameWork> &frames, Overlap overlap, const Assumptions &a, End e)
+Timeline simulate(const std::vector<FrameWork> &frames, Overlap overlap, const Assumptions &a, End e, double period)
 {
 	const std::size_t n = frames.size();
 	Timeline t;
@@ -205,7 +222,14 @@ Timeline simulate(const std::vector<FrameWork> &frames, Overlap overlap, const A
 		return t;
 	Engine eng;
 	std::vector<char> done(n, 0);
-	std::function<void(std::size_t)> push;
+	std::function<void(std::size_t)> push, start;
+	/* Frame i is captured at i * period and pushed once the element takes it. */
+	auto next = [&](std::size_t i) {
+		if (period > 0 && static_cast<double>(i) * period > eng.now())
+			eng.at(static_cast<double>(i) * period, [&, i] { start(i); });
+		else
+			start(i);
+	};
 	/* Whole frames: the frame whose result the caller waits for, and what it does then
 	 * (here, as the flows call back after this function's blocks). */
 	std::size_t awaiting = n;
@@ -218,7 +242,7 @@ Timeline simulate(const std::vector<FrameWork> &frames, Overlap overlap, const A
 			eng.start(concat(concat(frontSegs(f, a, e), traceSegs(f, a, e)), finishSegs(f, a, e)), [&, i] {
 				t.out[i] = eng.now();
 				if (i + 1 < n)
-					push(i + 1);
+					next(i + 1);
 			});
 		};
 	} else if (overlap == Overlap::Frames) {
@@ -234,7 +258,7 @@ Timeline simulate(const std::vector<FrameWork> &frames, Overlap overlap, const A
 		};
 		got = [&](std::size_t j) {
 			if (j + 2 < n)
-				push(j + 2);
+				next(j + 2);
 			else if (j + 1 < n)
 				waitFor(j + 1);
 		};
@@ -250,7 +274,7 @@ Timeline simulate(const std::vector<FrameWork> &frames, Overlap overlap, const A
 				}
 			});
 			if (i == 0 && n > 1)
-				push(1);
+				next(1);
 			else
 				waitFor(i == 0 ? 0 : i - 1);
 		};
@@ -265,7 +289,7 @@ Timeline simulate(const std::vector<FrameWork> &frames, Overlap overlap, const A
 					return;
 				if (i == 0) {
 					if (n > 1)
-						push(1);
+						next(1);
 					else
 						eng.start(concat(traceSegs(frames[0], a, e), finishSegs(frames[0], a, e)),
 							  [&] { t.out[0] = eng.now(); });
@@ -274,7 +298,7 @@ Timeline simulate(const std::vector<FrameWork> &frames, Overlap overlap, const A
 				eng.start(finishSegs(frames[i - 1], a, e), [&, i] {
 					t.out[i - 1] = eng.now();
 					if (i + 1 < n) {
-						push(i + 1);
+						next(i + 1);
 					} else {
 						/* flush: the last frame's trace and finish */
 						eng.start(concat(traceSegs(frames[i], a, e), finishSegs(frames[i], a, e)),
@@ -287,8 +311,13 @@ Timeline simulate(const std::vector<FrameWork> &frames, Overlap overlap, const A
 				eng.start(traceSegs(frames[i - 1], a, e), bothDone);
 		};
 	}
-	push(0);
+	/* A frame's latency counts from its capture, its push may come later. */
+	start = [&](std::size_t i) { push(i); };
+	next(0);
 	eng.run();
+	if (period > 0)
+		for (std::size_t i = 0; i < n; ++i)
+			t.in[i] = static_cast<double>(i) * period;
 	t.cpuBusy = eng.cpuBusy();
 	t.gpuBusy = eng.gpuBusy();
 	return t;

@@ -70,8 +70,9 @@ struct FrameWork {
 enum class Overlap { None, Frames, Stages };
 const char *overlapName(Overlap o);
 
-// When each frame went in (its push) and came out, in seconds from the first push. The
-// source is never the bottleneck: a frame is pushed as soon as the element takes it.
+// When each frame went in and came out, in seconds from the first push: with a source that
+// is never the bottleneck, its push (as soon as the element takes it); with a camera, its
+// capture (the push may come later when the element is behind).
 struct Timeline {
 	std::vector<double> in, out;
 	double cpuBusy = 0; // seconds the ARM worked
@@ -79,8 +80,10 @@ struct Timeline {
 };
 
 // Plays `frames` through the element. The ARM is one core shared evenly by the threads
-// that have CPU work; the GPU runs one launch at a time, in the order they come.
-Timeline simulate(const std::vector<FrameWork> &frames, Overlap overlap, const Assumptions &a, End end);
+// that have CPU work; the GPU runs one launch at a time, in the order they come. `period`
+// > 0: a camera captures frame i at i * period seconds; 0: frames come as fast as taken.
+Timeline simulate(const std::vector<FrameWork> &frames, Overlap overlap, const Assumptions &a, End end,
+		  double period = 0);
 
 // Seconds of one frame's stages on their own (no overlap), for the stage shares.
 struct StageTimes {

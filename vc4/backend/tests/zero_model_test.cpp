@@ -142,3 +142,17 @@ TEST(ZeroModel, TheFiguresHaveSourcesAndOrderedEnds)
 		}
 	}
 }
+
+/* A camera at 100 Hz (10 ms a frame) feeds the element. Staged: frame 0's front end runs
+ * alone (done at 3 ms); at each capture the new frame's front end runs beside the trace of
+ * the frame before (4 ms), whose finish (1 ms) brings it out: 15 ms after its capture. */
+TEST(ZeroModel, ACameraPacesTheFramesAndLatencyCountsFromCapture)
+{
+	const Timeline t = simulate(std::vector<FrameWork>(3, frame()), Overlap::Stages, unit(), End::Mid, 10e-3);
+	expectTimes(t.in, { 0, 10, 20 }, "in");
+	/* The flush traces and finishes the last frame after frame 1 came out: 25 + 4. */
+	expectTimes(t.out, { 15, 25, 29 }, "out");
+	const Timeline u = simulate(std::vector<FrameWork>(3, frame()), Overlap::None, unit(), End::Mid, 10e-3);
+	expectTimes(u.out, { 7, 17, 27 }, "unpipelined out");
+	EXPECT_NEAR(summarise(u).latency_max, 7e-3, 1e-12);
+}
