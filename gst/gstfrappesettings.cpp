@@ -127,7 +127,8 @@ bool Settings::samePipeline(const Settings &o) const
 	       cornerThreshold == o.cornerThreshold && regionContrast == o.regionContrast &&
 	       maxHamming == o.maxHamming &&
 	       scaledSize == o.scaledSize && maxScaledFrames == o.maxScaledFrames &&
-	       backend == o.backend && pipelined == o.pipelined && overlap == o.overlap &&
+	       backend == o.backend && pipelined == o.pipelined &&
+	       (overlap == o.overlap || !pipelined) && /* overlap means nothing unpipelined */
 	       customDictionary == o.customDictionary;
 }
 

@@ -236,3 +236,28 @@ TEST(Backend, StatsSayWhichOverlapRanAndTheQpuContextsOpened)
 		gst_harness_teardown(h);
 	}
 }
+
+/* overlap means nothing unpipelined: setting it keeps the pipeline and its
+ * context; pipelined=true then rebuilds it (every new pipeline opens its own
+ * contexts, which qpu-contexts counts: here two for whole frames). */
+TEST(Backend, OverlapUnpipelinedKeepsTheQpuContext)
+{
+	GstHarness *h = gst_harness_new_parse("frappedetect backend=vc4-emu");
+	gst_harness_set_src_caps_str(h, capsString(kSpec).c_str());
+	auto push = [&](int i) {
+		ASSERT_EQ(gst_harness_push(h, makeFrame(kSpec, markersOf(i), dict("aruco_mip_36h12"),
+							static_cast<GstClockTime>(i) * kFrame, kFrame)),
+			  GST_FLOW_OK);
+	};
+	push(0);
+	g_object_set(detector(h), "overlap", 1 /* frames */, nullptr);
+	push(1);
+	EXPECT_EQ(statsField(h, "overlap"), "none");
+	EXPECT_EQ(statsField(h, "qpu-contexts"), "1");
+	g_object_set(detector(h), "pipelined", TRUE, nullptr);
+	push(2);
+	push(3);
+	EXPECT_EQ(statsField(h, "overlap"), "frames");
+	EXPECT_EQ(statsField(h, "qpu-contexts"), "3");
+	gst_harness_teardown(h);
+}
