@@ -10,7 +10,7 @@
 //
 //   vc4-zero-model --counts FRAMES.csv (--images DIR | --list FILE) [--mode normal|ascale]
 //                  [--dictionary D] [--max N] [--pool N] [--copy-in] [--emulate-each]
-//                  [--per-frame] [--name NAME]
+//                  [--per-frame [--targeted]] [--name NAME]
 //
 // The QPU front end's counts depend on the frame's geometry only (its programs have no
 // branch on pixel values), so they are emulated once per scaled size unless --emulate-each;
@@ -146,7 +146,7 @@ private:
 
 struct Options {
 	std::string counts, images, list, dictionary = "aruco_mip_36h12", name;
-	bool ascale = false, perFrame = false, emulateEach = false, copyIn = false;
+	bool ascale = false, perFrame = false, emulateEach = false, copyIn = false, targeted = false;
 	int max = 0, pool = 4;
 };
 
@@ -251,11 +251,13 @@ int main(int argc, char **argv)
 			o.emulateEach = true;
 		else if (a == "--per-frame")
 			o.perFrame = true;
+		else if (a == "--targeted")
+			o.targeted = true;
 		else {
 			std::fprintf(stderr,
 				     "usage: vc4-zero-model --counts FRAMES.csv (--images DIR | --list FILE) "
 				     "[--mode normal|ascale] [--dictionary D] [--max N] [--pool N] [--copy-in] "
-				     "[--emulate-each] [--per-frame] [--name NAME]\n");
+				     "[--emulate-each] [--per-frame [--targeted]] [--name NAME]\n");
 			return 2;
 		}
 	}
@@ -395,12 +397,13 @@ int main(int argc, char **argv)
 	const model::Overlap overlaps[] = { model::Overlap::None, model::Overlap::Frames, model::Overlap::Stages };
 	const model::End ends[] = { model::End::Fast, model::End::Mid, model::End::Slow };
 
-	/* Per frame, central figures, today's runtime. */
+	/* Per frame, central figures, today's runtime (or --targeted syncs). */
 	model::Timeline mid[3];
 	for (int k = 0; k < 3; ++k)
-		mid[k] = model::simulate(all, overlaps[k], a, model::End::Mid);
+		mid[k] = model::simulate(o.targeted ? targeted : all, overlaps[k], a, model::End::Mid);
 	if (o.perFrame) {
-		std::printf("\nper frame (central figures, runtime as it is): frame time / latency, ms\n");
+		std::printf("\nper frame (central figures, %s): frame time / latency, ms\n",
+			    o.targeted ? "targeted syncs" : "runtime as it is");
 		std::printf("%-14s %7s %5s  %15s  %15s  %15s\n", "frame", "size", "marks", "unpipelined", "whole frames",
 			    "staged");
 		for (std::size_t i = 0; i < works.size(); ++i) {
@@ -424,7 +427,7 @@ int main(int argc, char **argv)
 		for (int v = 0; v < 2; ++v)
 			for (int e = 0; e < 3; ++e)
 				ft[v][e] = model::summarise(model::simulate(v ? targeted : all, overlaps[k], a, ends[e])).frame_time;
-		const model::Summary s = model::summarise(mid[k]);
+		const model::Summary s = model::summarise(model::simulate(all, overlaps[k], a, model::End::Mid));
 		const model::Summary st =
 			model::summarise(model::simulate(targeted, overlaps[k], a, model::End::Mid));
 		std::printf("%-13s | %6.2f %6.2f %6.2f  %4.0f %4.0f %4.0f | %6.2f %6.2f %6.2f  %4.0f %4.0f %4.0f | "
@@ -444,8 +447,9 @@ int main(int argc, char **argv)
 			    ms(st.latency_max));
 	}
 	const double span = mid[2].out.back();
-	std::printf("staged, central: ARM busy %.0f%%, QPUs and mailbox busy %.0f%% of the run\n",
-		    100 * mid[2].cpuBusy / span, 100 * mid[2].gpuBusy / span);
+	std::printf("staged, central, %s: ARM busy %.0f%%, QPUs and mailbox busy %.0f%% of the run\n",
+		    o.targeted ? "targeted syncs" : "runtime as it is", 100 * mid[2].cpuBusy / span,
+		    100 * mid[2].gpuBusy / span);
 	std::printf("GPU memory a QPU context holds: %.1f MB (whole frames: two contexts)\n",
 		    static_cast<double>(fe->last().device_bytes) / 1e6);
 
