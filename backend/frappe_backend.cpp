@@ -5,7 +5,9 @@
  */
 #include "frappe_backend.h"
 
+#include <algorithm>
 #include <utility>
+#include <vector>
 
 #ifdef FRAPPE_HAVE_VC4
 #include "frontend/backend.hpp"
@@ -36,6 +38,22 @@ std::string selectBackend(Pipeline &pipeline, std::string_view name)
 	if (name == "vc4" || name == "vc4-emu")
 		throw BackendNotBuilt("backend " + std::string(name) + " needs vc4/, which this build lacks");
 	throw std::invalid_argument("unknown backend '" + std::string(name) + "' (auto, cpu, vc4, vc4-emu)");
+#endif
+}
+
+int qpuContexts(Pipeline &pipeline)
+{
+#ifdef FRAPPE_HAVE_VC4
+	std::vector<const void *> seen;
+	for (int i = 0; i < pipeline.detectorCount(); ++i) {
+		const void *context = vc4::contextOf(pipeline.detector(i).frontEnd());
+		if (context && std::find(seen.begin(), seen.end(), context) == seen.end())
+			seen.push_back(context);
+	}
+	return static_cast<int>(seen.size());
+#else
+	(void)pipeline;
+	return 0;
 #endif
 }
 

@@ -37,6 +37,12 @@ public:
 std::string selectBackend(Pipeline &pipeline, std::string_view name);
 
 /*
+ * The QPU contexts (devices: GPU memory, one set of buffers each) that the
+ * detectors of `pipeline` hold: one per detector on the QPUs, 0 on CPUs.
+ */
+int qpuContexts(Pipeline &pipeline);
+
+/*
  * Frame memory the QPUs of `backend` ("vc4" or "vc4-emu") read in place: a
  * dma-buf of at least `bytes`, for an upstream element to write frames into
  * (the element's pool of GPU-visible buffers). Returns its file descriptor,

@@ -76,16 +76,28 @@
  * luma plane that lies in one dma-buf in place; other input is copied (the
  * stats' `copied-bytes`, and one debug line saying why).
  *
- * With #GstFrappeDetect:pipelined, two frames are detected at once, each
- * whole frame on a detector of its own on one of two threads (a
- * frappe::Pipeline): about 1.5 times the frame rate a core allows, for one
- * frame of latency. The element then holds one buffer, answers the LATENCY query
- * with one extra frame, asks upstream pools for one more buffer, pushes the
- * held buffer on EOS, caps, segment, gap, stream-start and DRAIN queries,
- * and drops it on flush. Every buffer the element receives comes out once,
- * in order, with its own metas (QoS may drop buffers before that: below).
- * In AScale mode each of the two detectors scales a frame from the last
- * frame it ran.
+ * With #GstFrappeDetect:pipelined, two frames are detected at once (a
+ * frappe::Pipeline), in the way #GstFrappeDetect:overlap says. `frames`:
+ * each whole frame on a detector of its own on one of two threads, about
+ * 1.5 times the frame rate a core allows where there are two cores.
+ * `stages`: one detector whose worker thread runs the next frame's front
+ * end (on the QPUs: their passes, while that thread sleeps in the GPU
+ * call) while the streaming thread traces this frame's contours and then
+ * finishes it: the paper's overlap for a Pi Zero's one core beside its 12
+ * QPUs, with one QPU context and one set of GPU buffers. `auto` (the
+ * default) stages when the front end runs on the QPUs (backend vc4, vc4-emu,
+ * or auto that found them) and takes whole frames on CPUs; the `stats`
+ * field `overlap` says which ran (`none` when not pipelined) and
+ * `qpu-contexts` how many QPU contexts the element opened since it started.
+ * Either way, one frame of latency: the element then holds one buffer,
+ * answers the LATENCY query with one extra frame, asks upstream pools for
+ * one more buffer, pushes the held buffer on EOS, caps, segment, gap,
+ * stream-start and DRAIN queries, and drops it on flush. Every buffer the
+ * element receives comes out once, in order, with its own metas (QoS may
+ * drop buffers before that: below). In AScale mode a frame scales from
+ * the last frame finished before its front end started (with `frames`,
+ * the last its own detector ran), so it may differ from the unpipelined
+ * element's; in NORMAL mode the markers are the same.
  *
  * A buffer that does not hold the frame it describes is neither mapped nor
  * read: no memory at all; a #GstVideoMeta whose format, size or planes
@@ -103,8 +115,9 @@
  * message. With qos=false every buffer comes out.
  *
  * When detection fails on a frame the element posts an error and returns
- * a flow error, pipelined or not (pipelined, when the held frame is
- * finished: at the next buffer or a drain); that buffer does not come out.
+ * a flow error, pipelined or not (pipelined, when that frame is finished:
+ * at the next buffer or a drain); that buffer does not come out, the ones
+ * before and after it do.
  *
  * ## Example launch lines
  * |[
@@ -136,6 +149,7 @@
 #include <frappe/frappe.h>
 
 #include "annotate.h"
+#include "frappe_backend.h"
 #include "gstfrappebuffer.h"
 #include "gstfrappecamera.h"
 #include "gstfrappeenums.h"
@@ -156,6 +170,10 @@ using frappe::gst::Settings;
  * Instance
  */
 
+/* What the pipeline overlaps: nothing (not pipelined), whole frames, or
+ * one detector's stages. */
+enum class Overlap { None, Frames, Stages };
+
 struct FrappeDetectPrivate {
 	/* Under the object lock. */
 	Settings props;
@@ -169,6 +187,8 @@ struct FrappeDetectPrivate {
 	std::vector<std::optional<frappe::Pose>> bestPoses;
 	std::string dictionary;         /* the pipeline's dictionary name */
 	std::unique_ptr<frappe::Pipeline> pipeline;
+	Overlap overlap = Overlap::None; /* the pipeline's */
+	guint qpuContexts = 0;           /* opened since start */
 	std::vector<MappedFrame> held;   /* in the pipeline, oldest first */
 	std::vector<GstBuffer *> output; /* finished, waiting for generate_output */
 	frappe::gst::BufferLog bufferLog;
@@ -200,32 +220,75 @@ static GstStaticPadTemplate src_template =
  * Detection
  */
 
-/* The pipeline of the active settings: frames on one thread, or whole
- * frames on two with one frame of latency (pipelined: one buffer held). */
+static const char *overlap_name(Overlap o)
+{
+	return o == Overlap::Stages ? "stages" : o == Overlap::Frames ? "frames" : "none";
+}
+
+/* A pipeline of the active settings with its front end, or nullptr after
+ * an element error. Not pipelined: frames one at a time on one thread.
+ * Pipelined, one frame held either way: whole frames on two detectors and
+ * threads (frappe::Pipeline::Mode::Frames, latency 1), or one detector's
+ * stages (Mode::Stages, latency 1: the next frame's front end beside this
+ * frame's trace). */
+static std::unique_ptr<frappe::Pipeline> make_pipeline(GstFrappeDetect *self, Overlap overlap,
+						       GstFrappeBackend backend)
+{
+	FrappeDetectPrivate *priv = self->priv;
+	const bool staged = overlap == Overlap::Stages;
+	std::unique_ptr<frappe::Pipeline> pipeline;
+	try {
+		pipeline = std::make_unique<frappe::Pipeline>(
+			priv->active.config(staged), staged ? frappe::Pipeline::Mode::Stages : frappe::Pipeline::Mode::Frames,
+			overlap == Overlap::None ? 0 : 1);
+	} catch (const std::exception &e) {
+		GST_ELEMENT_ERROR(self, LIBRARY, SETTINGS, ("Invalid detector settings"), ("%s", e.what()));
+		return nullptr;
+	}
+	if (!frappe::gst::selectFrontEnd(GST_ELEMENT(self), *pipeline, backend, priv->warnedFallback))
+		return nullptr;
+	return pipeline;
+}
+
+/* The pipeline of the active settings. overlap=auto stages the frames when
+ * the front end runs on the QPUs: backend=auto only knows after its probe,
+ * so it is first built staged (only that shape may hold the QPUs' one
+ * context) and rebuilt over whole frames when the front end came out on the
+ * CPU (no QPU context was opened then). */
 static bool ensure_pipeline(GstFrappeDetect *self)
 {
 	FrappeDetectPrivate *priv = self->priv;
 	if (priv->pipeline)
 		return true;
-	const frappe::Config config = priv->active.config();
-	try {
-		priv->pipeline = std::make_unique<frappe::Pipeline>(config, frappe::Pipeline::Mode::Frames,
-								     priv->active.pipelined ? 1 : 0);
-	} catch (const std::exception &e) {
-		GST_ELEMENT_ERROR(self, LIBRARY, SETTINGS, ("Invalid detector settings"), ("%s", e.what()));
-		return false;
+	const Settings &s = priv->active;
+	Overlap overlap = Overlap::None;
+	if (s.pipelined) {
+		if (s.overlap == GST_FRAPPE_OVERLAP_FRAMES)
+			overlap = Overlap::Frames;
+		else if (s.overlap == GST_FRAPPE_OVERLAP_STAGES)
+			overlap = Overlap::Stages;
+		else
+			overlap = s.backend == GST_FRAPPE_BACKEND_CPU ? Overlap::Frames : Overlap::Stages;
 	}
-	if (!frappe::gst::selectFrontEnd(GST_ELEMENT(self), *priv->pipeline, priv->active.backend,
-					 priv->warnedFallback)) {
-		priv->pipeline.reset();
-		return false;
+	priv->pipeline = make_pipeline(self, overlap, s.backend);
+	if (priv->pipeline && s.pipelined && s.overlap == GST_FRAPPE_OVERLAP_AUTO && overlap == Overlap::Stages &&
+	    !frappe::gst::frontEndOnQpus(*priv->pipeline)) {
+		GST_DEBUG_OBJECT(self, "overlap=auto: the front end is on the CPU, whole frames then");
+		overlap = Overlap::Frames;
+		priv->pipeline = make_pipeline(self, overlap, GST_FRAPPE_BACKEND_CPU);
 	}
+	if (!priv->pipeline)
+		return false;
+	priv->overlap = overlap;
+	priv->qpuContexts += static_cast<guint>(frappe::qpuContexts(*priv->pipeline));
 	priv->held.reserve(static_cast<std::size_t>(priv->pipeline->latency()) + 1);
 	priv->dictionary = priv->pipeline->detector().dictionary().name;
-	GST_DEBUG_OBJECT(self, "pipeline for %s, mode %s, max-hamming %d, front end %s, %d thread(s)",
-			 priv->dictionary.c_str(), config.mode == frappe::Mode::AScale ? "ascale" : "normal",
+	GST_DEBUG_OBJECT(self,
+			 "pipeline for %s, mode %s, max-hamming %d, front end %s, overlap %s, %d thread(s), "
+			 "%u QPU context(s) opened",
+			 priv->dictionary.c_str(), s.mode == GST_FRAPPE_MODE_ASCALE ? "ascale" : "normal",
 			 priv->pipeline->detector().maxHamming(), priv->pipeline->detector().frontEnd().name(),
-			 priv->pipeline->threads());
+			 overlap_name(overlap), priv->pipeline->threads(), priv->qpuContexts);
 	return true;
 }
 
@@ -234,14 +297,17 @@ static void update_stats(GstFrappeDetect *self, const frappe::Result &result, do
 	FrappeDetectPrivate *priv = self->priv;
 	GstStructure *s = frappe::gst::statsStructure(priv->frames, result, poseMs,
 						      priv->pipeline->detector().frontEnd().name(),
-						      priv->active.pipelined);
+						      priv->active.pipelined, overlap_name(priv->overlap),
+						      priv->qpuContexts);
 
 	GST_LOG_OBJECT(self, "stats %" GST_PTR_FORMAT, static_cast<void *>(s));
 	frappe::gst::reportDroppedCandidates(GST_ELEMENT(self), priv->frames, result, priv->warnedDropped);
 
 	if (const auto line = priv->window.add(priv->frames, result, poseMs))
 		GST_INFO_OBJECT(self, "last 100 frames, ms per frame: %s%s", line->c_str(),
-				priv->active.pipelined ? " (two frames at once)" : "");
+				priv->overlap == Overlap::Frames   ? " (two frames at once)"
+				: priv->overlap == Overlap::Stages ? " (the next frame's front end beside this trace)"
+								   : "");
 	GST_OBJECT_LOCK(self);
 	if (priv->stats)
 		gst_structure_free(priv->stats);
@@ -591,6 +657,7 @@ static gboolean gst_frappe_detect_start(GstBaseTransform *trans)
 	self->priv->bufferLog.reset();
 	self->priv->warnedDropped = false;
 	self->priv->poolOffered = false;
+	self->priv->qpuContexts = 0;
 	return TRUE;
 }
 

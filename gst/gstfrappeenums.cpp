@@ -45,6 +45,26 @@ GType gst_frappe_backend_get_type(void)
 	return type;
 }
 
+GType gst_frappe_overlap_get_type(void)
+{
+	static GType type = 0;
+	static const GEnumValue values[] = {
+		{ GST_FRAPPE_OVERLAP_AUTO,
+		  "stages when the front end runs on the QPUs (vc4, vc4-emu, auto that found them), else frames",
+		  "auto" },
+		{ GST_FRAPPE_OVERLAP_FRAMES, "Two whole frames at once, each on a detector and a thread of its own",
+		  "frames" },
+		{ GST_FRAPPE_OVERLAP_STAGES,
+		  "One detector: the next frame's front end (the QPU passes) while this frame is traced", "stages" },
+		{ 0, nullptr, nullptr },
+	};
+	if (g_once_init_enter(&type)) {
+		GType t = g_enum_register_static("GstFrappeOverlap", values);
+		g_once_init_leave(&type, t);
+	}
+	return type;
+}
+
 /* Value names are the library's dictionary names ("apriltag_36h11"), nicks
  * the same with dashes ("apriltag-36h11"): GStreamer parses an enum by name
  * or by nick, so `dictionary=` takes both spellings. */

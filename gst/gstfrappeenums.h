@@ -22,11 +22,21 @@ typedef enum {
 	GST_FRAPPE_BACKEND_VC4_EMU,
 } GstFrappeBackend;
 
+/* What pipelined=true overlaps (pipelined=false overlaps nothing). */
+typedef enum {
+	GST_FRAPPE_OVERLAP_AUTO,
+	GST_FRAPPE_OVERLAP_FRAMES,
+	GST_FRAPPE_OVERLAP_STAGES,
+} GstFrappeOverlap;
+
 #define GST_TYPE_FRAPPE_MODE (gst_frappe_mode_get_type())
 GType gst_frappe_mode_get_type(void);
 
 #define GST_TYPE_FRAPPE_BACKEND (gst_frappe_backend_get_type())
 GType gst_frappe_backend_get_type(void);
+
+#define GST_TYPE_FRAPPE_OVERLAP (gst_frappe_overlap_get_type())
+GType gst_frappe_overlap_get_type(void);
 
 /* One value per built-in dictionary, in the library's stable order; value
  * names are the library's names ("6x6_250"), nicks the same with dashes

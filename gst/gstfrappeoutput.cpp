@@ -148,7 +148,7 @@ void reportDroppedCandidates(GstElement *element, guint64 frame, const Result &r
 }
 
 GstStructure *statsStructure(guint64 frames, const Result &result, double poseMs, const char *backend,
-			     bool pipelined)
+			     bool pipelined, const char *overlap, guint qpuContexts)
 {
 	GstStructure *s = gst_structure_new("frappe-stats", "frames", G_TYPE_UINT64, frames, "markers",
 					    G_TYPE_UINT, static_cast<guint>(result.markers.size()), "candidates",
@@ -164,7 +164,8 @@ GstStructure *statsStructure(guint64 frames, const Result &result, double poseMs
 	}
 	gst_structure_set(s, "pose-ms", G_TYPE_DOUBLE, poseMs, "total-ms", G_TYPE_DOUBLE,
 			  result.times.total_ms + poseMs, "backend", G_TYPE_STRING, backend, "pipelined",
-			  G_TYPE_BOOLEAN, static_cast<gboolean>(pipelined), "copied-bytes", G_TYPE_UINT64,
+			  G_TYPE_BOOLEAN, static_cast<gboolean>(pipelined), "overlap", G_TYPE_STRING, overlap,
+			  "qpu-contexts", G_TYPE_UINT, qpuContexts, "copied-bytes", G_TYPE_UINT64,
 			  static_cast<guint64>(result.copy_bytes), nullptr);
 	return s;
 }

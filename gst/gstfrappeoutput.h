@@ -29,9 +29,11 @@ GstStructure *frameMessage(GstBuffer *buffer, const GstSegment &segment, const R
 			   const Poses &poses, const char *dictionary);
 
 /* The `stats` property's structure for the last frame; `copied-bytes`
- * is what the backend copied of it before reading (0: read in place). */
+ * is what the backend copied of it before reading (0: read in place),
+ * `overlap` what the pipeline overlapped (none, frames, stages),
+ * `qpu-contexts` the QPU contexts the element opened since it started. */
 GstStructure *statsStructure(guint64 frames, const Result &result, double poseMs, const char *backend,
-			     bool pipelined);
+			     bool pipelined, const char *overlap, guint qpuContexts);
 
 /* A frame full of squares (a tiled wall, a dot grid) had more candidates
  * than frappe::Config::max_candidates, and markers among those dropped may

@@ -129,10 +129,12 @@ bool Settings::samePipeline(const Settings &o) const
 	       lightFloor == o.lightFloor &&
 	       maxHamming == o.maxHamming &&
 	       scaledSize == o.scaledSize && maxScaledFrames == o.maxScaledFrames &&
-	       backend == o.backend && pipelined == o.pipelined && customDictionary == o.customDictionary;
+	       backend == o.backend && pipelined == o.pipelined &&
+	       (overlap == o.overlap || !pipelined) && /* overlap means nothing unpipelined */
+	       customDictionary == o.customDictionary;
 }
 
-frappe::Config Settings::config() const
+frappe::Config Settings::config(bool staged) const
 {
 	frappe::Config config;
 	const auto dicts = frappe::dictionaries();
@@ -147,7 +149,7 @@ frappe::Config Settings::config() const
 	config.max_hamming = std::min(maxHamming, dict.bits * dict.bits / 2);
 	config.scaled_size = scaledSize;
 	config.max_scaled_frames = maxScaledFrames;
-	config.threads = pipelined ? 2 : 1; /* whole frames on two threads */
+	config.threads = pipelined && !staged ? 2 : 1; /* whole frames on two threads */
 	return config;
 }
 
@@ -245,9 +247,29 @@ void installProperties(GObjectClass *gobject_class)
 	g_object_class_install_property(
 		gobject_class, PROP_PIPELINED,
 		g_param_spec_boolean("pipelined", "Pipelined",
-				     "Detect two frames at once on two threads "
+				     "Detect two frames at once, as overlap says "
 				     "(holds one buffer: one frame of extra latency)",
 				     defaults.pipelined, live));
+	/**
+	 * GstFrappeDetect:overlap:
+	 *
+	 * What #GstFrappeDetect:pipelined overlaps; no effect without it.
+	 * `auto` (the default): `stages` when the front end runs on the QPUs
+	 * (backend vc4, vc4-emu, or auto that found them), `frames` on CPUs.
+	 * `frames`: two whole frames at once, each on a detector and a thread of
+	 * its own (for several cores). `stages`: one detector, the next frame's
+	 * front end (the QPU passes) while this frame's contours are traced,
+	 * then this frame finished (for a Pi Zero's one core beside its QPUs: one
+	 * QPU context). Either holds one buffer. The `stats` field `overlap`
+	 * says which ran.
+	 */
+	g_object_class_install_property(
+		gobject_class, PROP_OVERLAP,
+		g_param_spec_enum("overlap", "Overlap",
+				  "What pipelined=true overlaps: auto (stages with the QPUs, else frames), frames "
+				  "(two whole frames on two threads), stages (the next frame's QPU front end beside "
+				  "this frame's trace, one detector)",
+				  GST_TYPE_FRAPPE_OVERLAP, defaults.overlap, live));
 	g_object_class_install_property(
 		gobject_class, PROP_BACKEND,
 		g_param_spec_enum("backend", "Backend", "Where the front end runs", GST_TYPE_FRAPPE_BACKEND,
@@ -296,7 +318,8 @@ void installProperties(GObjectClass *gobject_class)
 		g_param_spec_boxed("stats", "Statistics",
 				   "Per-stage timings (ms) and counts of the last frame (candidates read, "
 				   "candidates-dropped over the cap, copied-bytes the backend copied before "
-				   "reading it)", GST_TYPE_STRUCTURE,
+				   "reading it), the overlap that ran (none, frames, stages) and the QPU "
+				   "contexts opened since start", GST_TYPE_STRUCTURE,
 				   static_cast<GParamFlags>(G_PARAM_READABLE | G_PARAM_STATIC_STRINGS)));
 }
 
@@ -342,6 +365,9 @@ bool setValue(Settings &p, guint propId, const GValue *value, std::string &warni
 		break;
 	case PROP_PIPELINED:
 		p.pipelined = g_value_get_boolean(value);
+		break;
+	case PROP_OVERLAP:
+		p.overlap = static_cast<GstFrappeOverlap>(g_value_get_enum(value));
 		break;
 	case PROP_BACKEND:
 		p.backend = static_cast<GstFrappeBackend>(g_value_get_enum(value));
@@ -507,6 +533,11 @@ bool selectFrontEnd(GstElement *element, frappe::Pipeline &pipeline, GstFrappeBa
 	return true;
 }
 
+bool frontEndOnQpus(frappe::Pipeline &pipeline)
+{
+	return g_str_has_prefix(pipeline.detector().frontEnd().name(), "vc4");
+}
+
 const char *frameMemoryBackend(GstFrappeBackend backend, frappe::Pipeline *pipeline)
 {
 	if (backend == GST_FRAPPE_BACKEND_VC4 || backend == GST_FRAPPE_BACKEND_VC4_EMU)
@@ -555,6 +586,9 @@ bool getProperty(const Settings &p, guint propId, GValue *value)
 		break;
 	case PROP_PIPELINED:
 		g_value_set_boolean(value, p.pipelined);
+		break;
+	case PROP_OVERLAP:
+		g_value_set_enum(value, p.overlap);
 		break;
 	case PROP_BACKEND:
 		g_value_set_enum(value, p.backend);

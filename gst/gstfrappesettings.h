@@ -44,6 +44,7 @@ enum Property {
 	PROP_MARKER_SIZES,
 	PROP_DICTIONARY_FILE,
 	PROP_STATS,
+	PROP_OVERLAP,
 };
 
 /* The library's defaults: the detector's properties start from these. */
@@ -64,6 +65,7 @@ struct Settings {
 	gboolean annotate = FALSE;
 	gboolean postMessages = TRUE;
 	gboolean pipelined = FALSE;
+	GstFrappeOverlap overlap = GST_FRAPPE_OVERLAP_AUTO;
 	GstFrappeBackend backend = GST_FRAPPE_BACKEND_AUTO;
 	gdouble markerSize = 0.0; /* no pose */
 	std::string markerSizesSpec;   /* marker-sizes, as set */
@@ -85,10 +87,11 @@ struct Settings {
 	/* Whether a change between two settings needs a new Pipeline. */
 	bool samePipeline(const Settings &o) const;
 
-	/* The pipeline's configuration: one thread, or two when pipelined;
-	 * max-hamming clamped to what the dictionary allows; the custom
-	 * dictionary when dictionary-file is set. */
-	frappe::Config config() const;
+	/* The pipeline's configuration: one thread, or two when pipelined
+	 * over whole frames (`staged`: one detector, whose second thread is
+	 * the pipeline's); max-hamming clamped to what the dictionary allows;
+	 * the custom dictionary when dictionary-file is set. */
+	frappe::Config config(bool staged = false) const;
 
 	/* The camera of the pose, at the calibration's size: the calibration
 	 * file's when one is set (it wins over camera-matrix and distortion),
@@ -119,6 +122,9 @@ bool startSettings(GstElement *element, Settings &props, bool &running);
  * time: `warnedFallback`) when auto falls back to the CPU. */
 bool selectFrontEnd(GstElement *element, frappe::Pipeline &pipeline, GstFrappeBackend backend,
 		    bool &warnedFallback);
+
+/* Whether the pipeline's front end runs on the QPUs (vc4 or vc4-emu). */
+bool frontEndOnQpus(frappe::Pipeline &pipeline);
 
 /* The backend whose QPUs read frames in place, for the pool offered
  * upstream: vc4 or vc4-emu, or auto when `pipeline` (the one auto made, or

@@ -24,6 +24,8 @@
 #   --no-opencv        count frappe only (always so with --arch aarch64)
 #   --region-contrast C  Config::region_contrast for frappe (0: no region map
 #                      and no region candidates; default: the Config default)
+#   --mode M           normal (default) or ascale: the list as one video in its
+#                      order (what the Pi Zero model, vc4-zero-model, reads)
 #   --out DIR          where the results go (default: BUILD/arm-count)
 #   --build DIR        cross build dir (default in the checkout: build-armel,
 #                      build-arm64-count, build-arm64-count-scalar)
@@ -40,7 +42,7 @@ set -euo pipefail
 
 SRC=$(cd "$(dirname "$0")/.." && pwd)
 HERE=$SRC/scripts/arm
-LIST="" IMAGES="" DICT=aruco_mip_36h12 MAX=0 OPENCV=1 BUILD="" SETUP=0 JOBS=2 REGION="" OUT=""
+LIST="" IMAGES="" DICT=aruco_mip_36h12 MAX=0 OPENCV=1 BUILD="" SETUP=0 JOBS=2 REGION="" OUT="" MODE=normal
 ARCH=armv6 SCALAR=0
 while [ $# -gt 0 ]; do
 	case "$1" in
@@ -52,6 +54,7 @@ while [ $# -gt 0 ]; do
 	--max) MAX=$2; shift 2;;
 	--no-opencv) OPENCV=0; shift;;
 	--region-contrast) REGION=$2; shift 2;;
+	--mode) MODE=$2; shift 2;;
 	--out) OUT=$2; shift 2;;
 	--build) BUILD=$2; shift 2;;
 	--setup) SETUP=1; shift;;
@@ -280,6 +283,7 @@ step "counting $n images under ${QEMU[*]:0:3} (OpenCV: $([ "$OPENCV" = 1 ] && ec
 args=(--list "$LIST" --dictionary "$DICT" --max "$MAX" --out-frappe "$OUT/frappe.jsonl")
 [ "$OPENCV" = 1 ] && args+=(--out-opencv "$OUT/opencv.jsonl") || args+=(--no-opencv)
 [ -n "$REGION" ] && args+=(--region-contrast "$REGION")
+args+=(--mode "$MODE")
 # relative paths in the list are relative to the current directory (the contract)
 ( "${QEMU[@]}" -d plugin -plugin "$PLUGIN,out=$OUT/count.log,marks=$OUT/marks.txt" \
 	"$OUT/frappe-count" "${args[@]}" > "$OUT/driver.txt" 2> "$OUT/qemu.log" ) ||

@@ -2,9 +2,10 @@
 // Frames over several threads, results in order. Frames: whole frames from
 // a ring, each taken by an idle worker with its own detector as soon as it
 // is pushed, and by the caller only when it must return a frame nobody has
-// started. Stages: each call runs the front end of the new frame and the
-// finish (refine, warp, decode) of the oldest on the worker, while the
-// caller traces the frame in between.
+// started. Stages: each call runs the front end of the new frame on the
+// worker while the caller traces the frame before it; the finish (refine,
+// warp, decode) of the oldest runs after the front end on the worker
+// (latency 2) or after the trace on the caller (latency 1).
 #include "frappe/pipeline.h"
 
 #include <algorithm>
@@ -226,61 +227,65 @@ private:
 	std::vector<std::unique_ptr<Helper>> helpers_; /* last: they go first */
 };
 
-/// Mode::Stages. At most three frames in flight, oldest first, each in a
-/// slot of the one detector: one traced and waiting for its finish, one
-/// whose front end has run, and the new one.
+/// Mode::Stages. One detector, each frame in a slot of its own, oldest
+/// first. Latency 2: each push runs the new frame's front end and then the
+/// finish (refine, warp, decode) of the oldest on the worker while the
+/// caller traces the frame in between. Latency 1: the worker runs the new
+/// frame's front end while the caller traces the frame before it, then the
+/// caller finishes that frame once the front end is done (a QPU front end
+/// and the QPU warp share one device, which never runs two launches at
+/// once). A stage that throws fails its own frame, which skips its later
+/// stages and throws when it would be returned; the others go on.
 class StageQueue
 {
 public:
-	static constexpr int kLatency = 2;
-
-	explicit StageQueue(const Config &config) : detector_(config) {}
+	StageQueue(const Config &config, int latency) : latency_(latency), detector_(config) {}
 	~StageQueue() { worker_.wait(); }
 
 	const Result *push(const ImageView &image)
 	{
-		frames_[count_] = { image, freeSlot(), false };
+		frames_[count_] = { image, freeSlot(), false, nullptr };
 		Frame &fresh = frames_[count_];
-		Frame *oldest = count_ > 0 ? &frames_[0] : nullptr;
+		/* The frame the caller traces: the newest one before `fresh`
+		 * not yet traced. */
 		Frame *toTrace = nullptr;
 		for (int i = 0; i < count_; ++i)
 			if (!frames_[i].traced)
 				toTrace = &frames_[i];
+		Frame *oldest = count_ > 0 ? &frames_[0] : nullptr;
 		++count_;
 
 		round_.start = &fresh;
-		round_.finish = oldest && oldest->traced ? oldest : nullptr;
+		round_.finish = latency_ == 2 && oldest && oldest->traced ? oldest : nullptr;
 		round_.finished = nullptr;
 		worker_.post(round_);
-		if (toTrace) {
-			DetectorStages::trace(detector_, toTrace->slot);
-			toTrace->traced = true;
-		}
+		if (toTrace)
+			trace(*toTrace);
 		worker_.wait();
-		if (failure_) {
-			count_ = 0; /* out of memory mid-round: drop the frames in flight */
-			std::rethrow_exception(std::exchange(failure_, nullptr));
+		if (latency_ == 2) {
+			if (!round_.finish)
+				return nullptr;
+			return popOldest(round_.finished);
 		}
-		if (!round_.finish)
+		if (count_ <= latency_)
 			return nullptr;
-		popOldest();
-		return round_.finished;
+		return popOldest(finish(frames_[0]));
 	}
 
 	const Result *flush()
 	{
 		if (count_ == 0)
 			return nullptr;
-		const Frame oldest = frames_[0];
-		popOldest();
+		Frame &oldest = frames_[0];
 		if (!oldest.traced)
-			DetectorStages::trace(detector_, oldest.slot);
-		return &DetectorStages::finish(detector_, oldest.image, oldest.slot);
+			trace(oldest);
+		return popOldest(finish(oldest));
 	}
 
 	/* push() returns only once its round has, so nothing runs here. */
 	void drop() { count_ = 0; }
 	bool pending() const { return count_ > 0; }
+	int latency() const { return latency_; }
 	Detector &detector() { return detector_; }
 
 private:
@@ -288,27 +293,53 @@ private:
 		ImageView image;
 		int slot = 0;
 		bool traced = false;
+		std::exception_ptr failure; /* thrown when the frame is returned */
 	};
 
-	/* The worker's round: the new frame's front end, then the oldest
-	 * frame's finish when there is one. A member, so posting it allocates
-	 * nothing. */
+	/* The worker's round: the new frame's front end, then (latency 2) the
+	 * oldest frame's finish when there is one. A member, so posting it
+	 * allocates nothing. */
 	struct Round {
 		StageQueue *self;
-		const Frame *start = nullptr;
-		const Frame *finish = nullptr;
+		Frame *start = nullptr;
+		Frame *finish = nullptr;
 		const Result *finished = nullptr;
 		void operator()()
 		{
 			try {
 				DetectorStages::frontEnd(self->detector_, start->image, start->slot);
-				if (finish)
-					finished = &DetectorStages::finish(self->detector_, finish->image, finish->slot);
 			} catch (...) {
-				self->failure_ = std::current_exception();
+				start->failure = std::current_exception();
 			}
+			if (finish)
+				finished = self->finish(*finish);
 		}
 	};
+
+	void trace(Frame &f)
+	{
+		if (!f.failure) {
+			try {
+				DetectorStages::trace(detector_, f.slot);
+			} catch (...) {
+				f.failure = std::current_exception();
+			}
+		}
+		f.traced = true;
+	}
+
+	/* The frame's result, or nullptr when a stage failed it. */
+	const Result *finish(Frame &f)
+	{
+		if (f.failure)
+			return nullptr;
+		try {
+			return &DetectorStages::finish(detector_, f.image, f.slot);
+		} catch (...) {
+			f.failure = std::current_exception();
+			return nullptr;
+		}
+	}
 
 	int freeSlot() const
 	{
@@ -322,18 +353,24 @@ private:
 		return 0; /* not reached: at most kSlots - 1 frames wait */
 	}
 
-	void popOldest()
+	/* Takes the oldest frame out; returns its result or throws its failure. */
+	const Result *popOldest(const Result *result)
 	{
+		std::exception_ptr failed = std::exchange(frames_[0].failure, nullptr);
 		for (int i = 1; i < count_; ++i)
-			frames_[i - 1] = frames_[i];
+			frames_[i - 1] = std::move(frames_[i]);
+		frames_[count_ - 1].failure = nullptr;
 		--count_;
+		if (failed)
+			std::rethrow_exception(failed);
+		return result;
 	}
 
+	const int latency_;
 	Detector detector_;
 	Frame frames_[DetectorStages::kSlots];
 	int count_ = 0;
 	Round round_{ this };
-	std::exception_ptr failure_;
 	Worker worker_; /* last: it goes first */
 };
 
@@ -348,9 +385,11 @@ Pipeline::Pipeline(const Config &config, Mode mode, int latency) : impl_(std::ma
 {
 	auto fail = [](const std::string &what) { throw std::invalid_argument("frappe::Pipeline: " + what); };
 	if (mode == Mode::Stages) {
-		if (latency != kDefaultLatency && latency != detail::StageQueue::kLatency)
-			fail("Mode::Stages has a latency of 2, not " + std::to_string(latency));
-		impl_->stages = std::make_unique<detail::StageQueue>(config);
+		if (latency == kDefaultLatency)
+			latency = 2;
+		if (latency != 1 && latency != 2)
+			fail("Mode::Stages has a latency of 1 or 2, not " + std::to_string(latency));
+		impl_->stages = std::make_unique<detail::StageQueue>(config, latency);
 		return;
 	}
 	const int threads = detail::threadCount(config);
@@ -398,7 +437,7 @@ bool Pipeline::pending() const
 
 int Pipeline::latency() const
 {
-	return impl_->frames ? impl_->frames->latency() : detail::StageQueue::kLatency;
+	return impl_->frames ? impl_->frames->latency() : impl_->stages->latency();
 }
 
 int Pipeline::threads() const { return impl_->frames ? impl_->frames->detectorCount() : 2; }

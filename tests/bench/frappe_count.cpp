@@ -11,10 +11,12 @@
 //
 //   frappe-count --list LIST.txt [--dictionary aruco_mip_36h12] [--max N]
 //                [--no-opencv] [--out-frappe F.jsonl] [--out-opencv O.jsonl]
-//                [--region-contrast C]
+//                [--region-contrast C] [--mode normal|ascale]
 //
 // --region-contrast sets Config::region_contrast (0 turns the region map and
-// its candidates off), to measure what that path costs.
+// its candidates off), to measure what that path costs. --mode ascale runs
+// the list as one video in its order (each frame scaled from the markers of
+// the frames before it), for the Pi Zero model's ASCALE figures.
 // frappe runs as Detector::detect() does, split into its two halves (the
 // library's internal detail::DetectorStages: the front end, then the back
 // end) with a marker between them; it links the static library. OpenCV gets the
@@ -170,6 +172,7 @@ int main(int argc, char **argv)
 	int maxImages = 0;
 	bool useOpencv = true;
 	float regionContrast = -1.0f; /* < 0: the Config default */
+	bool ascale = false;
 	for (int i = 1; i < argc; ++i) {
 		const std::string a = argv[i];
 		auto value = [&]() -> std::string {
@@ -191,11 +194,13 @@ int main(int argc, char **argv)
 			outF = value();
 		else if (a == "--out-opencv")
 			outO = value();
+		else if (a == "--mode")
+			ascale = value() == "ascale";
 		else if (a == "--region-contrast")
 			regionContrast = std::stof(value());
 		else {
 			std::cerr << "usage: frappe-count --list L [--dictionary D] [--max N] [--no-opencv] "
-				     "[--out-frappe F] [--out-opencv O] [--region-contrast C]\n";
+				     "[--out-frappe F] [--out-opencv O] [--region-contrast C] [--mode normal|ascale]\n";
 			return 2;
 		}
 	}
@@ -239,6 +244,8 @@ int main(int argc, char **argv)
 	frappe::Config cfg;
 	cfg.dictionary = dictName;
 	cfg.threads = 1;
+	if (ascale)
+		cfg.mode = frappe::Mode::AScale;
 	if (regionContrast >= 0.0f)
 		cfg.region_contrast = regionContrast;
 	frappe::Detector det(cfg);
@@ -269,6 +276,7 @@ int main(int argc, char **argv)
 		}
 #endif
 		armcount_mark_warmup();
+		det.reset(); /* the video starts at its first frame */
 	}
 
 	for (std::size_t k = 0; k < images.size(); ++k) {

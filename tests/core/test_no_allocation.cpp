@@ -133,3 +133,28 @@ TEST_P(NoAllocation, PipelinePushAllocatesNothingOnceWarm)
 	EXPECT_EQ(markers, 4u * (6 + 6 + 2));
 	EXPECT_EQ(after - before, 0) << "push() allocated on frames of a size it had seen";
 }
+
+/* One detector's stages, at either latency (the element's staged overlap is
+ * latency 1): each slot is warmed by the frames that pass through it. */
+TEST_P(NoAllocation, StagedPipelinePushAllocatesNothingOnceWarm)
+{
+	const std::vector<Image> s = scenes();
+	Config config;
+	config.threads = GetParam();
+	for (int latency : { 1, 2 }) {
+		Pipeline pipeline(config, Pipeline::Mode::Stages, latency);
+		for (int k = 0; k < 12; ++k)
+			pipeline.push(s[static_cast<std::size_t>(k) % 3].view());
+
+		std::size_t markers = 0;
+		const long before = gAllocations.load();
+		for (int k = 12; k < 24; ++k)
+			if (const Result *r = pipeline.push(s[static_cast<std::size_t>(k) % 3].view()))
+				markers += r->markers.size();
+		const long after = gAllocations.load();
+		while (pipeline.flush()) {
+		}
+		EXPECT_EQ(markers, 4u * (6 + 6 + 2)) << "latency " << latency;
+		EXPECT_EQ(after - before, 0) << "push() allocated on frames of a size it had seen, latency " << latency;
+	}
+}

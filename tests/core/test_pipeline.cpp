@@ -3,6 +3,9 @@
 // detect() gives frame by frame; bad frames are refused without losing the
 // ones in flight; dropped frames leave nothing behind.
 #include <algorithm>
+#include <array>
+#include <cstdint>
+#include <span>
 #include <memory>
 #include <stdexcept>
 #include <thread>
@@ -204,8 +207,91 @@ TEST_P(PipelineModes, EachResultCarriesTheBytesItsFrontEndCopied)
 	EXPECT_EQ(next, frames.size());
 }
 
+namespace {
+
+/* Fails the detection of one frame: its front end throws (the first stage),
+ * or the warp of its candidates does (the last). */
+class FailingFrontEnd : public FrontEnd
+{
+public:
+	explicit FailingFrontEnd(int failAt) : failAt_(failAt) {}
+	const char *name() const override { return "failing"; }
+	void run(const ImageView &image, float scale, const FrontEndParams &params, EdgeMap &out) override
+	{
+		if (calls_++ == failAt_)
+			throw std::runtime_error("front end failed");
+		cpu_->run(image, scale, params, out);
+	}
+
+private:
+	std::unique_ptr<FrontEnd> cpu_ = makeCpuFrontEnd(1);
+	int failAt_, calls_ = 0;
+};
+
+class FailingWarper : public CandidateWarper
+{
+public:
+	explicit FailingWarper(int failAt) : failAt_(failAt) {}
+	const char *name() const override { return "failing"; }
+	void warp(const ImageView &image, std::span<const std::array<Point2f, 4>> quads, int side,
+		  std::span<CandidateSamples> out, std::span<std::uint8_t> ok) override
+	{
+		if (calls_++ == failAt_)
+			throw std::runtime_error("warp failed");
+		cpu_->warp(image, quads, side, out, ok);
+	}
+
+private:
+	std::unique_ptr<CandidateWarper> cpu_ = makeCpuWarper();
+	int failAt_, calls_ = 0;
+};
+
+} // namespace
+
+/* The frame whose detection failed throws where its result would come
+ * out, and only there: the frames before and after it come out in order
+ * with their own markers (the element fails that frame's buffer). One
+ * detector: its front end and warper run once a frame, in order. */
+TEST_P(PipelineModes, AFailedFrameThrowsInItsOwnPlaceAndTheOthersGoOn)
+{
+	if (GetParam().detectors != 1)
+		GTEST_SKIP() << "calls numbered per detector";
+	const std::vector<Image> frames = sequence(7);
+	Detector reference(Config{});
+	for (const bool inWarp : { false, true }) {
+		const std::size_t failed = 3;
+		Pipeline pipeline(configOf(GetParam()), GetParam().mode, GetParam().latencyAsked);
+		if (inWarp)
+			pipeline.detector().setWarper(std::make_unique<FailingWarper>(static_cast<int>(failed)));
+		else
+			pipeline.detector().setFrontEnd(std::make_unique<FailingFrontEnd>(static_cast<int>(failed)));
+		std::size_t next = 0;
+		auto take = [&](auto call) {
+			const Result *r = nullptr;
+			if (next == failed) {
+				EXPECT_THROW(r = call(), std::runtime_error) << (inWarp ? "warp" : "front end");
+				++next;
+				return true;
+			}
+			r = call();
+			if (!r)
+				return false;
+			expectSame(*r, reference.detect(frames[next].view()), static_cast<int>(next));
+			++next;
+			return true;
+		};
+		for (const Image &f : frames)
+			take([&] { return pipeline.push(f.view()); });
+		while (pipeline.pending() && take([&] { return pipeline.flush(); })) {
+		}
+		EXPECT_EQ(next, frames.size()) << (inWarp ? "warp" : "front end");
+		EXPECT_FALSE(pipeline.pending());
+	}
+}
+
 INSTANTIATE_TEST_SUITE_P(All, PipelineModes,
 			 ::testing::Values(Setup{ Pipeline::Mode::Stages, 1, -1, 2, 1, "Stages" },
+					   Setup{ Pipeline::Mode::Stages, 1, 1, 1, 1, "StagesLatencyOne" },
 					   Setup{ Pipeline::Mode::Frames, 1, -1, 0, 1, "FramesOneThread" },
 					   Setup{ Pipeline::Mode::Frames, 2, -1, 2, 2, "FramesTwoThreads" },
 					   Setup{ Pipeline::Mode::Frames, 2, 1, 1, 2, "FramesTwoThreadsLatencyOne" },
@@ -226,7 +312,9 @@ TEST(Pipeline, ThreadsAndLatencyAreCheckedAndZeroThreadsIsOnePerCore)
 	/* Each detector of Mode::Frames runs on its own thread only. */
 	EXPECT_EQ(perCore.detector(0).config().threads, 1);
 	EXPECT_THROW(Pipeline(Config{}, Pipeline::Mode::Stages).detector(1), std::out_of_range);
-	EXPECT_THROW(Pipeline(Config{}, Pipeline::Mode::Stages, 1), std::invalid_argument);
+	EXPECT_THROW(Pipeline(Config{}, Pipeline::Mode::Stages, 0), std::invalid_argument);
+	EXPECT_THROW(Pipeline(Config{}, Pipeline::Mode::Stages, 3), std::invalid_argument);
+	EXPECT_EQ(Pipeline(Config{}, Pipeline::Mode::Stages, 1).latency(), 1);
 	EXPECT_THROW(Pipeline(Config{}, Pipeline::Mode::Frames, -2), std::invalid_argument);
 	EXPECT_THROW(Pipeline(Config{}, Pipeline::Mode::Frames, 257), std::invalid_argument);
 }

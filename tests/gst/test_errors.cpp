@@ -1,13 +1,17 @@
 // SPDX-License-Identifier: MIT
 // frappedetect: a detection that fails is an element error and a flow
-// error, pipelined or not; no buffer leaves without its markers.
+// error, pipelined or not, on the buffer whose detection failed; no buffer
+// leaves without its markers.
 //
 // The failure is injected without a hook in the element: this program
 // defines frappe::Detector::detect itself and exports it, so the calls of
 // libfrappe-core's Pipeline reach this definition first (ELF
 // interposition), which throws from the call numbered failFrom on and
-// otherwise calls the library's. Where interposition does not happen (a
-// static libfrappe-core) the tests skip.
+// otherwise calls the library's. The staged overlap runs a frame stage by
+// stage, not through detect(): there frappe::scaledLength, which the front
+// end stage calls once a frame with the frame's width, is interposed alike
+// and throws for the frame numbered failFrame. Where interposition does not
+// happen (a static libfrappe-core) the tests skip.
 #include <atomic>
 #include <climits>
 #include <stdexcept>
@@ -34,7 +38,18 @@ namespace {
 std::atomic<int> detectCalls{ 0 };
 std::atomic<int> failFrom{ INT_MAX };
 
+/* Front-end stages of frames kSpec.width wide, numbered from 0. */
+std::atomic<int> widthCalls{ 0 };
+std::atomic<int> failFrame{ INT_MAX };
+
 using Detect = const frappe::Result &(*)(frappe::Detector *, const frappe::ImageView &);
+using ScaledLength = int (*)(int, float);
+
+ScaledLength libraryScaledLength()
+{
+	static const auto fn = reinterpret_cast<ScaledLength>(dlsym(RTLD_NEXT, "_ZN6frappe12scaledLengthEif"));
+	return fn;
+}
 
 Detect libraryDetect()
 {
@@ -55,6 +70,17 @@ const frappe::Result &frappe::Detector::detect(const ImageView &image)
 namespace {
 
 const FrameSpec kSpec;
+
+} // namespace
+
+int frappe::scaledLength(int full, float scale)
+{
+	if (full == kSpec.width && widthCalls++ == failFrame.load())
+		throw std::runtime_error("injected detection failure");
+	return libraryScaledLength()(full, scale);
+}
+
+namespace {
 
 GstBuffer *frame(int i)
 {
@@ -89,12 +115,26 @@ struct Harness {
 	~Harness()
 	{
 		failFrom = INT_MAX;
+		failFrame = INT_MAX;
 		gst_object_unref(bus);
 		gst_harness_teardown(h);
 	}
 	GstHarness *h;
 	GstBus *bus;
 };
+
+/* How many calls of the staged overlap's front-end stage come here a
+ * frame (the CPU front end calls it too), 0 when none. */
+int stagesInterposed()
+{
+	if (!libraryScaledLength())
+		return 0;
+	Harness t("frappedetect pipelined=true overlap=stages");
+	const int before = widthCalls;
+	if (gst_harness_push(t.h, frame(0)) != GST_FLOW_OK)
+		return 0;
+	return widthCalls - before;
+}
 
 /* Whether the plugin's detections come here. */
 bool interposed()
@@ -158,4 +198,37 @@ TEST(Errors, DetectionFailureOfTheHeldBufferAtEosIsAnError)
 	gst_harness_push_event(t.h, gst_event_new_eos());
 	expectDetectionError(t.bus);
 	EXPECT_EQ(gst_harness_try_pull(t.h), nullptr) << "a buffer left without its markers";
+}
+
+/* Staged: frame 2's front end fails while frame 1 is traced; frames 0 and 1
+ * come out with their markers, the push that would bring frame 2 out (frame
+ * 3's) is the error, and frame 3, whose front end ran, is still held and
+ * comes out at EOS: the failure stays on its own buffer. */
+TEST(Errors, DetectionFailureStagedFailsItsOwnBuffer)
+{
+	const int perFrame = stagesInterposed();
+	if (perFrame == 0)
+		GTEST_SKIP() << "frappe::scaledLength cannot be interposed in this build";
+	Harness t("frappedetect pipelined=true overlap=stages");
+	failFrame = widthCalls + 2 * perFrame; /* the front-end stage's own call comes first */
+	ASSERT_EQ(gst_harness_push(t.h, frame(0)), GST_FLOW_OK);
+	ASSERT_EQ(gst_harness_push(t.h, frame(1)), GST_FLOW_OK);
+	ASSERT_EQ(gst_harness_push(t.h, frame(2)), GST_FLOW_OK);
+	EXPECT_EQ(gst_harness_push(t.h, frame(3)), GST_FLOW_ERROR);
+	expectDetectionError(t.bus);
+	for (int i : { 0, 1 }) {
+		GstBuffer *out = gst_harness_try_pull(t.h);
+		ASSERT_NE(out, nullptr);
+		EXPECT_EQ(GST_BUFFER_PTS(out), static_cast<GstClockTime>(i) * (GST_SECOND / 30));
+		EXPECT_EQ(markerMetas(out).size(), 1u);
+		gst_buffer_unref(out);
+	}
+	EXPECT_EQ(gst_harness_try_pull(t.h), nullptr) << "a buffer left without its markers";
+	gst_harness_push_event(t.h, gst_event_new_eos());
+	GstBuffer *out = gst_harness_try_pull(t.h);
+	ASSERT_NE(out, nullptr) << "frame 3 was lost with frame 2";
+	EXPECT_EQ(GST_BUFFER_PTS(out), 3 * (GST_SECOND / 30));
+	EXPECT_EQ(markerMetas(out).size(), 1u);
+	gst_buffer_unref(out);
+	EXPECT_EQ(gst_harness_try_pull(t.h), nullptr);
 }

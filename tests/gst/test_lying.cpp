@@ -225,12 +225,12 @@ TEST(Lying, OneWarningPerKind)
 	expectLieWarning(warnings[1], "no memory");
 }
 
-/* Pipelined, a lying buffer must not overtake the held one: the held
- * frame is finished first and both come out in order. */
-TEST(Lying, PipelinedKeepsOrder)
+/* Pipelined (either overlap), a lying buffer must not overtake the held
+ * one: the held frame is finished first and both come out in order. */
+static void PipelinedKeepsOrder(const char *overlap)
 {
 	const FrameSpec spec{ GST_VIDEO_FORMAT_GRAY8, 640, 480, 0 };
-	BusHarness t("frappedetect pipelined=true", spec);
+	BusHarness t((std::string("frappedetect pipelined=true overlap=") + overlap).c_str(), spec);
 	auto good = [&](int i) {
 		return makeFrame(spec, { square(i, 100.0f, 80.0f, 150.0f) }, dict("aruco_mip_36h12"),
 				 static_cast<GstClockTime>(i) * kFrame, kFrame);
@@ -266,6 +266,14 @@ TEST(Lying, PipelinedKeepsOrder)
 	EXPECT_TRUE(msgs.of(GST_MESSAGE_ERROR).empty());
 	/* One frappedetect message per detected frame, none for the lie. */
 	EXPECT_EQ(msgs.of(GST_MESSAGE_ELEMENT).size(), 3u);
+}
+
+TEST(Lying, PipelinedKeepsOrder)
+{
+	for (const char *overlap : { "frames", "stages" }) {
+		SCOPED_TRACE(overlap);
+		PipelinedKeepsOrder(overlap);
+	}
 }
 
 /* Caps beyond frappe::Config::max_pixels are refused at negotiation: no

@@ -50,13 +50,24 @@ GstMessage *runToEnd(GstElement *pipeline)
 
 } // namespace
 
+static void longPipelinedStream(const char *overlap);
+
+/* Every buffer of a long stream out once and in order, with either overlap. */
 TEST(Pipeline, LongPipelinedStreamCountsMatch)
 {
+	for (const char *overlap : { "frames", "stages" })
+		longPipelinedStream(overlap);
+}
+
+static void longPipelinedStream(const char *overlap)
+{
+	SCOPED_TRACE(overlap);
 	GError *err = nullptr;
 	GstElement *pipeline = gst_parse_launch(
-		"videotestsrc num-buffers=300 pattern=ball ! video/x-raw,format=I420,width=320,height=240 ! "
-		"identity name=in signal-handoffs=true ! frappedetect pipelined=true annotate=true ! "
-		"fakesink name=out signal-handoffs=true sync=false",
+		(std::string("videotestsrc num-buffers=300 pattern=ball ! video/x-raw,format=I420,width=320,height=240 ! "
+			     "identity name=in signal-handoffs=true ! frappedetect pipelined=true annotate=true overlap=") +
+		 overlap + " ! fakesink name=out signal-handoffs=true sync=false")
+			.c_str(),
 		&err);
 	ASSERT_EQ(err, nullptr);
 	Counter in, out;

@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: MIT
 // frappedetect pipelined=true: one buffer held, N in and N out in order with
 // their own metas, the latency answer, EOS drain, flush, caps changes and
-// live toggling.
+// live toggling; with either overlap (whole frames on two detectors, or one
+// detector's stages), each saying in the stats which ran.
 #include <string>
 #include <vector>
 
@@ -42,14 +43,37 @@ void expectFrame(GstBuffer *out, int i, const FrameSpec &s, float tol = 0.3f)
 	expectMarkers(out, markersOf(i, s), "aruco_mip_36h12", tol);
 }
 
+/* The element, pipelined with the overlap under test, and `extra`. */
+std::string launch(const std::string &overlap, const std::string &extra = "")
+{
+	return "frappedetect pipelined=true overlap=" + overlap + (extra.empty() ? "" : " " + extra);
+}
+
+std::string statsString(GstElement *e, const char *field)
+{
+	GstStructure *st = nullptr;
+	g_object_get(e, "stats", &st, nullptr);
+	const gchar *v = st ? gst_structure_get_string(st, field) : nullptr;
+	std::string out = v ? v : "";
+	if (st)
+		gst_structure_free(st);
+	return out;
+}
+
 } // namespace
 
-TEST(Pipelined, NInNOutInOrderWithOwnMetas)
+class Pipelined : public ::testing::TestWithParam<std::string>
+{
+};
+
+INSTANTIATE_TEST_SUITE_P(Overlap, Pipelined, ::testing::Values("frames", "stages"),
+			 [](const auto &info) { return info.param; });
+
+TEST_P(Pipelined, NInNOutInOrderWithOwnMetas)
 {
 	for (const char *mode : { "normal", "ascale" }) {
 		FrameSpec spec{ GST_VIDEO_FORMAT_NV12, 640, 480, 0 };
-		GstHarness *h = gst_harness_new_parse(
-			(std::string("frappedetect pipelined=true mode=") + mode).c_str());
+		GstHarness *h = gst_harness_new_parse(launch(GetParam(), std::string("mode=") + mode).c_str());
 		gst_harness_set_src_caps_str(h, capsString(spec).c_str());
 		GstBus *bus = gst_bus_new();
 		gst_element_set_bus(h->element, bus);
@@ -82,6 +106,7 @@ TEST(Pipelined, NInNOutInOrderWithOwnMetas)
 			gst_event_unref(ev);
 		}
 		EXPECT_TRUE(sawEos);
+		EXPECT_EQ(statsString(detector(h), "overlap"), GetParam()) << "the stats say which overlap ran";
 		/* One message per frame, in order, each with its own markers. */
 		for (int i = 0; i < n; ++i) {
 			GstMessage *msg = gst_bus_pop_filtered(bus, GST_MESSAGE_ELEMENT);
@@ -100,10 +125,10 @@ TEST(Pipelined, NInNOutInOrderWithOwnMetas)
 	}
 }
 
-TEST(Pipelined, LatencyAddsOneFrame)
+TEST_P(Pipelined, LatencyAddsOneFrame)
 {
 	FrameSpec spec;
-	GstHarness *h = gst_harness_new_parse("frappedetect pipelined=true");
+	GstHarness *h = gst_harness_new_parse(launch(GetParam()).c_str());
 	gst_harness_set_src_caps_str(h, capsString(spec, 25).c_str());
 	gst_harness_set_upstream_latency(h, 10 * GST_MSECOND);
 	/* The caps reach the element with the first buffer. */
@@ -115,10 +140,10 @@ TEST(Pipelined, LatencyAddsOneFrame)
 	gst_harness_teardown(h);
 }
 
-TEST(Pipelined, FlushDropsTheHeldBuffer)
+TEST_P(Pipelined, FlushDropsTheHeldBuffer)
 {
 	FrameSpec spec;
-	GstHarness *h = gst_harness_new_parse("frappedetect pipelined=true");
+	GstHarness *h = gst_harness_new_parse(launch(GetParam()).c_str());
 	gst_harness_set_src_caps_str(h, capsString(spec).c_str());
 	ASSERT_EQ(gst_harness_push(h, frameOf(0, spec)), GST_FLOW_OK);
 	ASSERT_EQ(gst_harness_push(h, frameOf(1, spec)), GST_FLOW_OK);
@@ -145,10 +170,10 @@ TEST(Pipelined, FlushDropsTheHeldBuffer)
 	gst_harness_teardown(h);
 }
 
-TEST(Pipelined, DrainQueryPushesTheHeldBuffer)
+TEST_P(Pipelined, DrainQueryPushesTheHeldBuffer)
 {
 	FrameSpec spec;
-	GstHarness *h = gst_harness_new_parse("frappedetect pipelined=true");
+	GstHarness *h = gst_harness_new_parse(launch(GetParam()).c_str());
 	gst_harness_set_src_caps_str(h, capsString(spec).c_str());
 	ASSERT_EQ(gst_harness_push(h, frameOf(0, spec)), GST_FLOW_OK);
 	ASSERT_EQ(gst_harness_push(h, frameOf(1, spec)), GST_FLOW_OK);
@@ -171,11 +196,11 @@ TEST(Pipelined, DrainQueryPushesTheHeldBuffer)
 	gst_harness_teardown(h);
 }
 
-TEST(Pipelined, CapsChangeDrains)
+TEST_P(Pipelined, CapsChangeDrains)
 {
 	FrameSpec a{ GST_VIDEO_FORMAT_I420, 640, 480, 0 };
 	FrameSpec b{ GST_VIDEO_FORMAT_GRAY8, 480, 360, 0 };
-	GstHarness *h = gst_harness_new_parse("frappedetect pipelined=true");
+	GstHarness *h = gst_harness_new_parse(launch(GetParam()).c_str());
 	gst_harness_set_src_caps_str(h, capsString(a).c_str());
 	ASSERT_EQ(gst_harness_push(h, frameOf(0, a)), GST_FLOW_OK);
 	ASSERT_EQ(gst_harness_push(h, frameOf(1, a)), GST_FLOW_OK);
@@ -191,10 +216,10 @@ TEST(Pipelined, CapsChangeDrains)
 	gst_harness_teardown(h);
 }
 
-TEST(Pipelined, ToggleAndRetuneWhilePlaying)
+TEST_P(Pipelined, ToggleAndRetuneWhilePlaying)
 {
 	FrameSpec spec{ GST_VIDEO_FORMAT_I420, 640, 480, 0 };
-	GstHarness *h = gst_harness_new_parse("frappedetect");
+	GstHarness *h = gst_harness_new_parse(("frappedetect overlap=" + GetParam()).c_str());
 	gst_harness_set_src_caps_str(h, capsString(spec).c_str());
 	const int n = 30;
 	for (int i = 0; i < n; ++i) {
@@ -215,10 +240,10 @@ TEST(Pipelined, ToggleAndRetuneWhilePlaying)
 	gst_harness_teardown(h);
 }
 
-TEST(Pipelined, StateCyclesWithAFrameInFlight)
+TEST_P(Pipelined, StateCyclesWithAFrameInFlight)
 {
 	FrameSpec spec;
-	GstHarness *h = gst_harness_new_parse("frappedetect pipelined=true");
+	GstHarness *h = gst_harness_new_parse(launch(GetParam()).c_str());
 	gst_harness_set_src_caps_str(h, capsString(spec).c_str());
 	for (int cycle = 0; cycle < 5; ++cycle) {
 		ASSERT_EQ(gst_harness_push(h, frameOf(2 * cycle, spec)), GST_FLOW_OK);

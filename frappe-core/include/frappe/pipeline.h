@@ -31,12 +31,22 @@ namespace frappe {
 /// frame it ran.
 ///
 /// Mode::Stages (the paper's pipelined mode): one detector, two threads,
-/// three stages. While the calling thread traces the contours of frame N, a
-/// worker thread runs the front end of frame N+1 and then refines, warps and
-/// decodes frame N-1. Latency 2. Throughput is bounded by the slower of the
-/// trace and the rest (1.3x on the synth images). `config.threads` splits
-/// the front end into row bands. In AScale mode a frame's scale comes from
-/// the last frame finished before its front end started.
+/// three stages: the front end (on a QPU backend, the QPU passes), the
+/// contour trace, and the finish (refine, warp, decode). Latency 2 (the
+/// default): while the calling thread traces frame N, a worker thread runs
+/// the front end of frame N+1 and then finishes frame N-1; throughput is
+/// bounded by the slower of the trace and the rest (1.3x on the synth
+/// images). Latency 1: while the calling thread traces frame N, the worker
+/// runs the front end of frame N+1; once both are done the calling thread
+/// finishes frame N. What the paper proposes for the Pi Zero: the QPUs
+/// work on the next frame while its one core traces this one, with one
+/// frame held and never two launches on the GPU at once. `config.threads`
+/// splits a CPU front end into row bands. In AScale mode a frame's scale
+/// comes from the last frame finished before its front end started.
+///
+/// A frame whose detection fails (out of memory, a GPU that stopped
+/// responding) throws from the push() or flush() that would return it, in
+/// either mode; the frames beside it are unaffected.
 class FRAPPE_EXPORT Pipeline {
 public:
 	enum class Mode { Frames, Stages };
@@ -46,7 +56,7 @@ public:
 	static constexpr int kDefaultLatency = -1;
 
 	/// Throws std::invalid_argument like Detector's constructor, and for a
-	/// latency other than 2 in Mode::Stages or outside [0, 256] in
+	/// latency other than 1 or 2 in Mode::Stages or outside [0, 256] in
 	/// Mode::Frames (below threads - 1, threads are left idle).
 	explicit Pipeline(const Config &config, Mode mode = Mode::Frames, int latency = kDefaultLatency);
 	~Pipeline();
@@ -60,8 +70,7 @@ public:
 	/// flush(). Throws std::invalid_argument for a bad image, before
 	/// starting it: the frames in flight are unaffected. When the detection
 	/// of the frame to return failed (out of memory), throws its exception
-	/// instead; that frame is gone, `image` is in flight (Mode::Frames; in
-	/// Mode::Stages every frame in flight is dropped).
+	/// instead; that frame is gone, `image` and the others stay in flight.
 	const Result *push(const ImageView &image);
 
 	/// At the end of the stream: finishes the oldest frame in flight and

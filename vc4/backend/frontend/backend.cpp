@@ -107,4 +107,10 @@ std::string_view copyReason(const frappe::FrontEnd &front_end)
 	return contextInfo(front_end, info) ? info.copy_reason : std::string_view();
 }
 
+const void *contextOf(const frappe::FrontEnd &front_end)
+{
+	ContextInfo info;
+	return contextInfo(front_end, info) ? info.context : nullptr;
+}
+
 } // namespace frappe::vc4

@@ -50,4 +50,9 @@ int allocateFrameMemory(std::string_view backend, std::size_t bytes, std::string
 /// `front_end` is not a QPU one. Valid until the next frame.
 std::string_view copyReason(const frappe::FrontEnd &front_end);
 
+/// The QPU context (one device and its buffers) `front_end` runs on, as an identity to
+/// compare (a front end and the warper sharing it give the same); nullptr when it is not
+/// a QPU front end.
+const void *contextOf(const frappe::FrontEnd &front_end);
+
 } // namespace frappe::vc4

@@ -42,6 +42,8 @@ struct ContextInfo {
 	std::size_t imports = 0;         // dma-bufs imported now (cached)
 	std::size_t copy_bytes = 0;      // bytes of the last frame copied (front end + warp)
 	std::string_view copy_reason;    // why they were copied; empty when read in place
+	uint64_t total_copy_bytes = 0;   // bytes of all frames copied since the context opened
+	uint64_t device_bytes = 0;       // GPU memory the device holds (its buffers, not imports)
 };
 template <class Device>
 class QpuContext {
@@ -64,29 +66,46 @@ public:
 	Device &device() { return *device_; }
 	const FrontEndOptions &options() const { return options_; }
 
-	// A new frame: forget the last one's source and count its copies from zero.
-	void beginFrame()
+	// A new frame: count its copies from zero. The frames staged before stay staged for
+	// their warps (a pipeline warps frame N after staging frame N+1).
+	void beginFrame() { copy_bytes_ = 0; }
+
+	// A frame the front end runs without the QPUs: an earlier staging of a buffer at the
+	// same address must not stand for it.
+	void forget(const ImageView &image)
 	{
-		staged_ = false;
-		copy_bytes_ = 0;
+		for (Staged &st : staged_)
+			st.valid = st.valid && !same(st.image, image);
 	}
 
-	// The frame as the QPUs read it. The front end stages each frame (`remember`); the
-	// warper then finds the same frame and reads it without a second import or copy.
+	// The frame as the QPUs read it. The front end stages each frame (`remember`: always
+	// afresh, as a recycled buffer may hold new pixels at the same address); the warper
+	// then finds it among the last kStaged staged frames and reads it without a second
+	// import or copy.
 	FrameSource frame(const ImageView &image, bool remember)
 	{
-		if (staged_ && image.data == last_.data && image.width == last_.width &&
-		    image.height == last_.height && image.stride == last_.stride && image.dmabuf_fd == last_.dmabuf_fd &&
-		    image.dmabuf_offset == last_.dmabuf_offset)
-			return source_;
+		if (!remember) {
+			// Newest first: an older entry at the same address is a frame since freed.
+			for (int k = 1; k <= kStaged; ++k) {
+				const Staged &st = staged_[(next_ + kStaged - k) % kStaged];
+				if (st.valid && same(st.image, image))
+					return st.source;
+			}
+		} else {
+			forget(image);
+		}
+		// The oldest staged frame's place (or, for a frame never staged, the warper's own).
+		Staged &st = remember ? staged_[next_] : unstaged_;
+		if (remember)
+			next_ = (next_ + 1) % kStaged;
+		st.valid = false;
 		FrameSource src;
 		if (!inPlace(image, src))
-			src = copy(image);
-		// A copy of the warper's own overwrote the staging buffer: nothing to reuse.
-		staged_ = remember;
+			src = copy(image, st);
 		if (remember) {
-			last_ = image;
-			source_ = src;
+			st.image = image;
+			st.source = src;
+			st.valid = true;
 		}
 		return src;
 	}
@@ -95,7 +114,10 @@ public:
 	// the QPUs read the frame in place).
 	std::size_t copyBytes() const { return copy_bytes_; }
 	std::string_view copyReason() const { return copy_bytes_ ? std::string_view(reason_) : std::string_view(); }
-	ContextInfo info() const { return {this, imports(), copyBytes(), copyReason()}; }
+	ContextInfo info() const
+	{
+		return {this, imports(), copyBytes(), copyReason(), total_copy_bytes_, device_->allocatedBytes()};
+	}
 	std::size_t imports() const
 	{
 		if constexpr (kEmulated)
@@ -142,22 +164,41 @@ private:
 		return true;
 	}
 
-	// The fallback: the frame copied once, rows 4-aligned (the buffer grows, never per frame).
-	FrameSource copy(const ImageView &image)
+	// Frames staged at once: the newest and the two before it, so that a pipeline of up to
+	// three frames in flight (frappe::Pipeline's stages) warps each without a second copy.
+	static constexpr int kStaged = 3;
+	struct Staged {
+		ImageView image;
+		FrameSource source;
+		Buffer staging; // its copy, when it needed one (grows, never per frame)
+		uint32_t staging_bytes = 0;
+		bool valid = false;
+	};
+
+	static bool same(const ImageView &a, const ImageView &b)
+	{
+		return a.data == b.data && a.width == b.width && a.height == b.height && a.stride == b.stride &&
+		       a.dmabuf_fd == b.dmabuf_fd && a.dmabuf_offset == b.dmabuf_offset;
+	}
+
+	// The fallback: the frame copied once into the staged place's buffer, rows 4-aligned.
+	FrameSource copy(const ImageView &image, Staged &st)
 	{
 		const uint32_t stride = (static_cast<uint32_t>(image.width) + 3) & ~3u;
 		const uint32_t bytes = stride * static_cast<uint32_t>(image.height) + 64;
-		if (bytes > staging_bytes_) {
-			if (staging_bytes_)
-				device_->release(staging_);
-			staging_ = device_->alloc(bytes);
-			staging_bytes_ = bytes;
+		if (bytes > st.staging_bytes) {
+			if (st.staging_bytes)
+				device_->release(st.staging);
+			st.staging = device_->alloc(bytes);
+			st.staging_bytes = bytes;
 		}
 		for (int y = 0; y < image.height; ++y)
-			std::memcpy(staging_.cpu.data() + static_cast<std::size_t>(y) * stride, image.row(y),
+			std::memcpy(st.staging.cpu.data() + static_cast<std::size_t>(y) * stride, image.row(y),
 			            static_cast<std::size_t>(image.width));
-		copy_bytes_ += static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height);
-		return {staging_.bus, stride};
+		const std::size_t copied = static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height);
+		copy_bytes_ += copied;
+		total_copy_bytes_ += copied;
+		return {st.staging.bus, stride};
 	}
 
 	// The frame's dma-buf as the QPUs see it, imported once per buffer; false with the
@@ -225,12 +266,11 @@ private:
 	std::unique_ptr<Device> device_;
 	FrontEndOptions options_;
 	runtime::ImportCache<Mapped> mapped_; // emulator only
-	Buffer staging_;
-	uint32_t staging_bytes_ = 0;
-	bool staged_ = false;
-	ImageView last_;
-	FrameSource source_;
+	Staged staged_[kStaged];
+	int next_ = 0;
+	Staged unstaged_; // a frame the warper was given that no front end staged
 	std::size_t copy_bytes_ = 0;
+	uint64_t total_copy_bytes_ = 0;
 	char reason_[256] = {};
 };
 

@@ -158,6 +158,7 @@ public:
 		if (g.w < 3 || g.h < 3 || g.w > kMaxQpuWidth) {
 			// Nothing for the QPUs (an all-zero map) or wider than the VDW stride allows.
 			counted_ = false;
+			backend_.context->forget(image);
 			if (!cpu_)
 				cpu_ = makeCpuFrontEnd(1);
 			cpu_->run(image, scale, params, out);

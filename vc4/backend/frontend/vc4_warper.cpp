@@ -38,12 +38,15 @@ struct SharedTarget {
 	std::shared_ptr<QpuContext<Device>> context;
 
 	static const char *name() { return QpuContext<Device>::kEmulated ? "vc4-emu" : "vc4"; }
-	void run(std::span<const Job> jobs)
+	/* The slowest QPU's cycles on the emulator, 0 on the GPU. */
+	uint64_t run(std::span<const Job> jobs)
 	{
-		if constexpr (QpuContext<Device>::kEmulated)
-			runOnEmulator(context->device(), jobs, context->options());
-		else
+		if constexpr (QpuContext<Device>::kEmulated) {
+			return runOnEmulator(context->device(), jobs, context->options()).cycles;
+		} else {
 			context->device().wait(context->device().launch(jobs));
+			return 0;
+		}
 	}
 };
 using EmuTarget = SharedTarget<emu::Device>;
@@ -104,7 +107,7 @@ public:
 			Job jobs[kPrograms];
 			for (unsigned p = 0; p < programs; ++p)
 				jobs[p] = { unif_[p].bus, code_.bus };
-			target_.run(std::span<const Job>(jobs, programs));
+			counts_.slowest_cycles += target_.run(std::span<const Job>(jobs, programs));
 			++counts_.launches;
 			for (std::size_t c = 0; c < count; ++c) {
 				const std::size_t k = onQpu_[first + c];

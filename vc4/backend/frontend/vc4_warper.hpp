@@ -10,6 +10,7 @@
 // fallback.
 #pragma once
 
+#include <cstdint>
 #include <memory>
 
 #include "frappe/candidate_warp.h"
@@ -26,6 +27,7 @@ struct WarpCounts {
 	unsigned on_qpus = 0;
 	unsigned on_cpu = 0;
 	unsigned launches = 0;
+	uint64_t slowest_cycles = 0; // emulator: the launches' slowest-QPU cycles, summed (emu::Timing)
 };
 /// False when `warper` is not a VC4 warper.
 bool lastWarpCounts(const frappe::CandidateWarper &warper, WarpCounts &out);

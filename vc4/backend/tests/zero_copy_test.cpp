@@ -200,6 +200,49 @@ TEST(ZeroCopyEmu, UnalignedStrideOrShortBufferIsCopiedWithTheReason)
 	EXPECT_EQ(vc4::copyReason(*qpu.frontEnd), "");
 }
 
+/* frappe::Pipeline's stages on the QPUs: the warp of frame N comes after the front end of
+ * frame N+1 (and of N+2 at latency 2), and finds its own staged copy: each system-memory
+ * frame copied once, into the one context, even when two buffers take turns at the same
+ * addresses with new pixels. */
+TEST(ZeroCopyEmu, StagedPipelineCopiesEachFrameOnceAndWarpsItsOwnCopy)
+{
+	Detector cpu{ Config{} };
+	for (int latency : { 1, 2 }) {
+		Pipeline pipeline(Config{}, Pipeline::Mode::Stages, latency);
+		vc4::BackendChoice c = vc4::selectFrontEnd("vc4-emu", 1);
+		const FrontEnd *frontEnd = c.frontEnd.get();
+		pipeline.detector().setFrontEnd(std::move(c.frontEnd));
+		pipeline.detector().setWarper(std::move(c.warper));
+		const int frames = 6, buffers = latency + 1;
+		std::vector<std::vector<std::uint8_t>> memory(static_cast<std::size_t>(buffers));
+		std::vector<Result> want;
+		std::size_t next = 0, found = 0;
+		auto check = [&](const Result *r) {
+			ASSERT_NE(r, nullptr);
+			const std::string what = "latency " + std::to_string(latency) + " frame " + std::to_string(next);
+			expectSameMarkers(*r, want[next], what);
+			EXPECT_EQ(r->copy_bytes, static_cast<std::size_t>(kW) * kH) << what;
+			found += r->markers.size();
+			++next;
+		};
+		for (int f = 0; f < frames; ++f) {
+			/* Buffer f % buffers is free again: its frame has come out. */
+			std::vector<std::uint8_t> &m = memory[static_cast<std::size_t>(f % buffers)];
+			m = scene(41 + static_cast<unsigned>(f), kW, kH, 4);
+			want.push_back(cpu.detect(ImageView{ m.data(), kW, kH }));
+			if (const Result *r = pipeline.push(ImageView{ m.data(), kW, kH }))
+				check(r);
+		}
+		while (const Result *r = pipeline.flush())
+			check(r);
+		EXPECT_EQ(next, static_cast<std::size_t>(frames));
+		EXPECT_GE(found, 12u);
+		vc4::ContextInfo info;
+		ASSERT_TRUE(vc4::contextInfo(*frontEnd, info));
+		EXPECT_EQ(info.total_copy_bytes, static_cast<std::uint64_t>(frames) * kW * kH) << "latency " << latency;
+	}
+}
+
 /* The real GPU's code path against a fake kernel. Its firmware does not run the programs,
  * so what is checked is where the QPUs are told to read and what the host does. */
 namespace {

@@ -10,6 +10,7 @@ Device::Device(Config config, uint32_t memory_bytes) : memory_(memory_bytes), v3
 Device::Buffer Device::alloc(uint32_t bytes, uint32_t align)
 {
 	const uint32_t bus = memory_.alloc(bytes, align);
+	live_[bus] = bytes;
 	return {bus, memory_.bytes(bus, bytes)};
 }
 

@@ -26,7 +26,20 @@ public:
 	Buffer upload(std::span<const uint64_t> code);
 	Buffer upload(std::span<const uint32_t> words);
 	// Frees a buffer that did not fit the arena (see Memory::alloc); others stay.
-	void release(const Buffer &buffer) { memory_.release(buffer.bus); }
+	void release(const Buffer &buffer)
+	{
+		memory_.release(buffer.bus);
+		live_.erase(buffer.bus);
+	}
+	// Bytes of the buffers allocated and not released: what the real GPU's runtime would
+	// hold in dma-heap buffers (and cache-sync around each launch).
+	uint64_t allocatedBytes() const
+	{
+		uint64_t sum = 0;
+		for (const auto &[bus, bytes] : live_)
+			sum += bytes;
+		return sum;
+	}
 	// The QPUs read (and, if `writable`, write) `host` in place at the returned bus
 	// address until release(); the caller keeps the memory alive until then.
 	Buffer importExternal(std::span<uint8_t> host, bool writable = false)
@@ -46,6 +59,7 @@ private:
 	V3d v3d_;
 	Fence next_ = 1;
 	std::map<Fence, LaunchStats> done_;
+	std::map<uint32_t, uint32_t> live_; // bus -> bytes of alloc()ed buffers
 };
 
 } // namespace frappe::vc4::emu

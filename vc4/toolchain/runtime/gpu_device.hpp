@@ -130,6 +130,16 @@ public:
 	             std::chrono::milliseconds timeout = std::chrono::milliseconds(500));
 	LaunchResult wait(Fence fence);
 
+	// Bytes of the dma-heap buffers held now: what launch() cache-syncs before and after
+	// each run, beside the imports.
+	uint64_t allocatedBytes() const
+	{
+		uint64_t sum = 0;
+		for (const auto &[bus, a] : buffers_)
+			sum += a.map_bytes;
+		return sum;
+	}
+
 private:
 	struct Allocation {
 		uint32_t bus = 0;
