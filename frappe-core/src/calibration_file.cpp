@@ -5,14 +5,12 @@
 
 #include <algorithm>
 #include <charconv>
-#include <filesystem>
-#include <fstream>
 #include <initializer_list>
 #include <stdexcept>
 #include <string>
-#include <system_error>
 
 #include "markup.h"
+#include "small_file.h"
 
 namespace frappe {
 
@@ -250,23 +248,19 @@ Camera parseCalibration(std::string_view text, std::string_view origin)
 
 Camera readCalibration(const std::string &path)
 {
-	std::error_code ec;
-	const auto status = std::filesystem::status(path, ec);
-	if (ec || !std::filesystem::exists(status))
-		throw std::runtime_error(path + ": no such file");
-	if (!std::filesystem::is_regular_file(status))
-		throw std::runtime_error(path + ": not a regular file");
-	const auto size = std::filesystem::file_size(path, ec);
-	if (ec)
-		throw std::runtime_error(path + ": " + ec.message());
-	if (size > detail::kMarkupMaxBytes)
-		throw std::runtime_error(path + ": " + std::to_string(size) +
+	using Fault = detail::SmallFile::Fault;
+	const detail::SmallFile f = detail::readSmallFile(path, detail::kMarkupMaxBytes);
+	switch (f.fault) {
+	case Fault::None: break;
+	case Fault::NotFound: throw std::runtime_error(path + ": no such file");
+	case Fault::Directory: throw std::runtime_error(path + ": not a regular file (a directory)");
+	case Fault::NotRegular: throw std::runtime_error(path + ": not a regular file (" + f.reason + ")");
+	case Fault::TooLarge:
+		throw std::runtime_error(path + ": " + std::to_string(f.size) +
 					 " bytes, over the 1 MiB a calibration file may have");
-	std::ifstream in(path, std::ios::binary);
-	std::string text(static_cast<std::size_t>(size), '\0');
-	if (!in || !in.read(text.data(), static_cast<std::streamsize>(text.size())))
-		throw std::runtime_error(path + ": cannot be read");
-	return parseCalibration(text, path);
+	case Fault::Unreadable: throw std::runtime_error(path + ": cannot be read: " + f.reason);
+	}
+	return parseCalibration(f.text, path);
 }
 
 } // namespace frappe

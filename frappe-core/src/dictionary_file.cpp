@@ -9,7 +9,6 @@
 #include <charconv>
 #include <cstdint>
 #include <filesystem>
-#include <fstream>
 #include <iterator>
 #include <optional>
 #include <stdexcept>
@@ -17,11 +16,13 @@
 #include <system_error>
 #include <vector>
 
+#include "small_file.h"
+
 namespace frappe {
 
 namespace {
 
-constexpr std::uintmax_t kMaxFileBytes = 64u << 20;
+constexpr std::size_t kMaxFileBytes = 64u << 20;
 constexpr std::size_t kMaxLineBytes = 4096;
 constexpr std::size_t kMaxNameBytes = 128;
 /* The min_hamming check compares every pair of codes in 4 rotations: at
@@ -437,32 +438,20 @@ std::shared_ptr<const Dictionary> parseDictionary(std::string_view text, std::st
 
 std::shared_ptr<const Dictionary> loadDictionary(const std::string &path)
 {
-	namespace fs = std::filesystem;
+	using Fault = detail::SmallFile::Fault;
 	const std::string what = "frappe::loadDictionary: cannot read dictionary file '" + path + "': ";
-	std::error_code ec;
-	const fs::file_status status = fs::status(path, ec);
-	if (status.type() == fs::file_type::not_found)
-		throw std::runtime_error(what + "no such file");
-	if (ec)
-		throw std::runtime_error(what + ec.message());
-	if (!fs::is_regular_file(status))
-		throw std::runtime_error(what + (fs::is_directory(status) ? "a directory" : "not a regular file"));
-	const std::uintmax_t size = fs::file_size(path, ec);
-	if (ec)
-		throw std::runtime_error(what + ec.message());
-	if (size > kMaxFileBytes)
+	const detail::SmallFile f = detail::readSmallFile(path, kMaxFileBytes);
+	switch (f.fault) {
+	case Fault::None: break;
+	case Fault::NotFound: throw std::runtime_error(what + "no such file");
+	case Fault::Directory: throw std::runtime_error(what + "a directory");
+	case Fault::NotRegular: throw std::runtime_error(what + "not a regular file (" + f.reason + ")");
+	case Fault::TooLarge:
 		throw std::runtime_error(what + "over " + std::to_string(kMaxFileBytes >> 20) +
 					 " MiB, too large for a dictionary");
-	std::ifstream in(path, std::ios::binary);
-	if (!in)
-		throw std::runtime_error(what + "cannot open it");
-	/* At most the limit, even when the file grows while read. */
-	std::string text(static_cast<std::size_t>(size), '\0');
-	in.read(text.data(), static_cast<std::streamsize>(size));
-	text.resize(static_cast<std::size_t>(in.gcount()));
-	if (in.bad())
-		throw std::runtime_error(what + "a read error");
-	return parse(text, path, fs::path(path).stem().string(), "frappe::loadDictionary");
+	case Fault::Unreadable: throw std::runtime_error(what + f.reason);
+	}
+	return parse(f.text, path, std::filesystem::path(path).stem().string(), "frappe::loadDictionary");
 }
 
 } // namespace frappe

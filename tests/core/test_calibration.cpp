@@ -13,6 +13,7 @@
 
 #include <gtest/gtest.h>
 
+#include "blocking_read.h"
 #include "frappe/camera.h"
 #include <vector>
 
@@ -451,6 +452,31 @@ TEST(Calibration, UnreadableFilesAreRuntimeErrors)
 		FAIL();
 	} catch (const std::invalid_argument &e) {
 		EXPECT_EQ(std::string(e.what()).rfind(bad + ": distortion_coefficients: ", 0), 0u) << e.what();
+	}
+}
+
+/* Issue 34: a name replaced by a FIFO (between any check and the open)
+ * blocked the open forever; a device was read without end. What is opened
+ * is checked, without waiting. */
+TEST(Calibration, FifoOrDeviceIsRefusedWithoutWaiting)
+{
+	const Scratch scratch;
+	const std::string fifo = (scratch.dir / "cam.yaml").string();
+	EXPECT_EQ(frappe::test::readingFifo(fifo, [](const std::string &p) { readCalibration(p); }),
+		  fifo + ": not a regular file (a FIFO)");
+	EXPECT_FALSE(frappe::test::blockedBySwappedFifo((scratch.dir / "swapped.yaml").string(), kRos, 1.0,
+							 [](const std::string &p) { readCalibration(p); }));
+	try {
+		readCalibration("/dev/zero");
+		FAIL() << "/dev/zero read";
+	} catch (const std::runtime_error &e) {
+		EXPECT_EQ(std::string(e.what()), "/dev/zero: not a regular file (a character device)");
+	}
+	try {
+		readCalibration(scratch.dir.string());
+		FAIL() << "a directory read";
+	} catch (const std::runtime_error &e) {
+		EXPECT_EQ(std::string(e.what()), scratch.dir.string() + ": not a regular file (a directory)");
 	}
 }
 

@@ -14,6 +14,7 @@
 
 #include <gtest/gtest.h>
 
+#include "blocking_read.h"
 #include "frappe/frappe.h"
 #include "scene.h"
 
@@ -253,6 +254,24 @@ TEST(DictionaryFile, AtMost4096Codes)
 	EXPECT_GT(d->min_hamming, 5); /* random 64-bit codes lie far apart */
 	text += "0x0000000000000001\n";
 	EXPECT_NE(parseError(text).find("bad.txt:4098: more than 4096 codes"), std::string::npos) << parseError(text);
+}
+
+/* Issue 34: a FIFO in a dictionary file's place blocked the open forever,
+ * and a device was read without end: what is opened is checked first. */
+TEST(DictionaryFile, FifoOrDeviceIsRefusedWithoutWaiting)
+{
+	const std::string fifo = writeFile("fifo.txt", "");
+	EXPECT_EQ(frappe::test::readingFifo(fifo, [](const std::string &p) { loadDictionary(p); }),
+		  "frappe::loadDictionary: cannot read dictionary file '" + fifo + "': not a regular file (a FIFO)");
+	EXPECT_FALSE(frappe::test::blockedBySwappedFifo(fifo + ".txt", "0x1234\n0xff00\n", 1.0,
+							 [](const std::string &p) { loadDictionary(p); }));
+	try {
+		loadDictionary("/dev/zero");
+		ADD_FAILURE() << "/dev/zero loaded";
+	} catch (const std::runtime_error &e) {
+		EXPECT_EQ(std::string(e.what()), "frappe::loadDictionary: cannot read dictionary file '/dev/zero': "
+						 "not a regular file (a character device)");
+	}
 }
 
 TEST(DictionaryFile, UnreadableFilesAreRuntimeErrors)
