@@ -244,6 +244,32 @@ TEST(MarkerSizes, MalformedIsRefusedWithAWarning)
 	}
 }
 
+/* Issue 34: marker-sizes was parsed in quadratic time under the object
+ * lock the streaming thread takes (400,000 ids in descending order: 107 s).
+ * The longest value accepted now takes milliseconds, a longer one is
+ * refused with a warning saying why, the previous value kept. */
+TEST(MarkerSizes, LongValuesAreQuickOrRefused)
+{
+	const FrameSpec spec{ GST_VIDEO_FORMAT_GRAY8, 64, 48 };
+	BusHarness t("frappedetect marker-sizes=\"0:0.05\"", spec);
+	GstElement *e = detector(t.h);
+	std::string longest;
+	for (int id = 999999; longest.size() + 16 < (1u << 20); --id)
+		longest += std::to_string(id) + ":0.05,";
+	longest += "7:0.25";
+	const gint64 t0 = g_get_monotonic_time();
+	g_object_set(e, "marker-sizes", longest.c_str(), nullptr);
+	EXPECT_LT(g_get_monotonic_time() - t0, 1000000) << "microseconds to set " << longest.size() << " bytes";
+	EXPECT_EQ(stringProperty(e, "marker-sizes"), longest);
+	EXPECT_TRUE(BusMessages(t.bus).of(GST_MESSAGE_WARNING).empty());
+
+	const std::string over = longest + std::string(1u << 20, ' ');
+	g_object_set(e, "marker-sizes", over.c_str(), nullptr);
+	EXPECT_EQ(stringProperty(e, "marker-sizes"), longest);
+	expectOneSettingsWarning(t.bus, "refused: marker sizes: " + std::to_string(over.size()) +
+						" bytes, more than the 1048576 a list of sizes may have");
+}
+
 /* camera-matrix of another count or an invalid matrix, distortion of
  * another count: a warning on the bus, the previous value kept. */
 TEST(CameraMatrix, RefusedValuesWarn)
