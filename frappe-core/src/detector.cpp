@@ -13,6 +13,7 @@
 
 #include "detector_impl.h"
 #include "quad_geometry.h"
+#include "utf8.h"
 
 namespace frappe {
 
@@ -36,6 +37,9 @@ void validate(const Config &c, const Dictionary &d)
 			fail("custom_dictionary: bits must be 3..8, got " + std::to_string(d.bits));
 		if (d.codes.empty())
 			fail("custom_dictionary: no codes");
+		/* Every output carries the name: JSON, GStreamer, Python. */
+		if (detail::invalidUtf8At(d.name) != std::string_view::npos)
+			fail("custom_dictionary: the name is not UTF-8 text");
 		const int cells = d.bits * d.bits;
 		for (std::uint64_t code : d.codes) {
 			if (cells < 64 && code >> cells)

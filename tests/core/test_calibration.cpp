@@ -480,6 +480,14 @@ TEST(Calibration, FifoOrDeviceIsRefusedWithoutWaiting)
 	}
 }
 
+/* Issue 34: messages quote the file's name and values; both may be any
+ * bytes, the message is UTF-8 (a byte that is not, read as Latin-1). */
+TEST(Calibration, MessagesAreUtf8WhateverTheInput)
+{
+	EXPECT_EQ(errorOf(replaced(kRos, "plumb_bob", "caf\xe9"), "cam\xff.yaml"),
+		  "cam\xc3\xbf.yaml: distortion_model: \"caf\xc3\xa9\" is unknown: expected plumb_bob or rational_polynomial");
+}
+
 /* The files shipped for the sample video: the camera it was rendered with. */
 TEST(Calibration, SampleVideoFiles)
 {
