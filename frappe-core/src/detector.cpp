@@ -109,10 +109,6 @@ private:
 	detail::WarpedMarker cellCentres_;
 };
 
-/* Largest image side accepted: contour coordinates are ints and buffers are
- * sized from width * height. */
-constexpr int kMaxSide = 1 << 15;
-
 } // namespace
 
 std::string_view stageName(Stage stage)
@@ -135,8 +131,8 @@ void Detector::Impl::checkImage(const ImageView &image) const
 	if (image.width <= 0 || image.height <= 0)
 		fail("image size must be positive, got " + std::to_string(image.width) + "x" +
 		     std::to_string(image.height));
-	if (image.width > kMaxSide || image.height > kMaxSide)
-		fail("image side must be at most " + std::to_string(kMaxSide) + " pixels");
+	if (image.width > kMaxImageSide || image.height > kMaxImageSide)
+		fail("image side must be at most " + std::to_string(kMaxImageSide) + " pixels");
 	if (static_cast<long long>(image.width) * image.height > config.max_pixels)
 		fail("image of " + std::to_string(image.width) + "x" + std::to_string(image.height) +
 		     " has more than max_pixels (" + std::to_string(config.max_pixels) + ") pixels");

@@ -66,6 +66,11 @@ struct Result {
 	std::size_t copy_bytes = 0;
 };
 
+/// The longest image side detect() accepts (it throws
+/// std::invalid_argument beyond, whatever Config::max_pixels allows): the
+/// tracer's coordinates are 16-bit.
+constexpr int kMaxImageSide = 1 << 15;
+
 /// Finds markers of one dictionary in 8-bit luma images.
 ///
 /// One instance is used by one thread at a time; separate instances share
