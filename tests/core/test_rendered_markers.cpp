@@ -419,7 +419,7 @@ TEST(RenderArguments, BadImagesIdsAndOptionsAreRefused)
 	RenderOptions opt;
 	opt.supersample = 100000; /* 10^10 samples a pixel would overflow */
 	EXPECT_TRUE(has(messageOf<std::invalid_argument>([&] { renderMarker(img.mut(), dict, 0, c, opt); }),
-			"supersample must be at most 256, got 100000"));
+			"supersample must be 1..256, got 100000"));
 	/* An empty image: nothing to draw, nothing refused. */
 	EXPECT_NO_THROW(renderMarker(MutableImageView{}, dict, 0, c));
 }
@@ -440,6 +440,40 @@ TEST(RenderArguments, QuietZoneBeyondTheHorizonStaysInTheImage)
 	EXPECT_NE(img.at(32, 30), 128); /* the code */
 }
 
+/* Issue 34: quiet_cells = 2^31 - 1 overflowed an int (undefined
+ * behaviour), and a negative quiet_cells or supersample was clamped
+ * silently where markerImage() refused it. Both refuse what they cannot
+ * draw, with the same words. */
+TEST(RenderArguments, QuietCellsAndSupersampleOutOfRangeAreRefused)
+{
+	const Dictionary &dict = *findDictionary("4x4_50");
+	Image img(64, 64, 128);
+	const std::array<Point2f, 4> c{ Point2f{ 10, 10 }, { 50, 10 }, { 50, 50 }, { 10, 50 } };
+	for (const int quiet : { -1, 32769, 2147483647 }) {
+		RenderOptions opt;
+		opt.quiet_cells = quiet;
+		EXPECT_EQ(messageOf<std::invalid_argument>([&] { renderMarker(img.mut(), dict, 0, c, opt); }),
+			  "renderMarker: quiet_cells must be 0..32768, got " + std::to_string(quiet));
+		int side = 0;
+		EXPECT_EQ(messageOf<std::invalid_argument>([&] { markerImage(dict, 0, 1, quiet, side); }),
+			  "markerImage: quiet_cells must be 0..32768, got " + std::to_string(quiet));
+	}
+	for (const int ss : { 0, -7, 257 }) {
+		RenderOptions opt;
+		opt.supersample = ss;
+		EXPECT_EQ(messageOf<std::invalid_argument>([&] { renderMarker(img.mut(), dict, 0, c, opt); }),
+			  "renderMarker: supersample must be 1..256, got " + std::to_string(ss));
+	}
+	EXPECT_EQ(img.at(30, 30), 128) << "nothing drawn by a refused call";
+	/* The widest quiet zone accepted is drawn, its cells computed in range. */
+	RenderOptions widest;
+	widest.quiet_cells = 32768;
+	widest.supersample = 1;
+	EXPECT_NO_THROW(renderMarker(img.mut(), dict, 0, c, widest));
+	EXPECT_EQ(img.at(12, 12), 0);
+	EXPECT_EQ(img.at(1, 1), 255) << "the quiet zone reaches the image's corner";
+}
+
 TEST(RenderArguments, MarkerImageRefusesBadSizesAndIds)
 {
 	const Dictionary &dict = *findDictionary("aruco_mip_36h12");
@@ -448,7 +482,7 @@ TEST(RenderArguments, MarkerImageRefusesBadSizesAndIds)
 			"cell_px must be at least 1, got 0"));
 	EXPECT_TRUE(has(messageOf<std::invalid_argument>([&] { markerImage(dict, 0, -3, 1, side); }), "got -3"));
 	EXPECT_TRUE(has(messageOf<std::invalid_argument>([&] { markerImage(dict, 0, 4, -5, side); }),
-			"quiet_cells must not be negative, got -5"));
+			"quiet_cells must be 0..32768, got -5"));
 	EXPECT_TRUE(has(messageOf<std::invalid_argument>([&] { markerImage(dict, 0, 1 << 28, 1, side); }),
 			"more than 32768"));
 	EXPECT_TRUE(has(messageOf<std::out_of_range>([&] { markerImage(dict, dict.size(), 4, 1, side); }), "not in"));
