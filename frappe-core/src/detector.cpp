@@ -77,8 +77,8 @@ void validate(const Config &c, const Dictionary &d)
 class TracedMarkerProbe final : public detail::MarkerProbe
 {
 public:
-	TracedMarkerProbe(const ImageView &image, float scale, const detail::CodeBook &codes)
-		: image_(image), scale_(scale), codes_(codes), dict_(codes.dictionary())
+	TracedMarkerProbe(const ImageView &image, float scale, const detail::CodeBook &codes, int maxHamming)
+		: image_(image), scale_(scale), codes_(codes), dict_(codes.dictionary()), maxHamming_(maxHamming)
 	{
 	}
 	/* Notes in quad.probeRead how many border cells read white at the
@@ -98,7 +98,15 @@ public:
 		 * inside the quad (markers on a dark panel, say), and with a small
 		 * dictionary and a generous max_hamming a third of all bit patterns
 		 * are within reach of some codeword. */
-		return detail::readable(b, dict_.bits) && codes_.decode(b.code, 0).id >= 0;
+		quad.probeReadable = detail::readable(b, dict_.bits);
+		if (!quad.probeReadable)
+			return false;
+		if (codes_.decode(b.code, 0).id >= 0)
+			return true;
+		/* Not sealed, but ranked before clutter when a frame has more
+		 * candidates than it may read (capCandidates()). */
+		quad.probeNearCode = maxHamming_ > 0 && codes_.decode(b.code, maxHamming_).id >= 0;
+		return false;
 	}
 
 private:
@@ -106,6 +114,7 @@ private:
 	float scale_;
 	const detail::CodeBook &codes_;
 	const Dictionary &dict_;
+	int maxHamming_;
 	detail::WarpedMarker cellCentres_;
 };
 
@@ -154,7 +163,7 @@ void Detector::Impl::trace(Slot &slot)
 	tp.cluster_radius = config.corner_cluster_radius;
 	tp.min_side = std::max(4.0f, config.min_marker_side * scale);
 	tp.border_margin = 1.0f;
-	TracedMarkerProbe probe(slot.image, scale, *codes);
+	TracedMarkerProbe probe(slot.image, scale, *codes, maxHamming);
 	tracer.trace(edges, tp, quads, &probe);
 	const TraceMap &regions = edges.regions;
 	if (regions.width > 0) {
@@ -166,7 +175,7 @@ void Detector::Impl::trace(Slot &slot)
 		rtp.max_winding = 2.0f;
 		rtp.holes = false;
 		rtp.min_side = std::max(4.0f, config.min_marker_side * regions.scale);
-		TracedMarkerProbe regionProbe(slot.image, regions.scale, *codes);
+		TracedMarkerProbe regionProbe(slot.image, regions.scale, *codes, maxHamming);
 		regionTracer.trace(regions, rtp, regionQuads, &regionProbe);
 		const float toEdges = scale / regions.scale;
 		for (detail::Quad q : regionQuads) {

@@ -491,3 +491,41 @@ TEST(RenderArguments, MarkerImageRefusesBadSizesAndIds)
 	EXPECT_EQ(side, (dict.bits + 4) * 4);
 	EXPECT_EQ(px.size(), static_cast<std::size_t>(side) * side);
 }
+
+/* Issue 34: past max_candidates the cap kept the exact reads, then the
+ * smallest: a 360 px marker with one damaged bit in a 1080p frame of a 16 px
+ * grid of squares (a perforated sheet: some 7,000 candidates) was dropped
+ * first. The trace's quick read now ranks a near codeword before the
+ * tiles, so it is read; the frame's time stays that of its candidates. */
+TEST(RenderedMarkers, DamagedMarkerInClutterIsNotDropped)
+{
+	const Dictionary &dict = *findDictionary("aruco_mip_36h12");
+	Image img(1920, 1080, 230);
+	squareGrid(img, 12, 16);
+	const int cx = 1200, cy = 520, side = 360, cell = side / (dict.bits + 2);
+	for (int y = cy - 260; y < cy + 260; ++y)
+		for (int x = cx - 260; x < cx + 260; ++x)
+			img.at(x, y) = 230;
+	const int id = 5;
+	renderMarker(img.mut(), dict, id, squarePose(static_cast<float>(cx), static_cast<float>(cy), side, 0.0f, 0.0f));
+	/* One code cell flipped: one bit away from id 5's codeword. */
+	const int x0 = cx - side / 2, y0 = cy - side / 2, bx = 3, by = 2;
+	const std::uint8_t was = img.at(x0 + bx * cell + cell / 2, y0 + by * cell + cell / 2);
+	for (int y = 0; y < cell; ++y)
+		for (int x = 0; x < cell; ++x)
+			img.at(x0 + bx * cell + x, y0 + by * cell + y) = was < 128 ? 255 : 0;
+
+	Detector det{ Config{} };
+	const auto t0 = std::chrono::steady_clock::now();
+	const Result &r = det.detect(img.view());
+	const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+	std::printf("1080p, %d candidates read, %d dropped: %.1f ms\n", r.candidates, r.candidates_dropped, ms);
+	EXPECT_GT(r.candidates_dropped, 1000) << "the tiles overflow the cap";
+	EXPECT_LE(r.candidates, Config{}.max_candidates);
+	ASSERT_EQ(r.markers.size(), 1u);
+	EXPECT_EQ(r.markers[0].id, id);
+	EXPECT_EQ(r.markers[0].hamming, 1);
+	EXPECT_LT(meanCornerError(r.markers[0].corners, squarePose(static_cast<float>(cx), static_cast<float>(cy), side,
+								      0.0f, 0.0f)),
+		  1.0f);
+}
