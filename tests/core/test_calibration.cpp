@@ -115,6 +115,19 @@ TEST(Camera, ScaledToOtherSizes)
 	const Camera unknown = Camera::pinhole(600, 600, 320, 240);
 	EXPECT_EQ(unknown.scaledTo(1920, 1080).matrix, unknown.matrix);
 	EXPECT_THROW(c.scaledTo(0, 240), std::invalid_argument);
+
+	/* Issue 34: a valid calibration of a 1x1 frame with a focal length
+	 * near the largest double scaled to an infinite one, and no pose
+	 * came, silently. Now the scaling says why. */
+	Camera huge = Camera::pinhole(1e308, 1e308, 0.0, 0.0);
+	huge.width = huge.height = 1;
+	ASSERT_TRUE(huge.valid());
+	try {
+		huge.scaledTo(640, 480);
+		ADD_FAILURE() << "scaled to an infinite focal length";
+	} catch (const std::invalid_argument &e) {
+		EXPECT_EQ(std::string(e.what()), "camera: scaled from 1x1 to 640x480 its matrix is no camera (fx inf, fy inf)");
+	}
 }
 
 namespace {

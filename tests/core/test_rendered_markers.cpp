@@ -529,3 +529,32 @@ TEST(RenderedMarkers, DamagedMarkerInClutterIsNotDropped)
 								      0.0f, 0.0f)),
 		  1.0f);
 }
+
+/* Issue 34: the candidates stat counted a quad twice when it was read at
+ * its outline and then inset, and could exceed max_candidates. Scenes of
+ * random grey rectangles (one of these went 6 over a cap of 5). */
+TEST(RenderedMarkers, CandidatesNeverExceedTheCap)
+{
+	std::mt19937 rng(1);
+	int over = 0;
+	for (int trial = 0; trial < 40; ++trial) {
+		Image img(640, 480, trial % 2 ? 230 : 40);
+		std::uniform_int_distribution<int> x(0, img.width - 1), y(0, img.height - 1), side(8, 80), grey(0, 255);
+		for (int k = 0; k < 50 + trial; ++k) {
+			const int x0 = x(rng), y0 = y(rng), w = side(rng), h = side(rng);
+			const auto g = static_cast<std::uint8_t>(grey(rng));
+			for (int yy = y0; yy < std::min(img.height, y0 + h); ++yy)
+				for (int xx = x0; xx < std::min(img.width, x0 + w); ++xx)
+					img.at(xx, yy) = g;
+		}
+		for (const int cap : { 5, 20, 60 }) {
+			Config c;
+			c.max_candidates = cap;
+			Detector det(c);
+			const Result &r = det.detect(img.view());
+			EXPECT_LE(r.candidates, cap) << "trial " << trial;
+			over += r.candidates > cap;
+		}
+	}
+	EXPECT_EQ(over, 0);
+}
