@@ -52,11 +52,11 @@ struct Result {
 	std::vector<Marker> markers;
 	StageTimes times;
 	float scale = 1.0f;     ///< resolution the frame was traced at
-	int candidates = 0;     ///< quadrilaterals that reached decoding
+	int candidates = 0;     ///< quadrilaterals that reached decoding, each once: at most Config::max_candidates
 	/// Candidate outlines the trace found beyond Config::max_candidates and
-	/// left unread (the largest of those its quick read did not find to be
-	/// markers): 0 unless the frame is full of squares (a tiled wall, a dot
-	/// grid). Markers among them are missed; a caller may report it as a
+	/// left unread (the largest of those its quick read found least
+	/// promising: Config::max_candidates): 0 unless the frame is full of
+	/// squares (a tiled wall, a dot grid). Markers among them are missed; a caller may report it as a
 	/// warning.
 	int candidates_dropped = 0;
 	/// Bytes of the frame its front end copied before reading it
