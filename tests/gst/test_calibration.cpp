@@ -13,6 +13,7 @@
 #include <gst/gst.h>
 #include <gtest/gtest.h>
 
+#include "../support/blocking_read.h"
 #include "gstfrappemeta.h"
 #include "helpers.h"
 
@@ -193,6 +194,35 @@ TEST(Calibration, SetWhilePlaying)
 	const GstFrappeMarkerMeta m = posePushed(t.h, spec, marker, 2 * GST_SECOND);
 	ASSERT_TRUE(m.has_pose);
 	EXPECT_NEAR(m.tvec[2], kTvec[2] / 2, 0.01 * kTvec[2]);
+}
+
+/* Issue 34: a calibration-file (or dictionary-file) name swapped for a
+ * FIFO between the check and the open blocked the property thread
+ * forever. Set while playing, again and again as the name is swapped, the
+ * property never blocks; the FIFO is refused with a warning naming it. */
+TEST(Calibration, FileSwappedForAFifoNeverBlocksTheProperty)
+{
+	TempDir dir;
+	const FrameSpec spec{ GST_VIDEO_FORMAT_GRAY8, 640, 480 };
+	BusHarness t("frappedetect marker-size=0.08", spec);
+	GstElement *e = detector(t.h);
+	for (const char *property : { "calibration-file", "dictionary-file" }) {
+		SCOPED_TRACE(property);
+		const bool calibration = std::string(property) == "calibration-file";
+		const std::string text = calibration ? rosCalibration(640, 480, 600, 600, 319.5, 239.5) : "0x1234\n0xff00\n";
+		EXPECT_FALSE(frappe::test::blockedBySwappedFifo(dir.path + "/swapped", text, 0.5, [&](const std::string &p) {
+			g_object_set(e, property, p.c_str(), nullptr);
+		}));
+		const std::string fifo = dir.path + "/fifo";
+		EXPECT_EQ(frappe::test::readingFifo(fifo, [&](const std::string &p) { g_object_set(e, property, p.c_str(), nullptr); }),
+			  "read without an error");
+		bool named = false;
+		const BusMessages msgs(t.bus);
+		for (GstMessage *m : msgs.of(GST_MESSAGE_WARNING))
+			named |= MessageError(m).text.find(fifo + ": not a regular file (a FIFO)") != std::string::npos ||
+				 MessageError(m).text.find(fifo + "': not a regular file (a FIFO)") != std::string::npos;
+		EXPECT_TRUE(named) << "a warning names the FIFO";
+	}
 }
 
 /* marker-sizes: an id of its own size has its tvec scaled by the ratio of
