@@ -232,6 +232,7 @@ void Detector::Impl::sampleRefined(Reading &r, const detail::Quad &q, std::size_
 	if (!r.refined || !bigEnough(q.corners, r.minSide))
 		return;
 	++res.candidates;
+	r.counted = true;
 	timer.lap(Stage::Warp);
 	if (r.inBatch) {
 		const int j = batch.place[k];
@@ -256,7 +257,7 @@ void Detector::Impl::readInset(Reading &r, detail::Quad &q, Result &res, StageTi
 	r.readable = inset && bigEnough(q.corners, r.minSide);
 	if (!r.readable)
 		return;
-	++res.candidates;
+	res.candidates += r.counted ? 0 : 1;
 	timer.lap(Stage::Decode);
 	r.samples = &warped;
 	r.b = detail::binarise(warped, dict->bits);

@@ -111,6 +111,7 @@ struct FRAPPE_HIDDEN Detector::Impl {
 		std::array<Point2f, 4> outline; /* the traced one */
 		bool refined = false;   /* then: and warped */
 		bool readable = true;
+		bool counted = false;   /* in Result::candidates: once a quad */
 		detail::Binarised b;
 		const detail::WarpedMarker *samples = nullptr;
 	};
