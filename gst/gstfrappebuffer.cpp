@@ -9,6 +9,7 @@
 #include <gst/allocators/gstdmabuf.h>
 
 #include <frappe/config.h>
+#include <frappe/detector.h>
 
 #include "gstfrappepool.h"
 
@@ -71,9 +72,18 @@ Lie checkBuffer(GstBuffer *buffer, const GstVideoInfo *info, bool allPlanes, std
 				planes);
 
 	const gsize size = gst_buffer_get_size(buffer);
-	for (guint p = 0; p < (allPlanes ? planes : 1u); ++p) {
+	for (guint p = 0; p < planes; ++p) {
 		const gsize offset = meta ? meta->offset[p] : GST_VIDEO_INFO_PLANE_OFFSET(info, p);
 		const gint stride = meta ? meta->stride[p] : GST_VIDEO_INFO_PLANE_STRIDE(info, p);
+		if (p > 0 && !allPlanes) {
+			/* Neither read nor written, but gst_video_frame_map()
+			 * maps the memory at each plane's offset: none there is
+			 * a buffer it cannot map. */
+			if (meta && offset >= size)
+				return describe(why, Lie::Size, "plane %u starts at offset %" G_GSIZE_FORMAT
+						", past the end of the buffer of %" G_GSIZE_FORMAT " bytes", p, offset, size);
+			continue;
+		}
 		guint64 rows = 0, rowBytes = 0;
 		planeExtent(info, p, rows, rowBytes);
 		if (stride < 0 || static_cast<guint64>(stride) < rowBytes)
@@ -94,6 +104,11 @@ Lie checkBuffer(GstBuffer *buffer, const GstVideoInfo *info, bool allPlanes, std
 			return describe(why, Lie::Memory, "plane %u is not within one memory: %" G_GUINT64_FORMAT
 					" bytes from offset %" G_GSIZE_FORMAT, p, need, offset);
 	}
+	/* Without a meta gst_video_frame_map() wants the caps' whole frame. */
+	if (!meta && size < GST_VIDEO_INFO_SIZE(info))
+		return describe(why, Lie::Size, "the buffer has %" G_GSIZE_FORMAT " bytes, a %dx%d %s frame %" G_GSIZE_FORMAT,
+				size, GST_VIDEO_INFO_WIDTH(info), GST_VIDEO_INFO_HEIGHT(info), GST_VIDEO_INFO_NAME(info),
+				GST_VIDEO_INFO_SIZE(info));
 	return Lie::None;
 }
 
@@ -164,12 +179,22 @@ bool acceptFrameSize(GstElement *element, const GstVideoInfo *info)
 	const gint w = GST_VIDEO_INFO_WIDTH(info), h = GST_VIDEO_INFO_HEIGHT(info);
 	GST_DEBUG_OBJECT(element, "%s %dx%d", GST_VIDEO_INFO_NAME(info), w, h);
 	const long long maxPixels = frappe::Config{}.max_pixels;
-	if (static_cast<long long>(w) * h <= maxPixels)
-		return true;
-	GST_ELEMENT_ERROR(element, CORE, NEGOTIATION,
-			  ("Frames of %dx%d are larger than the detector accepts (%lld pixels)", w, h, maxPixels),
-			  (nullptr));
-	return false;
+	if (static_cast<long long>(w) * h > maxPixels) {
+		GST_ELEMENT_ERROR(element, CORE, NEGOTIATION,
+				  ("Frames of %dx%d are larger than the detector accepts (%lld pixels)", w, h, maxPixels),
+				  (nullptr));
+		return false;
+	}
+	/* What Detector::checkImage() refuses, refused here rather than at
+	 * the first buffer. */
+	if (w > frappe::kMaxImageSide || h > frappe::kMaxImageSide) {
+		GST_ELEMENT_ERROR(element, CORE, NEGOTIATION,
+				  ("Frames of %dx%d are wider or taller than the detector accepts (%d pixels a side)", w,
+				   h, frappe::kMaxImageSide),
+				  (nullptr));
+		return false;
+	}
+	return true;
 }
 
 void askOneMoreBuffer(GstElement *element, GstQuery *query)

@@ -26,6 +26,7 @@ enum class Lie : unsigned {
 	Stride,       /* a stride negative or shorter than a row */
 	Size,         /* a plane ends past the buffer */
 	Memory,       /* a plane is not within the one memory its meta maps */
+	Map,          /* gst_video_frame_map() failed all the same */
 	Count,
 };
 
@@ -35,7 +36,9 @@ constexpr std::size_t kLieText = 192;
 /* Whether `buffer` holds the frame of the negotiated `info` as its
  * GstVideoMeta (or, without one, `info`) lays it out: the luma plane the
  * detector reads, and every plane when `allPlanes` (annotation writes the
- * chroma planes too). Arithmetic only: nothing is mapped or read. */
+ * chroma planes too); otherwise at least what gst_video_frame_map() needs
+ * of the chroma planes (an offset inside the buffer; without a meta, the
+ * caps' frame size). Arithmetic only: nothing is mapped or read. */
 Lie checkBuffer(GstBuffer *buffer, const GstVideoInfo *info, bool allPlanes, std::array<char, kLieText> &why);
 
 /* Warnings and debug lines about input buffers, once per stream (reset
@@ -72,8 +75,8 @@ private:
 };
 
 /* Whether frames of `info`'s size are within frappe::Config's max_pixels
- * (the element leaves it at its default); a GST_ELEMENT_ERROR if not, at
- * negotiation rather than at every buffer. */
+ * (the element leaves it at its default) and frappe::kMaxImageSide; a
+ * GST_ELEMENT_ERROR if not, at negotiation rather than at every buffer. */
 bool acceptFrameSize(GstElement *element, const GstVideoInfo *info);
 
 /* Raises every pool's minimum (and a lower maximum) in an ALLOCATION

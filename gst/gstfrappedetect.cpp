@@ -103,7 +103,9 @@
  * read: no memory at all; a #GstVideoMeta whose format, size or planes
  * differ from the caps; a stride negative or shorter than a row; the luma
  * plane (and, with #GstFrappeDetect:annotate, any plane) ending past the
- * buffer or, with a meta, past the memory its offset is in. It comes out
+ * buffer or, with a meta, past the memory its offset is in; a chroma
+ * plane starting past the buffer whatever #GstFrappeDetect:annotate is;
+ * any buffer that cannot be mapped all the same. It comes out
  * untouched, in its place (pipelined, after the held buffer), with no
  * metas, no drawing and no message. The first buffer of each kind of fault
  * posts a warning (GST_STREAM_ERROR_FORMAT), later ones only a debug line.
@@ -521,8 +523,10 @@ static GstFlowReturn process(GstFrappeDetect *self, GstBuffer *input)
 
 	MappedFrame f;
 	if (!f.map(buffer, info, priv->active.annotate)) {
-		GST_ELEMENT_ERROR(self, STREAM, FAILED, ("Could not map the video frame"), (nullptr));
-		return GST_FLOW_ERROR;
+		/* What checkBuffer() does not foresee: passed through all the
+		 * same, never a reason to stop the stream. */
+		priv->bufferLog.lie(GST_ELEMENT(self), Lie::Map, "the buffer could not be mapped", buffer);
+		return pass_through(self, buffer);
 	}
 	try {
 		priv->pipeline->detector().checkImage(f.image);

@@ -49,8 +49,7 @@ bool MappedFrame::map(GstBuffer *buf, const GstVideoInfo *info, bool forAnnotati
 	 * into system memory (and replaces them). */
 	dmabufInput = gst_is_dmabuf_memory(gst_buffer_peek_memory(buffer, 0));
 	if (!gst_video_frame_map(&frame, const_cast<GstVideoInfo *>(info), buffer, flags)) {
-		gst_buffer_unref(buffer);
-		buffer = nullptr;
+		buffer = nullptr; /* still the caller's */
 		return false;
 	}
 	image = ImageView(static_cast<const std::uint8_t *>(GST_VIDEO_FRAME_COMP_DATA(&frame, 0)),

@@ -19,7 +19,7 @@ struct MappedFrame {
 	bool dmabufInput = false;    /* dma-buf memory before mapping merged several memories */
 
 	/* Maps `buffer` (taking it) read-only, or read-write to annotate;
-	 * false, and the buffer dropped, when it cannot be mapped. */
+	 * false, the buffer left to the caller, when it cannot be mapped. */
 	bool map(GstBuffer *buffer, const GstVideoInfo *info, bool writable);
 	/* Unmaps the frame and gives the buffer to the caller. */
 	GstBuffer *release();

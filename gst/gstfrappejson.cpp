@@ -108,22 +108,34 @@ void appendNumber(std::string &out, T v)
 	out.append(text, r.ptr);
 }
 
+/* A JSON string, valid UTF-8 whatever the meta holds (any application may
+ * attach one): a byte that is not part of valid UTF-8 is written \\u00XX,
+ * as frappe-detect writes file names. */
 void appendString(std::string &out, const char *s)
 {
+	static const char hex[] = "0123456789abcdef";
 	out += '"';
-	for (; s && *s; ++s) {
+	while (s && *s) {
 		const unsigned char c = static_cast<unsigned char>(*s);
+		if (c >= 0x80) {
+			if (static_cast<gint32>(g_utf8_get_char_validated(s, -1)) >= 0) {
+				const char *next = g_utf8_next_char(s);
+				out.append(s, next);
+				s = next;
+				continue;
+			}
+		}
 		if (c == '"' || c == '\\') {
 			out += '\\';
 			out += static_cast<char>(c);
-		} else if (c < 0x20) {
-			static const char hex[] = "0123456789abcdef";
+		} else if (c < 0x20 || c >= 0x80) {
 			out += "\\u00";
 			out += hex[c >> 4];
 			out += hex[c & 15];
 		} else {
 			out += static_cast<char>(c);
 		}
+		++s;
 	}
 	out += '"';
 }

@@ -372,21 +372,6 @@ bool setValue(Settings &p, guint propId, const GValue *value, std::string &warni
 	case PROP_BACKEND:
 		p.backend = static_cast<GstFrappeBackend>(g_value_get_enum(value));
 		break;
-	case PROP_MARKER_SIZE:
-	case PROP_MARKER_SIZES: {
-		const double size = propId == PROP_MARKER_SIZE ? g_value_get_double(value) : p.markerSize;
-		const gchar *spec = propId == PROP_MARKER_SIZES ? g_value_get_string(value) : nullptr;
-		const std::string text = propId == PROP_MARKER_SIZES ? (spec ? spec : "") : p.markerSizesSpec;
-		try {
-			p.sizes = frappe::MarkerSizes::parse(text, size);
-		} catch (const std::exception &e) {
-			warning = "marker-sizes \"" + text + "\" refused: " + e.what();
-			return true;
-		}
-		p.markerSize = size;
-		p.markerSizesSpec = text;
-		break;
-	}
 	case PROP_CAMERA_MATRIX: {
 		std::vector<double> m;
 		setDoubleArray(value, m);
@@ -429,6 +414,47 @@ bool setValue(Settings &p, guint propId, const GValue *value, std::string &warni
 	return true;
 }
 
+/* The start of a refused text for a warning: a value may be up to
+ * MarkerSizes::kMaxSpecBytes long. */
+std::string quoted(const std::string &text)
+{
+	constexpr std::size_t kShown = 60;
+	return "\"" + (text.size() <= kShown ? text : text.substr(0, kShown) + "...") + "\"";
+}
+
+/* marker-size and marker-sizes make one MarkerSizes: parsed outside the
+ * object lock, which the streaming thread takes for every buffer, and
+ * parsed again if either changed meanwhile. `warning` set when refused. */
+void setMarkerSizes(GstElement *element, Settings &p, guint propId, const GValue *value, std::string &warning)
+{
+	const gchar *given = propId == PROP_MARKER_SIZES ? g_value_get_string(value) : nullptr;
+	for (;;) {
+		GST_OBJECT_LOCK(element);
+		const guint generation = p.generation;
+		const double size = propId == PROP_MARKER_SIZE ? g_value_get_double(value) : p.markerSize;
+		const std::string text = propId == PROP_MARKER_SIZES ? (given ? given : "") : p.markerSizesSpec;
+		GST_OBJECT_UNLOCK(element);
+		frappe::MarkerSizes sizes;
+		try {
+			sizes = frappe::MarkerSizes::parse(text, size);
+		} catch (const std::exception &e) {
+			warning = "marker-sizes " + quoted(text) + " refused: " + e.what();
+			return;
+		}
+		GST_OBJECT_LOCK(element);
+		if (p.generation == generation) {
+			p.sizes = std::move(sizes);
+			p.markerSize = size;
+			if (propId == PROP_MARKER_SIZES)
+				p.markerSizesSpec = text;
+			++p.generation;
+			GST_OBJECT_UNLOCK(element);
+			return;
+		}
+		GST_OBJECT_UNLOCK(element);
+	}
+}
+
 } /* namespace */
 
 bool setProperty(GstElement *element, Settings &props, const bool &running, guint propId, const GValue *value)
@@ -452,6 +478,8 @@ bool setProperty(GstElement *element, Settings &props, const bool &running, guin
 			++props.generation;
 			GST_OBJECT_UNLOCK(element);
 		}
+	} else if (propId == PROP_MARKER_SIZE || propId == PROP_MARKER_SIZES) {
+		setMarkerSizes(element, props, propId, value, warning);
 	} else {
 		GST_OBJECT_LOCK(element);
 		const guint cameraGeneration = props.cameraGeneration;

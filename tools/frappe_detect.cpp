@@ -378,28 +378,41 @@ void loadImage(Frame &f, long long maxPixels)
 	 * formats we cannot read the size of. Under 2 GiB: cv::Mat's int size. */
 	const std::size_t fileLimit = static_cast<std::size_t>(
 		std::min<long long>(8 * maxPixels + (16 << 20), std::numeric_limits<std::int32_t>::max()));
-	std::vector<std::uint8_t> bytes;
+	/* Standard input grows in place: never twice its size in memory. */
+	std::vector<std::uint8_t> file;
+	frappe::cli::StreamBytes stream;
 	try {
-		if (fromStdin ? !frappe::cli::readStreamBounded(0, name, fileLimit, bytes, f.error)
-			  : !frappe::cli::readFileBounded(f.path, fileLimit, bytes, f.error))
+		if (fromStdin ? !frappe::cli::readStreamBounded(0, name, fileLimit, stream, f.error)
+			  : !frappe::cli::readFileBounded(f.path, fileLimit, file, f.error))
 			return;
 	} catch (const std::bad_alloc &) { /* a 32-bit Pi may not find the room */
 		f.error = "out of memory reading " + name;
 		return;
 	}
-	const frappe::cli::ImageHeader h = frappe::cli::inspectImage(bytes.data(), bytes.size());
+	const std::uint8_t *data = fromStdin ? stream.data() : file.data();
+	const std::size_t size = fromStdin ? stream.size() : file.size();
+	const frappe::cli::ImageHeader h = frappe::cli::inspectImage(data, size);
 	if (!h.error.empty()) {
 		f.error = name + ": " + h.error;
 		return;
 	}
-	if (h.format != frappe::cli::ImageFormat::Unknown && h.width > maxPixels / h.height) {
+	/* OpenCV decodes whatever it recognises before any limit applies (a
+	 * 10 KB WebP to 1.1 GB): only formats whose size was read go on. */
+	if (h.format == frappe::cli::ImageFormat::Unknown) {
+		f.error = "cannot decode " + name + ": not an image of a format whose size frappe-detect reads before "
+			  "decoding (PNG, JPEG, BMP, PNM, PAM, PFM, WebP, TIFF, Sun raster, Radiance HDR, JPEG 2000, "
+			  "OpenEXR); not decoded";
+		return;
+	}
+	if (h.width > maxPixels / h.height) {
 		f.error = name + ": " + std::to_string(h.width) + " x " + std::to_string(h.height) + " " +
 			  frappe::cli::formatName(h.format) + ", more than the limit of " + std::to_string(maxPixels) +
 			  " pixels (Config::max_pixels); not decoded";
 		return;
 	}
 	try {
-		f.gray = cv::imdecode(cv::Mat(1, static_cast<int>(bytes.size()), CV_8UC1, bytes.data()), cv::IMREAD_GRAYSCALE);
+		f.gray = cv::imdecode(cv::Mat(1, static_cast<int>(size), CV_8UC1, const_cast<std::uint8_t *>(data)),
+				      cv::IMREAD_GRAYSCALE);
 	} catch (const cv::Exception &e) {
 		f.gray.release();
 		f.error = "cannot decode " + name + " as an image (OpenCV: " + e.err + ")";
@@ -413,8 +426,7 @@ void loadImage(Frame &f, long long maxPixels)
 		return;
 	}
 	/* EXIF orientation may swap the sides, never the count. */
-	if (h.format != frappe::cli::ImageFormat::Unknown &&
-	    static_cast<long long>(f.gray.cols) * f.gray.rows != h.width * h.height) {
+	if (static_cast<long long>(f.gray.cols) * f.gray.rows != h.width * h.height) {
 		f.error = name + ": decoded " + std::to_string(f.gray.cols) + " x " + std::to_string(f.gray.rows) +
 			  ", the header says " + std::to_string(h.width) + " x " + std::to_string(h.height);
 		f.gray.release();

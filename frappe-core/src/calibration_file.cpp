@@ -5,14 +5,13 @@
 
 #include <algorithm>
 #include <charconv>
-#include <filesystem>
-#include <fstream>
 #include <initializer_list>
 #include <stdexcept>
 #include <string>
-#include <system_error>
 
 #include "markup.h"
+#include "small_file.h"
+#include "utf8.h"
 
 namespace frappe {
 
@@ -219,7 +218,9 @@ private:
 
 } // namespace
 
-Camera parseCalibration(std::string_view text, std::string_view origin)
+namespace {
+
+Camera parse(std::string_view text, std::string_view origin)
 {
 	const std::string where(origin);
 	if (text.size() > detail::kMarkupMaxBytes)
@@ -248,25 +249,37 @@ Camera parseCalibration(std::string_view text, std::string_view origin)
 	return Calibration(root, origin).camera();
 }
 
+} // namespace
+
+Camera parseCalibration(std::string_view text, std::string_view origin)
+{
+	try {
+		return parse(text, origin);
+	} catch (const std::invalid_argument &e) {
+		/* Messages quote the file's name and text: UTF-8 whatever they are. */
+		const std::string_view what = e.what();
+		if (detail::invalidUtf8At(what) == std::string_view::npos)
+			throw;
+		throw std::invalid_argument(detail::toUtf8(what, std::string::npos));
+	}
+}
+
 Camera readCalibration(const std::string &path)
 {
-	std::error_code ec;
-	const auto status = std::filesystem::status(path, ec);
-	if (ec || !std::filesystem::exists(status))
-		throw std::runtime_error(path + ": no such file");
-	if (!std::filesystem::is_regular_file(status))
-		throw std::runtime_error(path + ": not a regular file");
-	const auto size = std::filesystem::file_size(path, ec);
-	if (ec)
-		throw std::runtime_error(path + ": " + ec.message());
-	if (size > detail::kMarkupMaxBytes)
-		throw std::runtime_error(path + ": " + std::to_string(size) +
+	using Fault = detail::SmallFile::Fault;
+	const detail::SmallFile f = detail::readSmallFile(path, detail::kMarkupMaxBytes);
+	const std::string where = detail::toUtf8(path, std::string::npos);
+	switch (f.fault) {
+	case Fault::None: break;
+	case Fault::NotFound: throw std::runtime_error(where + ": no such file");
+	case Fault::Directory: throw std::runtime_error(where + ": not a regular file (a directory)");
+	case Fault::NotRegular: throw std::runtime_error(where + ": not a regular file (" + f.reason + ")");
+	case Fault::TooLarge:
+		throw std::runtime_error(where + ": " + std::to_string(f.size) +
 					 " bytes, over the 1 MiB a calibration file may have");
-	std::ifstream in(path, std::ios::binary);
-	std::string text(static_cast<std::size_t>(size), '\0');
-	if (!in || !in.read(text.data(), static_cast<std::streamsize>(text.size())))
-		throw std::runtime_error(path + ": cannot be read");
-	return parseCalibration(text, path);
+	case Fault::Unreadable: throw std::runtime_error(where + ": cannot be read: " + f.reason);
+	}
+	return parseCalibration(f.text, path);
 }
 
 } // namespace frappe

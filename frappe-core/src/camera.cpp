@@ -110,6 +110,13 @@ Camera Camera::scaledTo(int frame_width, int frame_height) const
 	c.matrix[2] = (matrix[2] + 0.5) * rx - 0.5;
 	c.matrix[4] *= ry;
 	c.matrix[5] = (matrix[5] + 0.5) * ry - 0.5;
+	/* A valid camera can scale past what a double holds: say so, rather
+	 * than give a camera no pose can use. */
+	if (!c.valid())
+		throw std::invalid_argument("camera: scaled from " + std::to_string(width) + "x" + std::to_string(height) +
+					    " to " + std::to_string(frame_width) + "x" + std::to_string(frame_height) +
+					    " its matrix is no camera (fx " + std::to_string(c.matrix[0]) + ", fy " +
+					    std::to_string(c.matrix[4]) + ")");
 	return c;
 }
 

@@ -988,16 +988,25 @@ int capCandidates(std::vector<Quad> &quads, int most)
 	const std::size_t n = quads.size(), cap = static_cast<std::size_t>(std::max(most, 0));
 	if (n <= cap)
 		return 0;
-	const auto decoded = static_cast<std::size_t>(
-		std::count_if(quads.begin(), quads.end(), [](const Quad &q) { return q.probeDecoded; }));
-	/* What is left of the cap once the probe's markers have their places. */
-	std::size_t decodedLeft = std::min(decoded, cap), othersLeft = cap - decodedLeft;
+	/* The rank a quad earns from the probe: the higher ranks take the cap
+	 * first, so a damaged marker among thousands of tiles is read however
+	 * large it is. */
+	constexpr int kRanks = 4;
+	auto rank = [](const Quad &q) { return q.probeDecoded ? 0 : q.probeNearCode ? 1 : q.probeReadable ? 2 : 3; };
+	std::array<std::size_t, kRanks> left{};
+	for (const Quad &q : quads)
+		++left[static_cast<std::size_t>(rank(q))];
+	std::size_t room = cap;
+	for (std::size_t &l : left) {
+		l = std::min(l, room);
+		room -= l;
+	}
 	std::size_t kept = 0;
 	for (std::size_t i = 0; i < n; ++i) {
-		std::size_t &left = quads[i].probeDecoded ? decodedLeft : othersLeft;
-		if (left == 0)
+		std::size_t &l = left[static_cast<std::size_t>(rank(quads[i]))];
+		if (l == 0)
 			continue;
-		--left;
+		--l;
 		quads[kept++] = quads[i];
 	}
 	quads.resize(kept);

@@ -36,6 +36,12 @@ struct Quad {
 	/// The probe read it as a marker (and the tracer sealed its inside):
 	/// kept first when a frame has more candidates than it may read.
 	bool probeDecoded = false;
+	/// The probe read a codeword within the detector's max_hamming (a
+	/// damaged marker): kept next.
+	bool probeNearCode = false;
+	/// The probe read a black frame around cells of some contrast: kept
+	/// before what it found nothing in (clutter).
+	bool probeReadable = false;
 };
 
 struct TraceParams {
@@ -159,9 +165,11 @@ void removeDuplicateQuads(std::vector<Quad> &quads, float tolerance, PointGrid &
 /// The same with a grid of its own, which it allocates: for tests.
 void removeDuplicateQuads(std::vector<Quad> &quads, float tolerance);
 
-/// Keeps at most `most` of `quads`, in their order: first those the probe
-/// read as markers (probeDecoded), then the others from the front. Returns
-/// how many it dropped. In place; allocates nothing.
+/// Keeps at most `most` of `quads`, in their order, ranked by what the
+/// probe found: markers (probeDecoded), then near codes (probeNearCode),
+/// then readable frames (probeReadable), then the rest; within a rank from
+/// the front. Returns how many it dropped. In place, linear; allocates
+/// nothing.
 int capCandidates(std::vector<Quad> &quads, int most);
 
 } // namespace frappe::detail

@@ -13,6 +13,7 @@
 
 #include "detector_impl.h"
 #include "quad_geometry.h"
+#include "utf8.h"
 
 namespace frappe {
 
@@ -36,6 +37,9 @@ void validate(const Config &c, const Dictionary &d)
 			fail("custom_dictionary: bits must be 3..8, got " + std::to_string(d.bits));
 		if (d.codes.empty())
 			fail("custom_dictionary: no codes");
+		/* Every output carries the name: JSON, GStreamer, Python. */
+		if (detail::invalidUtf8At(d.name) != std::string_view::npos)
+			fail("custom_dictionary: the name is not UTF-8 text");
 		const int cells = d.bits * d.bits;
 		for (std::uint64_t code : d.codes) {
 			if (cells < 64 && code >> cells)
@@ -75,8 +79,8 @@ void validate(const Config &c, const Dictionary &d)
 class TracedMarkerProbe final : public detail::MarkerProbe
 {
 public:
-	TracedMarkerProbe(const ImageView &image, float scale, const detail::CodeBook &codes)
-		: image_(image), scale_(scale), codes_(codes), dict_(codes.dictionary())
+	TracedMarkerProbe(const ImageView &image, float scale, const detail::CodeBook &codes, int maxHamming)
+		: image_(image), scale_(scale), codes_(codes), dict_(codes.dictionary()), maxHamming_(maxHamming)
 	{
 	}
 	/* Notes in quad.probeRead how many border cells read white at the
@@ -97,7 +101,15 @@ public:
 		 * inside the quad (markers on a dark panel, say), and with a small
 		 * dictionary and a generous max_hamming a third of all bit patterns
 		 * are within reach of some codeword. */
-		return detail::readable(b, dict_.bits) && codes_.decode(b.code, 0).id >= 0;
+		quad.probeReadable = detail::readable(b, dict_.bits);
+		if (!quad.probeReadable)
+			return false;
+		if (codes_.decode(b.code, 0).id >= 0)
+			return true;
+		/* Not sealed, but ranked before clutter when a frame has more
+		 * candidates than it may read (capCandidates()). */
+		quad.probeNearCode = maxHamming_ > 0 && codes_.decode(b.code, maxHamming_).id >= 0;
+		return false;
 	}
 
 private:
@@ -105,12 +117,9 @@ private:
 	float scale_;
 	const detail::CodeBook &codes_;
 	const Dictionary &dict_;
+	int maxHamming_;
 	detail::WarpedMarker cellCentres_;
 };
-
-/* Largest image side accepted: contour coordinates are ints and buffers are
- * sized from width * height. */
-constexpr int kMaxSide = 1 << 15;
 
 } // namespace
 
@@ -134,8 +143,8 @@ void Detector::Impl::checkImage(const ImageView &image) const
 	if (image.width <= 0 || image.height <= 0)
 		fail("image size must be positive, got " + std::to_string(image.width) + "x" +
 		     std::to_string(image.height));
-	if (image.width > kMaxSide || image.height > kMaxSide)
-		fail("image side must be at most " + std::to_string(kMaxSide) + " pixels");
+	if (image.width > kMaxImageSide || image.height > kMaxImageSide)
+		fail("image side must be at most " + std::to_string(kMaxImageSide) + " pixels");
 	if (static_cast<long long>(image.width) * image.height > config.max_pixels)
 		fail("image of " + std::to_string(image.width) + "x" + std::to_string(image.height) +
 		     " has more than max_pixels (" + std::to_string(config.max_pixels) + ") pixels");
@@ -157,7 +166,7 @@ void Detector::Impl::trace(Slot &slot)
 	tp.cluster_radius = config.corner_cluster_radius;
 	tp.min_side = std::max(4.0f, config.min_marker_side * scale);
 	tp.border_margin = 1.0f;
-	TracedMarkerProbe probe(slot.image, scale, *codes);
+	TracedMarkerProbe probe(slot.image, scale, *codes, maxHamming);
 	tracer.trace(edges, tp, quads, &probe);
 	/* Region borders have no corner pixels: every closed one is fitted
 	 * from its outline. Their quads join the edge ones in the edge map's
@@ -171,7 +180,7 @@ void Detector::Impl::trace(Slot &slot)
 		rtp.max_winding = 2.0f;
 		rtp.holes = false;
 		rtp.min_side = std::max(4.0f, config.min_marker_side * regions->scale);
-		TracedMarkerProbe regionProbe(slot.image, regions->scale, *codes);
+		TracedMarkerProbe regionProbe(slot.image, regions->scale, *codes, maxHamming);
 		regionTracer.trace(*regions, rtp, regionQuads, &regionProbe);
 		const float toEdges = scale / regions->scale;
 		for (detail::Quad q : regionQuads) {

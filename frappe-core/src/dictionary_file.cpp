@@ -7,9 +7,9 @@
 #include <array>
 #include <bit>
 #include <charconv>
+#include <cstdio>
 #include <cstdint>
 #include <filesystem>
-#include <fstream>
 #include <iterator>
 #include <optional>
 #include <stdexcept>
@@ -17,11 +17,14 @@
 #include <system_error>
 #include <vector>
 
+#include "small_file.h"
+#include "utf8.h"
+
 namespace frappe {
 
 namespace {
 
-constexpr std::uintmax_t kMaxFileBytes = 64u << 20;
+constexpr std::size_t kMaxFileBytes = 64u << 20;
 constexpr std::size_t kMaxLineBytes = 4096;
 constexpr std::size_t kMaxNameBytes = 128;
 /* The min_hamming check compares every pair of codes in 4 rotations: at
@@ -67,7 +70,7 @@ std::optional<int> parseCount(std::string_view s)
 class Source {
 public:
 	Source(std::string_view text, std::string_view source, std::string_view caller)
-		: text_(text), prefix_(std::string(caller) + ": " + std::string(source) + ":")
+		: text_(text), prefix_(std::string(caller) + ": " + detail::toUtf8(source, std::string::npos) + ":")
 	{
 		if (text_.starts_with("\xEF\xBB\xBF")) /* a UTF-8 byte-order mark */
 			text_.remove_prefix(3);
@@ -112,6 +115,14 @@ void checkName(const Source &src, int line, std::string_view name)
 {
 	if (name.empty() || name.size() > kMaxNameBytes)
 		src.fail(line, "a dictionary name must have 1 to " + std::to_string(kMaxNameBytes) + " bytes");
+	/* The name goes into JSON, GStreamer structures and Python str, all
+	 * UTF-8: a file in another encoding (Latin-1) is refused here. */
+	if (const std::size_t at = detail::invalidUtf8At(name); at != std::string_view::npos) {
+		char byte[8];
+		std::snprintf(byte, sizeof(byte), "0x%02x", static_cast<unsigned char>(name[at]));
+		src.fail(line, "the dictionary name is not UTF-8 text (byte " + std::string(byte) + " at its byte " +
+				       std::to_string(at + 1) + "); save the file as UTF-8");
+	}
 }
 
 /* The sides whose cells fit a 64-bit code and the detector's sample grid
@@ -386,8 +397,8 @@ int minHamming(const Source &src, const std::vector<CodeLine> &codes, int n)
 	return best;
 }
 
-std::shared_ptr<const Dictionary> parse(std::string_view text, std::string_view source, std::string_view fallbackName,
-					std::string_view caller)
+std::shared_ptr<const Dictionary> parseAny(std::string_view text, std::string_view source,
+					    std::string_view fallbackName, std::string_view caller)
 {
 	Source src(text, source, caller);
 	/* The format from the first line that is neither blank nor a comment. */
@@ -410,9 +421,9 @@ std::shared_ptr<const Dictionary> parse(std::string_view text, std::string_view 
 			src.fail(c.line, "a code with bits beyond the " + std::to_string(cells) + " cells of a " +
 						 std::to_string(p.side) + "x" + std::to_string(p.side) + " marker");
 	}
-	/* A file's stem may be anything: cut, not refused. */
+	/* A file's stem may be any bytes: made UTF-8 and cut, not refused. */
 	if (p.name.empty())
-		p.name = fallbackName.empty() ? "custom" : std::string(fallbackName.substr(0, kMaxNameBytes));
+		p.name = fallbackName.empty() ? "custom" : detail::toUtf8(fallbackName, kMaxNameBytes);
 
 	auto owned = std::make_shared<OwnedDictionary>();
 	owned->name = std::move(p.name);
@@ -428,6 +439,20 @@ std::shared_ptr<const Dictionary> parse(std::string_view text, std::string_view 
 	return std::shared_ptr<const Dictionary>(owned, &owned->dict);
 }
 
+/* Messages quote the file's name and lines: UTF-8 whatever they are. */
+std::shared_ptr<const Dictionary> parse(std::string_view text, std::string_view source, std::string_view fallbackName,
+					std::string_view caller)
+{
+	try {
+		return parseAny(text, source, fallbackName, caller);
+	} catch (const std::invalid_argument &e) {
+		const std::string_view what = e.what();
+		if (detail::invalidUtf8At(what) == std::string_view::npos)
+			throw;
+		throw std::invalid_argument(detail::toUtf8(what, std::string::npos));
+	}
+}
+
 } // namespace
 
 std::shared_ptr<const Dictionary> parseDictionary(std::string_view text, std::string_view name)
@@ -437,32 +462,21 @@ std::shared_ptr<const Dictionary> parseDictionary(std::string_view text, std::st
 
 std::shared_ptr<const Dictionary> loadDictionary(const std::string &path)
 {
-	namespace fs = std::filesystem;
-	const std::string what = "frappe::loadDictionary: cannot read dictionary file '" + path + "': ";
-	std::error_code ec;
-	const fs::file_status status = fs::status(path, ec);
-	if (status.type() == fs::file_type::not_found)
-		throw std::runtime_error(what + "no such file");
-	if (ec)
-		throw std::runtime_error(what + ec.message());
-	if (!fs::is_regular_file(status))
-		throw std::runtime_error(what + (fs::is_directory(status) ? "a directory" : "not a regular file"));
-	const std::uintmax_t size = fs::file_size(path, ec);
-	if (ec)
-		throw std::runtime_error(what + ec.message());
-	if (size > kMaxFileBytes)
+	using Fault = detail::SmallFile::Fault;
+	const std::string what =
+		"frappe::loadDictionary: cannot read dictionary file '" + detail::toUtf8(path, std::string::npos) + "': ";
+	const detail::SmallFile f = detail::readSmallFile(path, kMaxFileBytes);
+	switch (f.fault) {
+	case Fault::None: break;
+	case Fault::NotFound: throw std::runtime_error(what + "no such file");
+	case Fault::Directory: throw std::runtime_error(what + "a directory");
+	case Fault::NotRegular: throw std::runtime_error(what + "not a regular file (" + f.reason + ")");
+	case Fault::TooLarge:
 		throw std::runtime_error(what + "over " + std::to_string(kMaxFileBytes >> 20) +
 					 " MiB, too large for a dictionary");
-	std::ifstream in(path, std::ios::binary);
-	if (!in)
-		throw std::runtime_error(what + "cannot open it");
-	/* At most the limit, even when the file grows while read. */
-	std::string text(static_cast<std::size_t>(size), '\0');
-	in.read(text.data(), static_cast<std::streamsize>(size));
-	text.resize(static_cast<std::size_t>(in.gcount()));
-	if (in.bad())
-		throw std::runtime_error(what + "a read error");
-	return parse(text, path, fs::path(path).stem().string(), "frappe::loadDictionary");
+	case Fault::Unreadable: throw std::runtime_error(what + f.reason);
+	}
+	return parse(f.text, path, std::filesystem::path(path).stem().string(), "frappe::loadDictionary");
 }
 
 } // namespace frappe

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace frappe {
 
@@ -43,9 +44,19 @@ MarkerSizes MarkerSizes::parse(std::string_view spec, double default_size)
 	if (!std::isfinite(default_size) || default_size < 0.0)
 		throw std::invalid_argument("marker sizes: the default size must be 0 (none) or positive, got " +
 					    std::to_string(default_size));
+	/* Every surface (the element under its lock, the CLI, Python) parses
+	 * at most this much: a few milliseconds. */
+	if (spec.size() > kMaxSpecBytes)
+		throw std::invalid_argument("marker sizes: " + std::to_string(spec.size()) + " bytes, more than the " +
+					    std::to_string(kMaxSpecBytes) + " a list of sizes may have");
 	MarkerSizes sizes(default_size);
 	if (trim(spec).empty())
 		return sizes;
+	/* Where each entry is in `spec`, to name the second of a repeated id
+	 * once all are sorted: appending then sorting is n log n where
+	 * inserting in order was quadratic. */
+	std::vector<std::size_t> at;
+	const std::string_view whole = spec;
 	while (true) {
 		const std::size_t comma = spec.find(',');
 		const std::string_view entry = trim(spec.substr(0, comma));
@@ -66,15 +77,31 @@ MarkerSizes MarkerSizes::parse(std::string_view spec, double default_size)
 			fail(entry, "the size is not a number");
 		if (!std::isfinite(size) || !(size > 0.0))
 			fail(entry, "the size must be positive and finite (metres)");
-		const auto at = std::lower_bound(sizes.sizes_.begin(), sizes.sizes_.end(), id,
-						 [](const auto &e, int i) { return e.first < i; });
-		if (at != sizes.sizes_.end() && at->first == id)
-			fail(entry, "id " + std::to_string(id) + " is given twice");
-		sizes.sizes_.insert(at, { id, size });
+		sizes.sizes_.push_back({ id, size });
+		at.push_back(static_cast<std::size_t>(entry.data() - whole.data()));
 		if (comma == std::string_view::npos)
 			break;
 		spec.remove_prefix(comma + 1);
 	}
+	std::vector<std::size_t> order(at.size());
+	for (std::size_t i = 0; i < order.size(); ++i)
+		order[i] = i;
+	const auto &s = sizes.sizes_;
+	std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return s[a].first < s[b].first; });
+	/* The repeat met first in the text, as a scan in order would. */
+	std::size_t repeat = order.size();
+	for (std::size_t k = 1; k < order.size(); ++k)
+		if (s[order[k]].first == s[order[k - 1]].first && (repeat == order.size() || order[k] < repeat))
+			repeat = order[k];
+	if (repeat != order.size()) {
+		const std::string_view rest = whole.substr(at[repeat]);
+		fail(trim(rest.substr(0, rest.find(','))), "id " + std::to_string(s[repeat].first) + " is given twice");
+	}
+	std::vector<std::pair<int, double>> sorted;
+	sorted.reserve(order.size());
+	for (std::size_t i : order)
+		sorted.push_back(s[i]);
+	sizes.sizes_ = std::move(sorted);
 	return sizes;
 }
 

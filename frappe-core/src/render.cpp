@@ -17,6 +17,18 @@ namespace {
  * markerImage()'s side^2 pixels. */
 constexpr int kMaxSupersample = 256;
 constexpr long long kMaxMarkerImageSide = 1 << 15;
+/* No quiet zone wider than the widest image: cells + 2 * quiet stays an int. */
+constexpr int kMaxQuietCells = 1 << 15;
+
+/* The cell a marker coordinate falls in, clamped to one past the widest
+ * quiet zone: near the horizon a sample maps arbitrarily far, or to NaN,
+ * which no cast to int may see. */
+int cellOf(float u, int cells)
+{
+	const double c = std::floor(static_cast<double>(u) * cells);
+	constexpr double kFar = 4.0 * kMaxQuietCells;
+	return c >= -kFar && c <= kFar ? static_cast<int>(c) : static_cast<int>(-kFar);
+}
 
 /* 1 = white, 0 = black; -1 outside the marker and its quiet zone. */
 int cellValue(const Dictionary &dict, std::uint64_t code, int cx, int cy, int quiet)
@@ -58,9 +70,12 @@ void checkRenderArguments(const MutableImageView &image, const Dictionary &dict,
 	if (image.height > 1 && image.stride < image.width)
 		fail("image stride (" + std::to_string(image.stride) + ") is smaller than its width (" +
 		     std::to_string(image.width) + ")");
-	if (opt.supersample > kMaxSupersample)
-		fail("supersample must be at most " + std::to_string(kMaxSupersample) + ", got " +
+	if (opt.supersample < 1 || opt.supersample > kMaxSupersample)
+		fail("supersample must be 1.." + std::to_string(kMaxSupersample) + ", got " +
 		     std::to_string(opt.supersample));
+	if (opt.quiet_cells < 0 || opt.quiet_cells > kMaxQuietCells)
+		fail("quiet_cells must be 0.." + std::to_string(kMaxQuietCells) + ", got " +
+		     std::to_string(opt.quiet_cells));
 	if (id < 0 || id >= dict.size())
 		throw std::out_of_range("renderMarker: id " + std::to_string(id) + " not in " + std::string(dict.name) +
 					" (0.." + std::to_string(dict.size() - 1) + ")");
@@ -103,7 +118,7 @@ void renderMarker(MutableImageView image, const Dictionary &dict, int id,
 		return;
 	const std::uint64_t code = dict.codes[id];
 	const int cells = dict.bits + 2;
-	const int q = std::max(0, opt.quiet_cells);
+	const int q = opt.quiet_cells;
 
 	/* Bounding box of the marker with its quiet zone. */
 	const double lo = -static_cast<double>(q) / cells, hi = 1.0 + static_cast<double>(q) / cells;
@@ -135,7 +150,7 @@ void renderMarker(MutableImageView image, const Dictionary &dict, int id,
 	const int y0 = clampedPixel(std::floor(minY) - 1.0, 0, image.height);
 	const int x1 = clampedPixel(std::ceil(maxX) + 1.0, -1, image.width - 1);
 	const int y1 = clampedPixel(std::ceil(maxY) + 1.0, -1, image.height - 1);
-	const int ss = std::max(1, opt.supersample);
+	const int ss = opt.supersample;
 	const double inv = 1.0 / ss;
 	for (int y = y0; y <= y1; ++y) {
 		std::uint8_t *row = image.row(y);
@@ -147,8 +162,8 @@ void renderMarker(MutableImageView image, const Dictionary &dict, int id,
 					const double px = x - 0.5 + (sx + 0.5) * inv;
 					const double py = y - 0.5 + (sy + 0.5) * inv;
 					const Point2f uv = Hinv->map(px, py);
-					const int cx = static_cast<int>(std::floor(uv.x * cells));
-					const int cy = static_cast<int>(std::floor(uv.y * cells));
+					const int cx = cellOf(uv.x, cells);
+					const int cy = cellOf(uv.y, cells);
 					const int v = cellValue(dict, code, cx, cy, q);
 					if (v < 0) {
 						sum += row[x];
@@ -186,8 +201,8 @@ std::vector<std::uint8_t> markerImage(const Dictionary &dict, int id, int cell_p
 	auto fail = [](const std::string &what) { throw std::invalid_argument("markerImage: " + what); };
 	if (cell_px < 1)
 		fail("cell_px must be at least 1, got " + std::to_string(cell_px));
-	if (quiet_cells < 0)
-		fail("quiet_cells must not be negative, got " + std::to_string(quiet_cells));
+	if (quiet_cells < 0 || quiet_cells > kMaxQuietCells)
+		fail("quiet_cells must be 0.." + std::to_string(kMaxQuietCells) + ", got " + std::to_string(quiet_cells));
 	if (id < 0 || id >= dict.size())
 		throw std::out_of_range("markerImage: id " + std::to_string(id) + " not in " + std::string(dict.name) +
 					" (0.." + std::to_string(dict.size() - 1) + ")");

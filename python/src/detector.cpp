@@ -2,6 +2,7 @@
 // python/src/detector.cpp: frappe.Detector: a frappe::Detector built from
 // keyword arguments, detecting in numpy arrays without the GIL.
 #include "module.h"
+#include "nogil.h"
 
 #include <algorithm>
 #include <cctype>
@@ -118,7 +119,7 @@ py::list PyDetector::detect(py::handle obj)
 	std::unique_lock<std::mutex> lock(mutex_, std::defer_lock);
 	const Result *result;
 	{
-		py::gil_scoped_release nogil;
+		WithoutGil nogil;
 		lock.lock();
 		ImageView view(data, static_cast<int>(w), static_cast<int>(h), stride);
 		if (!direct) {
@@ -156,7 +157,7 @@ py::dict PyDetector::stats()
 {
 	Stats last;
 	{
-		py::gil_scoped_release nogil;
+		WithoutGil nogil;
 		std::lock_guard<std::mutex> lock(mutex_);
 		last = last_;
 	}
@@ -175,7 +176,7 @@ py::dict PyDetector::stats()
 
 void PyDetector::reset()
 {
-	py::gil_scoped_release nogil;
+	WithoutGil nogil;
 	std::lock_guard<std::mutex> lock(mutex_);
 	detector_.reset();
 }

@@ -2,6 +2,7 @@
 // python/src/dictionary.cpp: frappe.Dictionary, frappe.dictionaries(),
 // frappe.get_dictionary() and frappe.load_dictionary().
 #include "module.h"
+#include "nogil.h"
 
 #include <stdexcept>
 #include <string>
@@ -32,8 +33,18 @@ DictionaryRef dictionaryArg(py::handle obj)
 {
 	if (py::isinstance<DictionaryRef>(obj))
 		return obj.cast<DictionaryRef>();
-	if (py::isinstance<py::str>(obj))
-		return builtinDictionary(obj.cast<std::string>());
+	if (py::isinstance<py::str>(obj)) {
+		/* A str that is not text (a lone surrogate, as os.fsdecode makes of
+		 * a file name's undecodable bytes) converts to no std::string. */
+		std::string name;
+		try {
+			name = obj.cast<std::string>();
+		} catch (const py::cast_error &) {
+			throw py::value_error("unknown dictionary " + std::string(py::str(py::module_::import("builtins").attr("ascii")(obj))) +
+					      ": not valid text (a lone surrogate); known: " + dictionaryNames());
+		}
+		return builtinDictionary(name);
+	}
 	throw py::type_error("dictionary must be a name (str) or a frappe.Dictionary, not " +
 			     std::string(py::str(obj.get_type().attr("__name__"))));
 }
@@ -100,8 +111,14 @@ Raises ValueError for an unknown name.)doc");
 	m.def(
 		"load_dictionary",
 		[](py::handle path) {
+			const std::string file = pathArg(path);
 			try {
-				return DictionaryRef{ loadDictionary(pathArg(path)) };
+				std::shared_ptr<const Dictionary> d;
+				{
+					WithoutGil nogil; /* a slow disk stops no other thread */
+					d = loadDictionary(file);
+				}
+				return DictionaryRef{ std::move(d) };
 			} catch (const std::invalid_argument &) {
 				throw;
 			} catch (const std::runtime_error &e) {

@@ -2,6 +2,7 @@
 // python/src/module.cpp: the extension module frappe._frappe, which the
 // package frappe re-exports, and the helpers its parts share.
 #include "module.h"
+#include "nogil.h"
 
 #include <frappe/version.h>
 
@@ -14,8 +15,10 @@ py::array_t<float> newFloatArray(py::ssize_t rows, py::ssize_t cols)
 
 std::string pathArg(py::handle obj)
 {
-	/* os.fsdecode: str, bytes or os.PathLike, as open() takes. */
-	return py::module_::import("os").attr("fsdecode")(obj).cast<std::string>();
+	/* os.fsencode: str, bytes or os.PathLike, as open() takes, as the
+	 * bytes the system sees (a name that is not UTF-8 has surrogates as
+	 * a str, which no std::string conversion takes). */
+	return py::module_::import("os").attr("fsencode")(obj).cast<py::bytes>();
 }
 
 void raiseOSError(const std::exception &error)
@@ -38,4 +41,5 @@ PYBIND11_MODULE(_frappe, m)
 	bindRender(m);
 	bindDetector(m);
 	bindPose(m);
+	registerExitHook();
 }

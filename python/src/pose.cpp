@@ -3,6 +3,7 @@
 // frappe.Pose and frappe.estimate_pose(), with project_points() and
 // undistort_points() to use them.
 #include "module.h"
+#include "nogil.h"
 
 #include <cmath>
 #include <cstdio>
@@ -201,8 +202,10 @@ calibrated at (0: unknown). Raises ValueError saying what is wrong.)doc")
 	m.def(
 		"read_calibration",
 		[](py::handle path) {
+			const std::string file = pathArg(path);
 			try {
-				return readCalibration(pathArg(path));
+				WithoutGil nogil; /* a slow disk stops no other thread */
+				return readCalibration(file);
 			} catch (const std::invalid_argument &) {
 				throw;
 			} catch (const std::runtime_error &e) {

@@ -4,6 +4,7 @@
 // corners, for test scenes).
 #include "module.h"
 
+#include <algorithm>
 #include <climits>
 #include <stdexcept>
 #include <string>
@@ -14,13 +15,28 @@ namespace frappe::python {
 
 namespace {
 
-py::array_t<std::uint8_t> renderMarker(py::handle dictionary, int id, int cell_px, int quiet_cells)
+/* Python's ints are of any size: one beyond C's int is clamped to it,
+ * where the library refuses it as it refuses one within, never wrapped. */
+long long clampedLong(const py::int_ &v)
+{
+	int overflow = 0;
+	const long long x = PyLong_AsLongLongAndOverflow(v.ptr(), &overflow);
+	return overflow > 0 ? LLONG_MAX : overflow < 0 ? LLONG_MIN : x;
+}
+
+int narrowed(const py::int_ &v)
+{
+	return static_cast<int>(std::clamp<long long>(clampedLong(v), INT_MIN, INT_MAX));
+}
+
+py::array_t<std::uint8_t> renderMarker(py::handle dictionary, const py::int_ &id, const py::int_ &cell_px,
+				       const py::int_ &quiet_cells)
 {
 	const DictionaryRef d = dictionaryArg(dictionary);
 	int side = 0;
 	std::vector<std::uint8_t> pixels;
 	try {
-		pixels = markerImage(*d.dict, id, cell_px, quiet_cells, side);
+		pixels = markerImage(*d.dict, narrowed(id), narrowed(cell_px), narrowed(quiet_cells), side);
 	} catch (const std::out_of_range &e) {
 		throw py::value_error(e.what());
 	}
@@ -53,19 +69,23 @@ MutableImageView writableView(py::handle obj)
 		 static_cast<int>(row) };
 }
 
-void drawMarker(py::handle image, py::handle dictionary, int id, py::handle corners, int quiet_cells,
-		int supersample, std::uint8_t black, std::uint8_t white)
+void drawMarker(py::handle image, py::handle dictionary, const py::int_ &id, py::handle corners,
+		const py::int_ &quiet_cells, const py::int_ &supersample, const py::int_ &black, const py::int_ &white)
 {
 	const MutableImageView view = writableView(image);
 	const DictionaryRef d = dictionaryArg(dictionary);
 	const std::array<Point2f, 4> c = cornersArg(corners);
+	for (const auto &[name, level] : { std::pair{ "black", &black }, std::pair{ "white", &white } })
+		if (clampedLong(*level) < 0 || clampedLong(*level) > 255)
+			throw py::value_error(std::string("renderMarker: ") + name + " must be 0..255, got " +
+					      std::string(py::str(py::handle(*level))));
 	RenderOptions options;
-	options.quiet_cells = quiet_cells;
-	options.supersample = supersample;
-	options.black = black;
-	options.white = white;
+	options.quiet_cells = narrowed(quiet_cells);
+	options.supersample = narrowed(supersample);
+	options.black = static_cast<std::uint8_t>(clampedLong(black));
+	options.white = static_cast<std::uint8_t>(clampedLong(white));
 	try {
-		frappe::renderMarker(view, *d.dict, id, c, options);
+		frappe::renderMarker(view, *d.dict, narrowed(id), c, options);
 	} catch (const std::out_of_range &e) {
 		throw py::value_error(e.what());
 	}
@@ -81,7 +101,8 @@ Marker `id` of `dictionary` (a name or a frappe.Dictionary), upright, as a
 square uint8 array (0 black, 255 white) of side (bits + 2 + 2 * quiet_cells)
 * cell_px: the code, its black border and a white quiet zone of quiet_cells
 cells. To print, or to paste into test scenes. Raises ValueError for an id
-not in the dictionary, cell_px < 1, quiet_cells < 0 or a side over 32768.)doc");
+not in the dictionary, cell_px < 1, quiet_cells outside 0..32768 or a side
+over 32768.)doc");
 
 	m.def("draw_marker", &drawMarker, py::arg("image"), py::arg("dictionary"), py::arg("id"),
 	      py::arg("corners"), py::kw_only(), py::arg("quiet_cells") = 1, py::arg("supersample") = 4,
@@ -93,7 +114,9 @@ through the perspective those corners define, its quiet zone around it.
 Pixels are area-averaged over supersample x supersample samples, so edges
 fall at their exact sub-pixel place: a synthetic view whose true corners are
 known. Raises ValueError for corners that are no view of a square (not
-convex, collinear, not finite) or an id not in the dictionary.)doc");
+convex, collinear, not finite), an id not in the dictionary, quiet_cells
+outside 0..32768, supersample outside 1..256, black or white outside
+0..255.)doc");
 }
 
 } // namespace frappe::python

@@ -183,6 +183,53 @@ def hostile_input(exe, render, sample, tmp):
           '--annotate with several images writes each')
 
 
+def max_rss_kb_stdin(exe, megabytes):
+    """The peak resident memory of frappe-detect reading `megabytes` MiB of
+    zeros from standard input (a pipe, so its length is not known)."""
+    code = ('import resource, subprocess, sys\n'
+            'p = subprocess.Popen(sys.argv[2:], stdin=subprocess.PIPE, stdout=subprocess.DEVNULL,\n'
+            '                     stderr=subprocess.DEVNULL)\n'
+            'chunk = bytes(1 << 20)\n'
+            'for _ in range(int(sys.argv[1])):\n'
+            '    p.stdin.write(chunk)\n'
+            'p.stdin.close()\n'
+            'print(p.wait(), resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss)\n')
+    env = dict(os.environ)
+    env['ASAN_OPTIONS'] = ':'.join(o for o in (env.get('ASAN_OPTIONS', ''), 'quarantine_size_mb=0') if o)
+    rc, kb = subprocess.run([sys.executable, '-c', code, str(megabytes), exe, '-'], capture_output=True,
+                            text=True, env=env).stdout.split()
+    return int(rc), int(kb)
+
+
+def format_bombs(exe, tmp):
+    """Issue 34: a 10 KB WebP decoded to 1.1 GB and a 1.8 MB TIFF to 0.94 GB
+    before the pixel limit applied, and 528 MiB of standard input took
+    1.1 GB. Now every format's size is read before decoding, what has none
+    to read is not decoded, and standard input grows in place."""
+    bombs = {
+        'bomb.webp': (b'RIFF' + struct.pack('<I', 22) + b'WEBPVP8X' + struct.pack('<I', 10) + b'\0' * 4
+                      + (16383 - 1).to_bytes(3, 'little') * 2 + b'\0' * 2, '16383 x 16383 WebP'),
+        'bomb.tif': (b'II*\0' + struct.pack('<IH', 8, 2) + struct.pack('<HHII', 256, 4, 1, 40000)
+                     + struct.pack('<HHII', 257, 3, 1, 30000), '40000 x 30000 TIFF'),
+        'bomb.pam': (b'P7\nWIDTH 20000\nHEIGHT 20000\nDEPTH 1\nMAXVAL 255\nENDHDR\n', '20000 x 20000 PAM'),
+    }
+    for name, (data, what) in bombs.items():
+        path = os.path.join(tmp, name)
+        with open(path, 'wb') as f:
+            f.write(data)
+        r = run(exe, path)
+        check(r.returncode == 1 and (what + ', more than the limit of 67108864 pixels') in r.stderr
+              and 'not decoded' in r.stderr, '%s: refused from its header (%s)' % (name, r.stderr.strip()))
+    gif = os.path.join(tmp, 'image.gif')
+    with open(gif, 'wb') as f:
+        f.write(b'GIF89a' + b'\0' * 100)
+    r = run(exe, gif)
+    check(r.returncode == 1 and 'not an image of a format whose size frappe-detect reads before decoding'
+          in r.stderr, 'a format whose size is not read is not decoded')
+    rc, kb = max_rss_kb_stdin(exe, 300)
+    check(rc == 1 and kb < 450 * 1024, '300 MiB on standard input: %d MB at most (815 MB before)' % (kb // 1024))
+
+
 def render_arguments(render, tmp):
     out = os.path.join(tmp, 'marker.png')
     r = run(render, '--id', '7', '--cell', '10', out)
@@ -279,6 +326,7 @@ def main():
                       '--backend vc4 without a usable GPU: exit 2 with the reason (%s)' % r.stderr.strip())
 
         hostile_input(exe, render, sample, tmp)
+        format_bombs(exe, tmp)
         render_arguments(render, tmp)
     return 0
 

@@ -104,6 +104,15 @@ void expectWhole(const Bytes &b, ImageFormat format, long long width, long long 
 	EXPECT_EQ(h.error, "");
 }
 
+/* A header read as that format and size. */
+void expectSize(const ImageHeader &h, ImageFormat format, long long width, long long height)
+{
+	EXPECT_EQ(formatName(h.format), std::string(formatName(format)));
+	EXPECT_EQ(h.width, width) << formatName(format);
+	EXPECT_EQ(h.height, height) << formatName(format);
+	EXPECT_EQ(h.error, "") << formatName(format);
+}
+
 Bytes cut(Bytes b, std::size_t n)
 {
 	b.resize(n);
@@ -190,10 +199,74 @@ TEST(ImageCheck, PnmSizeCommentsAndTruncation)
 
 TEST(ImageCheck, UnknownFormatsPassWithoutSize)
 {
-	const ImageHeader h = inspect(text("II*\0 a TIFF, say"));
+	const ImageHeader h = inspect(text("GIF89a, say"));
 	EXPECT_EQ(h.format, ImageFormat::Unknown);
 	EXPECT_EQ(h.error, "");
 	EXPECT_EQ(inspect(Bytes{}).format, ImageFormat::Unknown);
+}
+
+/* Issue 34: only PNG, JPEG, BMP and PNM had their size read; a 10 KB WebP
+ * decoded to 1.1 GB and a 1.8 MB TIFF to 0.94 GB before the pixel limit.
+ * Every other format OpenCV decodes has its size read from its header. */
+TEST(ImageCheck, EveryOtherOpenCvFormatGivesItsSize)
+{
+	auto bytes = [](std::initializer_list<int> v) {
+		Bytes b;
+		for (int x : v)
+			b.push_back(static_cast<std::uint8_t>(x));
+		return b;
+	};
+	auto plus = [](Bytes a, const Bytes &b) {
+		a.insert(a.end(), b.begin(), b.end());
+		return a;
+	};
+	const Bytes riff = plus(text("RIFF"), bytes({ 0, 1, 0, 0 }));
+	/* VP8X: canvas 16383 x 16383 (minus one, 24 bits each). */
+	expectSize(inspect(plus(plus(riff, text("WEBPVP8X")), bytes({ 10, 0, 0, 0, 0, 0, 0, 0, 0xfe, 0x3f, 0, 0xfe, 0x3f, 0, 0, 0 }))),
+		   ImageFormat::WebP, 16383, 16383);
+	/* VP8L: 0x2f, then 14 bits of width - 1 and of height - 1. */
+	const unsigned l = (1000 - 1) | (500 - 1) << 14;
+	expectSize(inspect(plus(plus(riff, text("WEBPVP8L")), bytes({ 9, 0, 0, 0, 0x2f, int(l & 255), int(l >> 8 & 255),
+									  int(l >> 16 & 255), int(l >> 24), 0, 0, 0, 0, 0 }))),
+		   ImageFormat::WebP, 1000, 500);
+	/* VP8: the key frame's start code, then 14-bit sizes. */
+	expectSize(inspect(plus(plus(riff, text("WEBPVP8 ")), bytes({ 9, 0, 0, 0, 0, 0, 0, 0x9d, 0x01, 0x2a, 0x80, 0x02,
+									  0xe0, 0x01, 0, 0 }))),
+		   ImageFormat::WebP, 640, 480);
+	/* TIFF: ImageWidth LONG 40000, ImageLength SHORT 30000, both byte orders. */
+	expectSize(inspect(bytes({ 'I', 'I', 42, 0, 8, 0, 0, 0, 2, 0, 0, 1, 4, 0, 1, 0, 0, 0, 0x40, 0x9c, 0, 0, 1, 1, 3, 0,
+				   1, 0, 0, 0, 0x30, 0x75, 0, 0 })),
+		   ImageFormat::Tiff, 40000, 30000);
+	expectSize(inspect(bytes({ 'M', 'M', 0, 42, 0, 0, 0, 8, 0, 2, 1, 0, 0, 4, 0, 0, 0, 1, 0, 0, 0x9c, 0x40, 1, 1, 0, 3,
+				   0, 0, 0, 1, 0x75, 0x30, 0, 0 })),
+		   ImageFormat::Tiff, 40000, 30000);
+	/* BigTIFF: version 43, 8-byte offsets and counts, LONG8 values. */
+	expectSize(inspect(bytes({ 'I', 'I', 43, 0, 8, 0, 0, 0, 16, 0, 0, 0, 0, 0, 0, 0, 2, 0, 0, 0, 0, 0, 0, 0,
+				   0, 1, 16, 0, 1, 0, 0, 0, 0, 0, 0, 0, 0x40, 0x9c, 0, 0, 0, 0, 0, 0,
+				   1, 1, 4, 0, 1, 0, 0, 0, 0, 0, 0, 0, 0x30, 0x75, 0, 0, 0, 0, 0, 0 })),
+		   ImageFormat::Tiff, 40000, 30000);
+	EXPECT_NE(inspect(bytes({ 'I', 'I', 42, 0, 8, 0, 0, 0, 9, 0 })).error.find("truncated TIFF"), std::string::npos);
+	expectSize(inspect(text("P7\nWIDTH 30000\nHEIGHT 20000\nDEPTH 1\nMAXVAL 255\nTUPLTYPE GRAYSCALE\nENDHDR\n")),
+		   ImageFormat::Pam, 30000, 20000);
+	expectSize(inspect(text("Pf\n3000 2000\n-1.0\n")), ImageFormat::Pfm, 3000, 2000);
+	expectSize(inspect(bytes({ 0x59, 0xa6, 0x6a, 0x95, 0, 0, 0x75, 0x30, 0, 0, 0x4e, 0x20, 0, 0, 0, 8 })),
+		   ImageFormat::SunRaster, 30000, 20000);
+	expectSize(inspect(text("#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 200 +X 300\n")), ImageFormat::Hdr, 300, 200);
+	/* JP2: signature box, ftyp, then jp2h holding ihdr (height, width). */
+	expectSize(inspect(plus(plus(bytes({ 0, 0, 0, 12, 'j', 'P', ' ', ' ', 13, 10, 0x87, 10, 0, 0, 0, 20 }),
+				     text("ftypjp2 ")),
+				bytes({ 0, 0, 0, 0, 'j', 'p', '2', ' ', 0, 0, 0, 45, 'j', 'p', '2', 'h', 0, 0, 0, 22, 'i', 'h',
+					'd', 'r', 0, 0, 0x4e, 0x20, 0, 0, 0x75, 0x30, 0, 1, 7, 7, 0, 0 }))),
+		   ImageFormat::Jpeg2000, 30000, 20000);
+	/* A codestream: SIZ's Xsiz, Ysiz less the offsets XOsiz, YOsiz. */
+	expectSize(inspect(bytes({ 0xff, 0x4f, 0xff, 0x51, 0, 41, 0, 0, 0, 0, 0x75, 0x40, 0, 0, 0x4e, 0x30, 0, 0, 0, 0x10,
+				   0, 0, 0, 0x10 })),
+		   ImageFormat::Jpeg2000, 30000, 20000);
+	/* OpenEXR: attributes up to dataWindow, a box2i (x0 y0 x1 y1). */
+	expectSize(inspect(plus(plus(bytes({ 0x76, 0x2f, 0x31, 0x01, 2, 0, 0, 0 }), text("dataWindow")),
+				plus(bytes({ 0 }), plus(text("box2i"), bytes({ 0, 16, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0,
+									     0x2f, 0x75, 0, 0, 0x1f, 0x4e, 0, 0 }))))),
+		   ImageFormat::Exr, 30000, 20000);
 }
 
 TEST(ReadFileBounded, RefusesWhatIsNotARegularFileOrTooBig)
@@ -222,7 +295,7 @@ TEST(ReadFileBounded, RefusesWhatIsNotARegularFileOrTooBig)
  * limit, however the writer splits it. */
 TEST(ReadStreamBounded, WholeEmptyOrOverTheLimit)
 {
-	auto through = [](const std::string &data, std::size_t limit, Bytes &b, std::string &error) {
+	auto through = [](const std::string &data, std::size_t limit, StreamBytes &b, std::string &error) {
 		int fds[2];
 		EXPECT_EQ(pipe(fds), 0);
 		/* Written by a child process: a pipe holds only 64 KiB. */
@@ -245,7 +318,7 @@ TEST(ReadStreamBounded, WholeEmptyOrOverTheLimit)
 		waitpid(child, &status, 0);
 		return ok;
 	};
-	Bytes b;
+	StreamBytes b;
 	std::string error;
 	std::string big(200000, 'x');
 	big[123456] = 'y';

@@ -13,6 +13,7 @@
 
 #include <gtest/gtest.h>
 
+#include "blocking_read.h"
 #include "frappe/camera.h"
 #include <vector>
 
@@ -114,6 +115,19 @@ TEST(Camera, ScaledToOtherSizes)
 	const Camera unknown = Camera::pinhole(600, 600, 320, 240);
 	EXPECT_EQ(unknown.scaledTo(1920, 1080).matrix, unknown.matrix);
 	EXPECT_THROW(c.scaledTo(0, 240), std::invalid_argument);
+
+	/* Issue 34: a valid calibration of a 1x1 frame with a focal length
+	 * near the largest double scaled to an infinite one, and no pose
+	 * came, silently. Now the scaling says why. */
+	Camera huge = Camera::pinhole(1e308, 1e308, 0.0, 0.0);
+	huge.width = huge.height = 1;
+	ASSERT_TRUE(huge.valid());
+	try {
+		huge.scaledTo(640, 480);
+		ADD_FAILURE() << "scaled to an infinite focal length";
+	} catch (const std::invalid_argument &e) {
+		EXPECT_EQ(std::string(e.what()), "camera: scaled from 1x1 to 640x480 its matrix is no camera (fx inf, fy inf)");
+	}
 }
 
 namespace {
@@ -452,6 +466,39 @@ TEST(Calibration, UnreadableFilesAreRuntimeErrors)
 	} catch (const std::invalid_argument &e) {
 		EXPECT_EQ(std::string(e.what()).rfind(bad + ": distortion_coefficients: ", 0), 0u) << e.what();
 	}
+}
+
+/* Issue 34: a name replaced by a FIFO (between any check and the open)
+ * blocked the open forever; a device was read without end. What is opened
+ * is checked, without waiting. */
+TEST(Calibration, FifoOrDeviceIsRefusedWithoutWaiting)
+{
+	const Scratch scratch;
+	const std::string fifo = (scratch.dir / "cam.yaml").string();
+	EXPECT_EQ(frappe::test::readingFifo(fifo, [](const std::string &p) { readCalibration(p); }),
+		  fifo + ": not a regular file (a FIFO)");
+	EXPECT_FALSE(frappe::test::blockedBySwappedFifo((scratch.dir / "swapped.yaml").string(), kRos, 1.0,
+							 [](const std::string &p) { readCalibration(p); }));
+	try {
+		readCalibration("/dev/zero");
+		FAIL() << "/dev/zero read";
+	} catch (const std::runtime_error &e) {
+		EXPECT_EQ(std::string(e.what()), "/dev/zero: not a regular file (a character device)");
+	}
+	try {
+		readCalibration(scratch.dir.string());
+		FAIL() << "a directory read";
+	} catch (const std::runtime_error &e) {
+		EXPECT_EQ(std::string(e.what()), scratch.dir.string() + ": not a regular file (a directory)");
+	}
+}
+
+/* Issue 34: messages quote the file's name and values; both may be any
+ * bytes, the message is UTF-8 (a byte that is not, read as Latin-1). */
+TEST(Calibration, MessagesAreUtf8WhateverTheInput)
+{
+	EXPECT_EQ(errorOf(replaced(kRos, "plumb_bob", "caf\xe9"), "cam\xff.yaml"),
+		  "cam\xc3\xbf.yaml: distortion_model: \"caf\xc3\xa9\" is unknown: expected plumb_bob or rational_polynomial");
 }
 
 /* The files shipped for the sample video: the camera it was rendered with. */

@@ -700,3 +700,37 @@ TEST(CapCandidates, KeepsTheProbesMarkersThenTheFirst)
 	ASSERT_EQ(one.size(), 1u);
 	EXPECT_EQ(one[0].probeRead, 7);
 }
+
+/* Issue 34: over the cap, the ranks the probe gives: markers, then near
+ * codewords (a damaged marker), then readable frames, then the rest, each
+ * rank from the front, the kept ones in their order. */
+TEST(CapCandidates, RanksNearCodesThenReadableFramesBeforeTheRest)
+{
+	std::vector<Quad> quads(12);
+	for (int i = 0; i < 12; ++i) {
+		quads[i].probeRead = i;
+		quads[i].probeDecoded = i == 11;
+		quads[i].probeNearCode = i == 9 || i == 10;
+		quads[i].probeReadable = i >= 6;
+	}
+	std::vector<Quad> four = quads;
+	EXPECT_EQ(capCandidates(four, 4), 8);
+	std::vector<int> kept;
+	for (const Quad &q : four)
+		kept.push_back(q.probeRead);
+	EXPECT_EQ(kept, (std::vector<int>{ 6, 9, 10, 11 }));
+
+	std::vector<Quad> two = quads;
+	EXPECT_EQ(capCandidates(two, 2), 10);
+	kept.clear();
+	for (const Quad &q : two)
+		kept.push_back(q.probeRead);
+	EXPECT_EQ(kept, (std::vector<int>{ 9, 11 }));
+
+	std::vector<Quad> eight = quads;
+	EXPECT_EQ(capCandidates(eight, 8), 4);
+	kept.clear();
+	for (const Quad &q : eight)
+		kept.push_back(q.probeRead);
+	EXPECT_EQ(kept, (std::vector<int>{ 0, 1, 6, 7, 8, 9, 10, 11 }));
+}

@@ -14,6 +14,7 @@
 
 #include <gtest/gtest.h>
 
+#include "blocking_read.h"
 #include "frappe/frappe.h"
 #include "scene.h"
 
@@ -179,6 +180,48 @@ TEST(DictionaryFile, ConfigChecksAgainstTheCustomDictionary)
 	}
 }
 
+/* Issue 34: a name that is not UTF-8 (Latin-1 in a file's header) was
+ * taken as it was, and every JSON line, GStreamer message and Python str
+ * carrying it broke. Refused at load naming the file, the line and the
+ * byte; a file name's stem (any bytes) becomes UTF-8; a hand-made
+ * dictionary with such a name is refused by the Detector; messages quoting
+ * a file's bytes are UTF-8 too. */
+TEST(DictionaryFile, NamesThatAreNotUtf8AreRefused)
+{
+	EXPECT_EQ(parseError("# dictionary: caf\xe9\n0x1234\n0xff00\n"),
+		  "frappe::parseDictionary: bad.txt:1: the dictionary name is not UTF-8 text (byte 0xe9 at its byte 4); "
+		  "save the file as UTF-8");
+	EXPECT_EQ(parseError("%YAML:1.0\nnmarkers: 1\nmarkersize: 3\nname: \xff\xfe\nmarker_0: \"010101010\"\n"),
+		  "frappe::parseDictionary: bad.txt:4: the dictionary name is not UTF-8 text (byte 0xff at its byte 1); "
+		  "save the file as UTF-8");
+	/* Overlong forms and surrogates are not UTF-8 either. */
+	EXPECT_NE(parseError("# dictionary: \xc0\xae\n0x1234\n").find("not UTF-8"), std::string::npos);
+	EXPECT_NE(parseError("# dictionary: \xed\xa0\x80\n0x1234\n").find("not UTF-8"), std::string::npos);
+	/* UTF-8 is kept as it is. */
+	EXPECT_EQ(parseDictionary("# dictionary: caf\xc3\xa9-\xe6\x97\xa5\n0x1234\n0xff00\n", "ok")->name,
+		  "caf\xc3\xa9-\xe6\x97\xa5");
+
+	/* The stem of a Latin-1 file name: its bytes read as Latin-1, cut at
+	 * 128 bytes on a character's start. */
+	const std::string latin1 = writeFile("caf\xe9.txt", "0x1234\n0xff00\n");
+	EXPECT_EQ(loadDictionary(latin1)->name, "caf\xc3\xa9");
+	const std::string longName = std::string(127, 'a') + "\xc3\xa9";
+	EXPECT_EQ(parseDictionary("0x1234\n", longName)->name, std::string(127, 'a'));
+	/* A message quoting a line of Latin-1 text is UTF-8. */
+	EXPECT_EQ(parseError("0x1234\n0x12\xe9\n"), "frappe::parseDictionary: bad.txt:2: a codeword must be a 0x hex "
+						    "number of at most 64 bits, got '0x12\xc3\xa9'");
+
+	static const std::uint64_t codes[] = { 0x1, 0x2 };
+	Config cfg;
+	cfg.custom_dictionary = std::make_shared<Dictionary>(Dictionary{ "caf\xe9", 3, 1, 0, codes });
+	try {
+		Detector det(cfg);
+		ADD_FAILURE() << "a name that is not UTF-8 was taken";
+	} catch (const std::invalid_argument &e) {
+		EXPECT_EQ(std::string(e.what()), "frappe::Config: custom_dictionary: the name is not UTF-8 text");
+	}
+}
+
 /* Each malformed input is refused naming the file, the line and what. */
 TEST(DictionaryFile, MalformedInputsNameFileLineAndWhat)
 {
@@ -253,6 +296,24 @@ TEST(DictionaryFile, AtMost4096Codes)
 	EXPECT_GT(d->min_hamming, 5); /* random 64-bit codes lie far apart */
 	text += "0x0000000000000001\n";
 	EXPECT_NE(parseError(text).find("bad.txt:4098: more than 4096 codes"), std::string::npos) << parseError(text);
+}
+
+/* Issue 34: a FIFO in a dictionary file's place blocked the open forever,
+ * and a device was read without end: what is opened is checked first. */
+TEST(DictionaryFile, FifoOrDeviceIsRefusedWithoutWaiting)
+{
+	const std::string fifo = writeFile("fifo.txt", "");
+	EXPECT_EQ(frappe::test::readingFifo(fifo, [](const std::string &p) { loadDictionary(p); }),
+		  "frappe::loadDictionary: cannot read dictionary file '" + fifo + "': not a regular file (a FIFO)");
+	EXPECT_FALSE(frappe::test::blockedBySwappedFifo(fifo + ".txt", "0x1234\n0xff00\n", 1.0,
+							 [](const std::string &p) { loadDictionary(p); }));
+	try {
+		loadDictionary("/dev/zero");
+		ADD_FAILURE() << "/dev/zero loaded";
+	} catch (const std::runtime_error &e) {
+		EXPECT_EQ(std::string(e.what()), "frappe::loadDictionary: cannot read dictionary file '/dev/zero': "
+						 "not a regular file (a character device)");
+	}
 }
 
 TEST(DictionaryFile, UnreadableFilesAreRuntimeErrors)

@@ -103,6 +103,29 @@ def main():
         with open(os.path.join(out, name), 'w', newline='') as f:
             f.write(text)
 
+    # Calibration files as tools write them: the samples' ROS camera_info
+    # and OpenCV FileStorage YAML, OpenCV's XML, a CameraInfo message.
+    out = os.path.join(HERE, 'corpus', 'calibration')
+    os.makedirs(out, exist_ok=True)
+    data = os.path.join(HERE, '..', '..', 'examples', 'data')
+    seeds = {name: open(os.path.join(data, name)).read() for name in ('camera-700.yaml', 'camera-700-opencv.yml')}
+    seeds['opencv.xml'] = (
+        '<?xml version="1.0"?>\n<opencv_storage>\n<image_width>1280</image_width>\n'
+        '<image_height>720</image_height>\n<!-- a comment -->\n<camera_matrix type_id="opencv-matrix">\n'
+        '  <rows>3</rows>\n  <cols>3</cols>\n  <dt>d</dt>\n'
+        '  <data>9.12e+02 0. 6.40e+02 0. 9.13e+02 3.60e+02 0. 0. 1.</data></camera_matrix>\n'
+        '<distortion_coefficients type_id="opencv-matrix">\n  <rows>1</rows>\n  <cols>5</cols>\n'
+        '  <dt>d</dt>\n  <data>1.2e-01 -2.3e-01 1.e-03 -2.e-03 &amp; 9.8e-02</data></distortion_coefficients>\n'
+        '</opencv_storage>\n')
+    seeds['camera-info-message'] = (
+        'header: \n  seq: 12\n  frame_id: "camera"\nheight: 480\nwidth: 640\n'
+        'distortion_model: "rational_polynomial"\nD: [0.35, -0.12, 0.0009, 0.0005, 0.02, 0.62, -0.06, 0.03]\n'
+        'K: [690.0, 0.0, 322.0, 0.0, 705.0, 236.0, 0.0, 0.0, 1.0]\n'
+        'camera_matrix: !!opencv-matrix\n  rows: 3\n  cols: 3\n  dt: d\n  data: {a: 1}\n')
+    for name, text in seeds.items():
+        with open(os.path.join(out, name), 'w', newline='') as f:
+            f.write(text)
+
 
 if __name__ == '__main__':
     main()

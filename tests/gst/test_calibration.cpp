@@ -13,6 +13,7 @@
 #include <gst/gst.h>
 #include <gtest/gtest.h>
 
+#include "../support/blocking_read.h"
 #include "gstfrappemeta.h"
 #include "helpers.h"
 
@@ -195,6 +196,35 @@ TEST(Calibration, SetWhilePlaying)
 	EXPECT_NEAR(m.tvec[2], kTvec[2] / 2, 0.01 * kTvec[2]);
 }
 
+/* Issue 34: a calibration-file (or dictionary-file) name swapped for a
+ * FIFO between the check and the open blocked the property thread
+ * forever. Set while playing, again and again as the name is swapped, the
+ * property never blocks; the FIFO is refused with a warning naming it. */
+TEST(Calibration, FileSwappedForAFifoNeverBlocksTheProperty)
+{
+	TempDir dir;
+	const FrameSpec spec{ GST_VIDEO_FORMAT_GRAY8, 640, 480 };
+	BusHarness t("frappedetect marker-size=0.08", spec);
+	GstElement *e = detector(t.h);
+	for (const char *property : { "calibration-file", "dictionary-file" }) {
+		SCOPED_TRACE(property);
+		const bool calibration = std::string(property) == "calibration-file";
+		const std::string text = calibration ? rosCalibration(640, 480, 600, 600, 319.5, 239.5) : "0x1234\n0xff00\n";
+		EXPECT_FALSE(frappe::test::blockedBySwappedFifo(dir.path + "/swapped", text, 0.5, [&](const std::string &p) {
+			g_object_set(e, property, p.c_str(), nullptr);
+		}));
+		const std::string fifo = dir.path + "/fifo";
+		EXPECT_EQ(frappe::test::readingFifo(fifo, [&](const std::string &p) { g_object_set(e, property, p.c_str(), nullptr); }),
+			  "read without an error");
+		bool named = false;
+		const BusMessages msgs(t.bus);
+		for (GstMessage *m : msgs.of(GST_MESSAGE_WARNING))
+			named |= MessageError(m).text.find(fifo + ": not a regular file (a FIFO)") != std::string::npos ||
+				 MessageError(m).text.find(fifo + "': not a regular file (a FIFO)") != std::string::npos;
+		EXPECT_TRUE(named) << "a warning names the FIFO";
+	}
+}
+
 /* marker-sizes: an id of its own size has its tvec scaled by the ratio of
  * sizes; the others keep marker-size's. */
 TEST(MarkerSizes, PerIdSizesScaleTvec)
@@ -242,6 +272,32 @@ TEST(MarkerSizes, MalformedIsRefusedWithAWarning)
 		EXPECT_EQ(stringProperty(e, "marker-sizes"), "0:0.05");
 		expectOneSettingsWarning(t.bus, bad);
 	}
+}
+
+/* Issue 34: marker-sizes was parsed in quadratic time under the object
+ * lock the streaming thread takes (400,000 ids in descending order: 107 s).
+ * The longest value accepted now takes milliseconds, a longer one is
+ * refused with a warning saying why, the previous value kept. */
+TEST(MarkerSizes, LongValuesAreQuickOrRefused)
+{
+	const FrameSpec spec{ GST_VIDEO_FORMAT_GRAY8, 64, 48 };
+	BusHarness t("frappedetect marker-sizes=\"0:0.05\"", spec);
+	GstElement *e = detector(t.h);
+	std::string longest;
+	for (int id = 999999; longest.size() + 16 < (1u << 20); --id)
+		longest += std::to_string(id) + ":0.05,";
+	longest += "7:0.25";
+	const gint64 t0 = g_get_monotonic_time();
+	g_object_set(e, "marker-sizes", longest.c_str(), nullptr);
+	EXPECT_LT(g_get_monotonic_time() - t0, 1000000) << "microseconds to set " << longest.size() << " bytes";
+	EXPECT_EQ(stringProperty(e, "marker-sizes"), longest);
+	EXPECT_TRUE(BusMessages(t.bus).of(GST_MESSAGE_WARNING).empty());
+
+	const std::string over = longest + std::string(1u << 20, ' ');
+	g_object_set(e, "marker-sizes", over.c_str(), nullptr);
+	EXPECT_EQ(stringProperty(e, "marker-sizes"), longest);
+	expectOneSettingsWarning(t.bus, "refused: marker sizes: " + std::to_string(over.size()) +
+						" bytes, more than the 1048576 a list of sizes may have");
 }
 
 /* camera-matrix of another count or an invalid matrix, distortion of

@@ -133,6 +133,26 @@ TEST(Json, ExactLineFromMetas)
 	gst_harness_teardown(h);
 }
 
+/* Issue 34: a meta's dictionary name that is not UTF-8 (any application
+ * may attach one) made every line invalid UTF-8. Such bytes are written
+ * \u00XX; UTF-8 is written as it is. */
+TEST(Json, LinesAreUtf8WhateverTheName)
+{
+	GstHarness *h = gst_harness_new("frappejson");
+	gst_harness_set_src_caps_str(h, capsString(kSpec).c_str());
+	GstBuffer *in = gst_buffer_new_allocate(nullptr, 320 * 240, nullptr);
+	const gfloat corners[8] = { 1, 2, 3, 4, 5, 6, 7, 8 };
+	gst_buffer_add_frappe_marker_meta(in, 1, "caf\xe9-\xc3\xa9-\xe6\x97\xa5-\xed\xa0\x80-\xc0\xae", corners, 0);
+	GstBuffer *out = gst_harness_push_and_pull(h, in);
+	const std::string line = text(out);
+	EXPECT_TRUE(g_utf8_validate(line.data(), static_cast<gssize>(line.size()), nullptr)) << line;
+	EXPECT_NE(line.find("\"dictionary\": \"caf\\u00e9-\xc3\xa9-\xe6\x97\xa5-\\u00ed\\u00a0\\u0080-\\u00c0\\u00ae\""),
+		  std::string::npos)
+		<< line;
+	gst_buffer_unref(out);
+	gst_harness_teardown(h);
+}
+
 /* Caps other than application/x-json downstream: no negotiation. */
 TEST(Json, RefusesOtherCapsDownstream)
 {

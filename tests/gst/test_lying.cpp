@@ -207,6 +207,58 @@ TEST(Lying, ChromaPlanesCountOnlyWhenAnnotating)
 	expectPassedThrough("frappedetect annotate=true", kI420, buffer(), "plane 2 needs");
 }
 
+/* Issue 34: with annotate=false only the luma plane was checked, and a
+ * chroma plane starting at or past the end made gst_video_frame_map() fail:
+ * "Could not map the video frame", the buffer lost and the stream stopped.
+ * Whatever annotate is, it now passes through with one warning. */
+TEST(Lying, ChromaPlanePastTheEndPassesThroughWhateverAnnotate)
+{
+	GstVideoInfo info;
+	gst_video_info_set_format(&info, GST_VIDEO_FORMAT_I420, 640, 480);
+	const gsize size = GST_VIDEO_INFO_SIZE(&info);
+	for (const gsize vOffset : { size, size + 4096 }) {
+		auto buffer = [&] {
+			return lyingBuffer(size, GST_VIDEO_FORMAT_I420, 640, 480,
+					   { 0, GST_VIDEO_INFO_PLANE_OFFSET(&info, 1), vOffset }, { 640, 320, 320 });
+		};
+		SCOPED_TRACE(vOffset);
+		expectPassedThrough("frappedetect", kI420, buffer(),
+				    "plane 2 starts at offset " + std::to_string(vOffset) +
+					    ", past the end of the buffer of " + std::to_string(size) + " bytes");
+		expectPassedThrough("frappedetect annotate=true", kI420, buffer(),
+				    "plane 2 needs 76800 bytes from offset " + std::to_string(vOffset));
+	}
+	/* Without a meta, a buffer shorter than the caps' frame whose luma
+	 * plane is whole. */
+	GstBuffer *shortFrame = gst_buffer_new_allocate(nullptr, 640 * 480 + 10, nullptr);
+	gst_buffer_memset(shortFrame, 0, 9, 640 * 480 + 10);
+	expectPassedThrough("frappedetect", kI420, shortFrame,
+			    "the buffer has 307210 bytes, a 640x480 I420 frame 460800");
+}
+
+/* Issue 34: caps over 32768 pixels a side (under max_pixels) passed
+ * negotiation, then the first buffer failed "Marker detection failed" and
+ * the stream stopped. They are refused at negotiation. */
+TEST(Lying, CapsBeyondTheLongestSideAreRefused)
+{
+	for (const FrameSpec huge : { FrameSpec{ GST_VIDEO_FORMAT_GRAY8, 40000, 16, 0 },
+				      FrameSpec{ GST_VIDEO_FORMAT_GRAY8, 16, 32769, 0 } }) {
+		BusHarness t("frappedetect", huge);
+		EXPECT_EQ(gst_harness_push(t.h, gst_buffer_new_allocate(nullptr, 64, nullptr)), GST_FLOW_NOT_NEGOTIATED);
+		EXPECT_EQ(gst_harness_buffers_received(t.h), 0u);
+		GstMessage *msg = gst_bus_pop_filtered(t.bus, GST_MESSAGE_ERROR);
+		ASSERT_NE(msg, nullptr);
+		GError *err = nullptr;
+		gst_message_parse_error(msg, &err, nullptr);
+		EXPECT_TRUE(g_error_matches(err, GST_CORE_ERROR, GST_CORE_ERROR_NEGOTIATION)) << err->message;
+		EXPECT_EQ(std::string(err->message), "Frames of " + std::to_string(huge.width) + "x" +
+							     std::to_string(huge.height) +
+							     " are wider or taller than the detector accepts (32768 pixels a side)");
+		g_error_free(err);
+		gst_message_unref(msg);
+	}
+}
+
 /* One warning per kind of lie, not one per frame; every buffer still out. */
 TEST(Lying, OneWarningPerKind)
 {

@@ -47,7 +47,9 @@ struct FRAPPE_EXPORT Camera {
 	/// pixel-centre convention kept: c' = (c + 0.5) * r - 0.5); distortion
 	/// unchanged (it is in normalised coordinates). Unchanged when the
 	/// calibration size is unknown or equal. Does not check fits(); throws
-	/// std::invalid_argument for a frame size that is not positive.
+	/// std::invalid_argument for a frame size that is not positive, or
+	/// when the scaled matrix fails validate() (a focal length scaled past
+	/// what a double holds).
 	Camera scaledTo(int frame_width, int frame_height) const;
 };
 

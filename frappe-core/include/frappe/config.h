@@ -115,9 +115,11 @@ struct Config {
 	/// Result::candidates_dropped. A bound on the back end's time whatever
 	/// the frame shows: a frame full of small squares (a tiled wall, a dot
 	/// grid, a perforated sheet) has one candidate per square, tens of
-	/// thousands at 4K, where a frame of markers has a few dozen. Those
-	/// the trace's quick read found to be markers are kept first, then the
-	/// smallest. Lower bounds a frame's time tighter, at the risk of
+	/// thousands at 4K, where a frame of markers has a few dozen. Kept
+	/// first: those the trace's quick read found to be markers, then those
+	/// it read within max_hamming of a codeword (a damaged marker), then
+	/// those with a readable black frame, then the rest; the smallest first
+	/// within each. Lower bounds a frame's time tighter, at the risk of
 	/// missing markers among such clutter. Range [1, 2^20].
 	int max_candidates = 4096;
 

@@ -52,11 +52,11 @@ struct Result {
 	std::vector<Marker> markers;
 	StageTimes times;
 	float scale = 1.0f;     ///< resolution the frame was traced at
-	int candidates = 0;     ///< quadrilaterals that reached decoding
+	int candidates = 0;     ///< quadrilaterals that reached decoding, each once: at most Config::max_candidates
 	/// Candidate outlines the trace found beyond Config::max_candidates and
-	/// left unread (the largest of those its quick read did not find to be
-	/// markers): 0 unless the frame is full of squares (a tiled wall, a dot
-	/// grid). Markers among them are missed; a caller may report it as a
+	/// left unread (the largest of those its quick read found least
+	/// promising: Config::max_candidates): 0 unless the frame is full of
+	/// squares (a tiled wall, a dot grid). Markers among them are missed; a caller may report it as a
 	/// warning.
 	int candidates_dropped = 0;
 	/// Bytes of the frame its front end copied before reading it
@@ -65,6 +65,11 @@ struct Result {
 	/// that detector may already be running a later frame.
 	std::size_t copy_bytes = 0;
 };
+
+/// The longest image side detect() accepts (it throws
+/// std::invalid_argument beyond, whatever Config::max_pixels allows): the
+/// tracer's coordinates are 16-bit.
+constexpr int kMaxImageSide = 1 << 15;
 
 /// Finds markers of one dictionary in 8-bit luma images.
 ///

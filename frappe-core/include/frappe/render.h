@@ -24,8 +24,8 @@ struct MutableImageView {
 };
 
 struct RenderOptions {
-	int quiet_cells = 1;      ///< white margin around the black border, in cells; below 0 counts as 0
-	int supersample = 4;      ///< samples per pixel side (anti-aliasing); below 1 counts as 1, at most 256
+	int quiet_cells = 1;      ///< white margin around the black border, in cells: 0..32768
+	int supersample = 4;      ///< samples per pixel side (anti-aliasing): 1..256
 	std::uint8_t black = 0;
 	std::uint8_t white = 255;
 };
@@ -39,7 +39,8 @@ struct RenderOptions {
 /// and why) for corners that are no perspective view of a square
 /// (non-finite, three of them collinear or coincident, or not a convex
 /// quadrilateral), an image of negative size, null data or a stride
-/// smaller than its width, or a supersample above 256.
+/// smaller than its width, a supersample outside 1..256 or quiet_cells
+/// outside 0..32768 (markerImage() refuses the same quiet_cells).
 FRAPPE_EXPORT void renderMarker(MutableImageView image, const Dictionary &dict, int id,
 		  const std::array<Point2f, 4> &corners, const RenderOptions &options = {});
 

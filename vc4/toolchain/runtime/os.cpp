@@ -5,8 +5,6 @@
 #include <cstring>
 #include <dirent.h>
 #include <fcntl.h>
-#include <fstream>
-#include <iterator>
 #include <sys/ioctl.h>
 #include <sys/mman.h>
 #include <sys/stat.h>
@@ -64,10 +62,31 @@ public:
 	}
 	std::optional<std::string> readFile(const std::string &path) override
 	{
-		std::ifstream in(path, std::ios::binary);
-		if (!in)
+		/* Opened without waiting (a FIFO in the file's place), checked
+		 * on the descriptor, read up to a bound (/dev/zero): device-tree
+		 * and sysfs files are small regular files. */
+		const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
+		if (fd < 0)
 			return std::nullopt;
-		return std::string(std::istreambuf_iterator<char>(in), {});
+		struct stat st;
+		std::optional<std::string> text;
+		if (::fstat(fd, &st) == 0 && S_ISREG(st.st_mode)) {
+			std::string buf(kMaxReadFileBytes + 1, '\0');
+			std::size_t got = 0;
+			for (;;) {
+				const ssize_t r = ::read(fd, buf.data() + got, buf.size() - got);
+				if (r < 0 && errno == EINTR)
+					continue;
+				if (r <= 0 || (got += static_cast<std::size_t>(r)) == buf.size())
+					break;
+			}
+			if (got <= kMaxReadFileBytes) {
+				buf.resize(got);
+				text = std::move(buf);
+			}
+		}
+		::close(fd);
+		return text;
 	}
 	std::vector<std::string> listDir(const std::string &path) override
 	{

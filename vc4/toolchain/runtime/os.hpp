@@ -32,8 +32,10 @@ public:
 	// with -errno in `error`.
 	virtual void *mmap(size_t length, int fd, uint64_t offset, int &error) = 0;
 	virtual int munmap(void *address, size_t length) = 0;
-	// Whole contents of a (small, sysfs/procfs) file; nullopt when it cannot be read.
+	// Whole contents of a (small, sysfs/procfs) file; nullopt when it cannot be read, is not a
+	// regular file (a FIFO, a device) or holds more than kMaxReadFileBytes.
 	virtual std::optional<std::string> readFile(const std::string &path) = 0;
+	static constexpr std::size_t kMaxReadFileBytes = 64 << 10;
 	// Names in a directory (without . and ..); empty when it does not exist.
 	virtual std::vector<std::string> listDir(const std::string &path) = 0;
 };

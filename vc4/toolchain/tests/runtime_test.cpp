@@ -6,12 +6,20 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
+#include <fstream>
+#include <future>
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <linux/dma-buf.h>
 #include <linux/dma-heap.h>
 
 #include "runtime/gpu_device.hpp"
 #include "runtime/mailbox.hpp"
+#include "runtime/os.hpp"
 #include "runtime/uapi.hpp"
 #include "runtime_fake_os.hpp"
 
@@ -560,4 +568,31 @@ TEST(RuntimeImport, FrameMemoryFromTheRuntimesHeap)
 	EXPECT_EQ(allocateDmaHeapBuffer(none, DeviceOptions{}, 4096, why), -1);
 	EXPECT_EQ(why, "no dma-heap frame memory: /dev/dma_heap/vidbuf_cached does not exist; "
 	               "/dev/dma_heap/linux,cma does not exist");
+}
+
+// Issue 34: the probe read /proc/device-tree/model with no limit: a FIFO there hung
+// --backend vc4, /dev/zero grew memory without end. What is opened is checked first.
+TEST(RuntimeOs, ReadFileRefusesFifosDevicesAndLargeFiles)
+{
+	char dir[] = "/tmp/frappe-vc4-os-XXXXXX";
+	ASSERT_NE(::mkdtemp(dir), nullptr);
+	const std::string fifo = std::string(dir) + "/model", small = std::string(dir) + "/small",
+	                  large = std::string(dir) + "/large";
+	ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+	auto outcome = std::async(std::launch::async, [&] { return systemOs().readFile(fifo); });
+	if (outcome.wait_for(std::chrono::seconds(3)) != std::future_status::ready) {
+		ADD_FAILURE() << "readFile blocked on a FIFO";
+		const int fd = ::open(fifo.c_str(), O_WRONLY | O_NONBLOCK); // set it free
+		if (fd >= 0)
+			::close(fd);
+	}
+	EXPECT_EQ(outcome.get(), std::nullopt);
+	EXPECT_EQ(systemOs().readFile("/dev/zero"), std::nullopt);
+	std::ofstream(small) << "Raspberry Pi Zero W Rev 1.1";
+	EXPECT_EQ(systemOs().readFile(small), "Raspberry Pi Zero W Rev 1.1");
+	std::ofstream(large) << std::string(Os::kMaxReadFileBytes + 1, 'x');
+	EXPECT_EQ(systemOs().readFile(large), std::nullopt);
+	for (const std::string &f : { fifo, small, large })
+		::unlink(f.c_str());
+	::rmdir(dir);
 }
