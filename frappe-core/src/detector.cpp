@@ -12,6 +12,7 @@
 #include <string>
 
 #include "detector_impl.h"
+#include "front_end_rows.h"
 #include "quad_geometry.h"
 #include "utf8.h"
 
@@ -273,6 +274,18 @@ void DetectorStages::frontEnd(Detector &detector, const ImageView &image, int sl
 		 * is taken into account when its quads are mapped); empty when
 		 * region_contrast is 0. */
 		detail::regionMap(image, 1.0f, d.params, s.edges.regions, s.edges.shades, d.regionScratch);
+	} else if (d.params.makesShades() && !d.frontEnd->makesShadeMap()) {
+		/* A front end with a region map but no shade map (the QPUs'
+		 * today): the CPU's, from the frame the front end traced (its
+		 * region map made again, unused), so the markers are the CPU
+		 * front end's. */
+		ImageView traced = image;
+		if (s.edges.scale < 1.0f) {
+			d.shadeFrame.resize(static_cast<std::size_t>(s.edges.width) * s.edges.height);
+			detail::scaleNearest(image, s.edges.width, s.edges.height, d.shadeFrame.data());
+			traced = ImageView(d.shadeFrame.data(), s.edges.width, s.edges.height, s.edges.width);
+		}
+		detail::regionMap(traced, s.edges.scale, d.params, d.shadeRegions, s.edges.shades, d.regionScratch);
 	}
 	s.result.scale = s.edges.scale;
 	s.result.copy_bytes = d.frontEnd->lastCopyBytes();

@@ -76,6 +76,10 @@ struct FRAPPE_HIDDEN Detector::Impl {
 	detail::PointGrid markerGrid; /* dropNestedMarkers()'s, in finish() */
 	detail::PointGrid markerCentres; /* the frame's markers so far, for skipCandidate() */
 	detail::RegionScratch regionScratch; /* for a front end without a region map */
+	/* For a front end without a shade map: the frame it traced, scaled, and
+	 * the region map made beside the shades (not used). */
+	std::vector<std::uint8_t> shadeFrame;
+	TraceMap shadeRegions;
 	detail::WarpedMarker warped;
 	/* Candidates with large cells are read on the frame halved into blocks
 	 * of f pixels (readBlock()): a patch around the candidate, or the whole

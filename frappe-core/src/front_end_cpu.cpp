@@ -87,6 +87,7 @@ public:
 	void run(const ImageView &image, float scale, const FrontEndParams &params,
 		 EdgeMap &out) override;
 	bool makesRegionMap() const override { return true; }
+	bool makesShadeMap() const override { return true; }
 
 private:
 	void runBand(const detail::BandJob &job);

@@ -31,8 +31,11 @@ struct CellRead {
 };
 
 /// Reads the cells of `w` against b's threshold and contrast; code cells
-/// with a margin below `weakMargin` are weak.
-CellRead readCells(const WarpedMarker &w, int bits, const Binarised &b, float weakMargin);
+/// with a margin below `weakMargin` are weak. Glare: where a border cell
+/// (black ink) clips, so may any code cell, and every code cell that clips
+/// is unknown (weak, margin 0), left to the code's distance. `tone` is the
+/// scale the samples are on.
+CellRead readCells(const WarpedMarker &w, int bits, const Binarised &b, float weakMargin, Tone tone = {});
 
 /// The bits corrected to reach d's codeword that were read clearly (not
 /// weak).

@@ -106,6 +106,8 @@ RESOLUTION = {
     'synth/apriltag_16h5':      (0.96,      0.96,       0.96,      0.95),
     'synth/seq01':              (None,      None,       None,      None),
     'synth/seq02':              (None,      None,       None,      None),
+    'synth/lighting':           (None,      None,       None,      None),
+    'synth/lighting-apriltag36h11': (None,  None,       None,      None),
 }
 
 

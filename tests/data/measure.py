@@ -280,11 +280,12 @@ def resolution_runs(sub, workdir):
     return runs
 
 
-def exposure_runs(sub, workdir, lights):
-    """frappe-sweep runs of the subset's dictionary as read and exposed
-    each of `lights` times as long (frappe-sweep's lightG)."""
+def exposure_runs(sub, workdir, lights, as_read=True):
+    """frappe-sweep runs of the subset's dictionary as read (the first,
+    unless as_read is False) and exposed each of `lights` times as long
+    (frappe-sweep's lightG)."""
     stem = os.path.join(workdir, sub.name.replace('/', '-'))
-    runs = [(sub.dictionary, 1, 'linear', stem + '-1x.jsonl')]
+    runs = [(sub.dictionary, 1, 'linear', stem + '-1x.jsonl')] if as_read else []
     runs += [(sub.dictionary, 1, 'light%g' % g, '%s-light%g.jsonl' % (stem, g)) for g in lights]
     return runs
 

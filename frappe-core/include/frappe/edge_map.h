@@ -138,6 +138,9 @@ public:
 	/// Whether run() fills out.regions and out.shades too; otherwise the
 	/// Detector adds the CPU's.
 	virtual bool makesRegionMap() const { return false; }
+	/// Whether run() fills out.shades when it fills out.regions; otherwise
+	/// the Detector adds the CPU's shade map (FrontEndParams::makesShades()).
+	virtual bool makesShadeMap() const { return false; }
 	/// Bytes of the last frame the front end copied into memory of its
 	/// own before reading them (0 when it read the frame in place, as the
 	/// CPU does), so that a zero-copy path can be checked and logged.
