@@ -250,9 +250,11 @@ __attribute__((optimize("omit-frame-pointer"))) void gradientRowV6(const std::ui
 		 * vd = c - a, four columns a step in even and odd lanes (the
 		 * smoothed rows are already in lanes), stored per block of four
 		 * columns 4k .. 4k+3 as the four words
-		 *   sE = vs(4k, 4k+2), sO = vs(4k+1, 4k+3), dE, dO (likewise vd)
-		 * by one STM: 12 instructions per four columns. The blocks live
-		 * in tmp (2w + 16 values): w/4 + 1 blocks of 8 values. */
+		 *   sE = vs(4k, 4k+2), sO = vs(4k+1, 4k+3), dE = vd(4k, 4k+2),
+		 *   U = dE + dO = (vd(4k) + vd(4k+1), vd(4k+2) + vd(4k+3))
+		 * by one STM: 13 instructions per four columns (U saves pass 2
+		 * two). The blocks live in tmp (2w + 16 values): w/4 + 1 blocks
+		 * of 8 values. */
 		std::uint8_t *const blocks = reinterpret_cast<std::uint8_t *>(tmp);
 		const int words = w / 4;
 		{
@@ -266,6 +268,7 @@ __attribute__((optimize("omit-frame-pointer"))) void gradientRowV6(const std::ui
 				"ldmia   %[pb]!, {r8, r9}\n\t"     /* eb, ob */            \
 				"ssub16  r10, r6, r4\n\t"          /* dE */                \
 				"ssub16  r11, r7, r5\n\t"          /* dO */                \
+				"sadd16  r11, r10, r11\n\t"        /* U */                 \
 				"add     r4, r4, r6\n\t"                                   \
 				"add     r5, r5, r7\n\t"                                   \
 				"add     r8, r4, r8, lsl #1\n\t"   /* sE */                \
@@ -286,11 +289,13 @@ __attribute__((optimize("omit-frame-pointer"))) void gradientRowV6(const std::ui
 				: [end] "r"(aEnd)
 				: "r4", "r5", "r6", "r7", "r8", "r9", "r10", "r11", "cc", "memory");
 		}
-		/* The last columns (0 .. 3) in block `words`. */
+		/* The last columns (0 .. 3) in block `words`; an odd column's
+		 * U lane adds the even column before it. */
 		for (int i = 4 * words; i < w; ++i) {
+			auto vd = [&](int j) { return getSmoothed(c, j) - getSmoothed(a, j); };
 			const int pa = getSmoothed(a, i), pb = getSmoothed(b, i), pc = getSmoothed(c, i);
 			const std::int16_t v[2] = { static_cast<std::int16_t>(pa + 2 * pb + pc),
-						    static_cast<std::int16_t>(pc - pa) };
+						    static_cast<std::int16_t>((i & 1) ? vd(i - 1) + vd(i) : vd(i)) };
 			for (int q = 0; q < 2; ++q)
 				std::memcpy(blocks + 16 * (i >> 2) + 8 * q + 4 * (i & 1) + 2 * ((i >> 1) & 1), &v[q], 2);
 		}
@@ -298,10 +303,11 @@ __attribute__((optimize("omit-frame-pointer"))) void gradientRowV6(const std::ui
 		 * of block k+1 (N): with F(X) = (C_X.hi, N_X.lo), the columns
 		 * (4k+2, 4k+4) or (4k+3, 4k+5),
 		 *   gx(4k+1, 4k+3) = F(sE) - sE,   gx(4k+2, 4k+4) = F(sO) - sO,
-		 *   gy(4k+1, 4k+3) = dE + F(dE) + 2 dO,
-		 *   gy(4k+2, 4k+4) = dO + F(dO) + 2 F(dE);
+		 *   with V = dO + F(dE) = U - dE + F(dE):
+		 *   gy(4k+1, 4k+3) = dE + 2 dO + F(dE) = U + V,
+		 *   gy(4k+2, 4k+4) = dO + 2 F(dE) + F(dO) = V + F(U);
 		 * the (gx, gy) pair of a pixel is one PKHBT/PKHTB, gx^2 + gy^2
-		 * one SMUAD; pairs and magnitudes stored by STM. 30 instructions
+		 * one SMUAD; pairs and magnitudes stored by STM. 26 instructions
 		 * per four pixels, all loads and stores aligned. */
 		const int steps = (w - 2) / 4;
 		std::uint8_t *pp = pairs + 4;
@@ -323,17 +329,15 @@ __attribute__((optimize("omit-frame-pointer"))) void gradientRowV6(const std::ui
 			"lsr     r12, " C2 ", #16\n\t"                                     \
 			"orr     r12, r12, " N2 ", lsl #16\n\t"  /* F(dE) */              \
 			"lsr     lr, " C3 ", #16\n\t"                                      \
-			"orr     lr, lr, " N3 ", lsl #16\n\t"    /* F(dO) */              \
-			"sadd16  " C2 ", " C2 ", r12\n\t"                                  \
-			"sadd16  " C2 ", " C2 ", " C3 "\n\t"                               \
-			"sadd16  " C2 ", " C2 ", " C3 "\n\t"     /* gy odd */             \
-			"sadd16  " C3 ", " C3 ", lr\n\t"                                   \
-			"sadd16  " C3 ", " C3 ", r12\n\t"                                  \
-			"sadd16  " C3 ", " C3 ", r12\n\t"        /* gy even */            \
-			"pkhtb   r12, " C2 ", " C0 ", asr #16\n\t" /* pixel 4k+3 */       \
-			"pkhtb   lr, " C3 ", " C1 ", asr #16\n\t"  /* pixel 4k+4 */       \
-			"pkhbt   " C0 ", " C0 ", " C2 ", lsl #16\n\t" /* pixel 4k+1 */    \
-			"pkhbt   " C1 ", " C1 ", " C3 ", lsl #16\n\t" /* pixel 4k+2 */    \
+			"orr     lr, lr, " N3 ", lsl #16\n\t"    /* F(U) */               \
+			"ssub16  " C2 ", " C3 ", " C2 "\n\t"     /* dO */                 \
+			"sadd16  " C2 ", " C2 ", r12\n\t"        /* V */                  \
+			"sadd16  " C3 ", " C3 ", " C2 "\n\t"     /* gy odd */             \
+			"sadd16  " C2 ", " C2 ", lr\n\t"         /* gy even */            \
+			"pkhtb   r12, " C3 ", " C0 ", asr #16\n\t" /* pixel 4k+3 */       \
+			"pkhtb   lr, " C2 ", " C1 ", asr #16\n\t"  /* pixel 4k+4 */       \
+			"pkhbt   " C0 ", " C0 ", " C3 ", lsl #16\n\t" /* pixel 4k+1 */    \
+			"pkhbt   " C1 ", " C1 ", " C2 ", lsl #16\n\t" /* pixel 4k+2 */    \
 			"stmia   %[pp]!, {" C0 ", " C1 ", r12, lr}\n\t"                    \
 			"smuad   " C0 ", " C0 ", " C0 "\n\t"                               \
 			"smuad   " C1 ", " C1 ", " C1 "\n\t"                               \
@@ -495,12 +499,12 @@ __attribute__((noinline)) u32 edgePixel(const EdgeRowCtx &e, int x, std::int32_t
 struct EdgeRowAsm {
 	std::int32_t du, dd, dp1, k;	  ///< 0: up, down, pairs[1] minus mid (bytes); k = (53, 128)
 	std::int32_t dq0, dq1, dq2, unused; ///< 16: pairs[r] minus mid plus 88 (bytes)
-	const std::int32_t *pm;		  ///< 32: mid + first pixel of the first group
-	std::uint8_t *po;		  ///< 36: out + that pixel
+	const std::int32_t *pm;		  ///< 32: mid (groups from pixel 0)
+	std::uint8_t *po;		  ///< 36: out
 	const std::int32_t *end;	  ///< 40: pm + 8 * groups (groups >= 1)
 	std::int32_t least;		  ///< 44: no pixel's edge threshold is below it
 	u32 any;			  ///< 48: out: the OR of the edge bits found
-	u32 sdelta;			  ///< 52: smoothed row - (mid + 36) / 2, as addresses
+	u32 sdelta;			  ///< 52: smoothed row - (mid + 32) / 2, as addresses
 	const std::int32_t *table;	  ///< 56: LightTable::t
 };
 static_assert(offsetof(EdgeRowAsm, pm) == 32 && offsetof(EdgeRowAsm, any) == 48 &&
@@ -511,8 +515,7 @@ extern "C" void frappe_armv6_edge_row8(EdgeRowAsm *a);
 /* Registers. Scan: r4 pm (after the group once loaded), r5 po, r6 end,
  * r7 least, r8 zero, lr any; r0-r3, r9-r12 the magnitudes. Hit: r4-r9 and
  * lr saved (r9, the upper half's OR, read back from the stack); r9 the
- * group's smoothed values (pixel 8g at 0: its smoothed base, = sdelta +
- * pm / 2), lr the table, r7 the group's threshold, r1 up, r2 down, r3
+ * group's smoothed values (pixel 8g at 0: sdelta + pm / 2), lr the table, r7 the group's threshold, r1 up, r2 down, r3
  * pairs (all at pm), r10 k, r11 mask, r0 m, r12 the pair, r5 |pair| /
  * previous / the pixel's threshold, r6 next. Corners: the smoothed base,
  * the edge bits and the table + 4 pushed; r1-r3 the pairs rows (see dq),
@@ -551,13 +554,13 @@ frappe_armv6_edge_row8:
 	str     lr, [r0, #48]
 	pop     {r0, r4-r11, pc}
 
-	@ Pixel at \off bytes from pm, bit \bit of the mask; \soff: its
-	@ smoothed value's offset from r9 (0: r7 is its threshold).
-	.macro  FE8_NMS off, bit, soff=0
+	@ Pixel at \off bytes from pm, bit \bit of the mask; \own: its
+	@ threshold is looked up (its smoothed value at \soff from r9), else r7.
+	.macro  FE8_NMS off, bit, own=0, soff=0
 	ldr     r0, [r4, #\off]
 	cmp     r0, r7
 	ble     .Lfe8_n\@
-	.if \soff
+	.if \own
 	ldrh    r5, [r9, #\soff]
 	ldr     r5, [lr, r5, lsl #3]
 	cmp     r0, r5
@@ -677,15 +680,13 @@ frappe_armv6_edge_row8:
 	add     r12, r12, #52
 	ldm     r12, {r2, r3}               @ sdelta, table
 	add     r9, r2, r4, lsr #1
-	ldm     r9, {r2, r5, r6, r7, r8}    @ pixels 8g .. 8g+7, 8g+8 and 8g+10
+	ldm     r9, {r2, r5, r6, r7}        @ pixels 8g .. 8g+7
 	usub16  r10, r2, r5
 	sel     r2, r5, r2
 	usub16  r10, r6, r7
 	sel     r6, r7, r6
 	usub16  r10, r2, r6
 	sel     r2, r6, r2
-	usub16  r10, r2, r8
-	sel     r2, r8, r2
 	uxth    r5, r2
 	cmp     r5, r2, lsr #16
 	movhi   r5, r2, lsr #16             @ the least smoothed value
@@ -705,18 +706,18 @@ frappe_armv6_edge_row8:
 	beq     .Lfe8_same
 	cmp     r0, r7
 	ble     .Lfe8_hi
-	FE8_NMS -32, 1, 4
-	FE8_NMS -28, 2, 2
-	FE8_NMS -24, 4, 6
-	FE8_NMS -20, 8, 8
+	FE8_NMS -32, 1, 1, 0
+	FE8_NMS -28, 2, 1, 4
+	FE8_NMS -24, 4, 1, 2
+	FE8_NMS -20, 8, 1, 6
 .Lfe8_hi:
 	ldr     r0, [sp, #20]
 	cmp     r0, r7
 	ble     .Lfe8_nmsdone
-	FE8_NMS -16, 16, 12
-	FE8_NMS -12, 32, 10
-	FE8_NMS -8, 64, 14
-	FE8_NMS -4, 128, 16
+	FE8_NMS -16, 16, 1, 8
+	FE8_NMS -12, 32, 1, 12
+	FE8_NMS -8, 64, 1, 10
+	FE8_NMS -4, 128, 1, 14
 	b       .Lfe8_nmsdone
 .Lfe8_same:                                 @ every pixel's threshold is r7
 	cmp     r0, r7
@@ -779,7 +780,7 @@ frappe_armv6_edge_row8:
 	.word   0x01000000, 0x01000001, 0x01000100, 0x01000101
 	.word   0x01010000, 0x01010001, 0x01010100, 0x01010101
 	.set    .Lfe8_soff, . - 24          @ indexed by 31 - i: pixel i's smoothed offset
-	.byte   16, 14, 10, 12, 8, 6, 2, 4
+	.byte   14, 10, 12, 8, 6, 2, 4, 0
 	.size frappe_armv6_edge_row8, .-frappe_armv6_edge_row8
 	.purgem FE8_NMS
 	.purgem FE8_ROW
@@ -801,9 +802,11 @@ bool edgeRowV6(const GradRows &rows, int w, const FrontEndParams &params, std::u
 	const int x1 = w - 1;
 	int x = 1;
 	u32 any = 0;
-	/* The groups take the least smoothed value's threshold for the least
-	 * of their pixels': thresholds rise with the light (light_floor >= 0). */
-	if (const int groups = (x1 - 1) / 8; groups > 0 && params.light_floor >= 0) {
+	/* Groups of eight from pixel 0, as the smoothed row's blocks: pixels 0
+	 * and w-1 (magnitude 0) are never edges while no threshold is
+	 * negative. A group's least smoothed value has the least threshold of
+	 * its pixels: thresholds rise with the light (light_floor >= 0). */
+	if (const int groups = w / 8; groups > 0 && params.light_floor >= 0 && lt.t[0][0] >= 0) {
 		auto bytesFromMid = [&](const void *p) {
 			return static_cast<std::int32_t>(reinterpret_cast<std::intptr_t>(p) -
 							 reinterpret_cast<std::intptr_t>(mid));
@@ -817,15 +820,15 @@ bool edgeRowV6(const GradRows &rows, int w, const FrontEndParams &params, std::u
 			      bytesFromMid(e.pairs[1]) + 88,
 			      bytesFromMid(e.pairs[2]) + 88,
 			      0,
-			      mid + 1,
-			      out + 1,
-			      mid + 1 + 8 * groups,
+			      mid,
+			      out,
+			      mid + 8 * groups,
 			      lt.t[0][0],
 			      0,
-			      address(rows.smooth) - (address(mid) + 36) / 2,
+			      address(rows.smooth) - (address(mid) + 32) / 2,
 			      &lt.t[0][0] };
 		frappe_armv6_edge_row8(&a);
-		x = 1 + 8 * groups;
+		x = 8 * groups;
 		any = a.any;
 	}
 	for (; x < x1; ++x) {
