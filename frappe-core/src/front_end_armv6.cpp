@@ -396,8 +396,8 @@ inline bool isCornerV6(const std::int16_t *const pairRows[3], int x, std::int32_
 
 /* The thresholds of each smoothed value p (FrontEndParams::relativeThreshold):
  * t[p][0] the edge threshold (never below leastEdgeThreshold(), as the
- * scalar rule tests both), t[p][1] twice the corner threshold. Both rise
- * with p when light_floor >= 0. */
+ * scalar rule tests both), t[p][1] minus twice the corner threshold (the
+ * corner sum's first addend). Both grow with p when light_floor >= 0. */
 struct LightTable {
 	std::int32_t edgeT, cornerT, floor;
 	std::int32_t t[256][2];
@@ -409,7 +409,7 @@ void fillLightTable(LightTable &tab, const FrontEndParams &params)
 	const std::int32_t least = leastEdgeThreshold(params);
 	for (int p = 0; p < 256; ++p) {
 		tab.t[p][0] = std::max(least, params.relativeThreshold(e, p));
-		tab.t[p][1] = 2 * params.relativeThreshold(c, p);
+		tab.t[p][1] = -2 * params.relativeThreshold(c, p);
 	}
 	tab.edgeT = e;
 	tab.cornerT = c;
@@ -519,8 +519,8 @@ extern "C" void frappe_armv6_edge_row8(EdgeRowAsm *a);
  * pairs (all at pm), r10 k, r11 mask, r0 m, r12 the pair, r5 |pair| /
  * previous / the pixel's threshold, r6 next. Corners: the smoothed base,
  * the edge bits and the table + 4 pushed; r1-r3 the pairs rows (see dq),
- * r7 the pixel's 2T, r8 corner bits, r11 the edge bits left, r0 the
- * lowest, r12 its CLZ, r4 Sxx + Syy, r5 Sxx - Syy, r6 Sxy, r9 r10 lr one
+ * r7 the pixel's -2T, r8 corner bits, r11 the edge bits left, r0 the
+ * lowest, r12 its CLZ, r4 Sxx + Syy - 2T, r5 Sxx - Syy, r6 Sxy, r9 r10 lr one
  * row's three pairs. */
 __asm__(R"(
 	.text
@@ -600,7 +600,7 @@ frappe_armv6_edge_row8:
 	sub     lr, \rp, r12, lsl #2
 	ldm     lr, {r9, r10, lr}
 	.if \first
-	smuad   r4, r9, r9
+	smlad   r4, r9, r9, r7              @ from -2T
 	smusd   r5, r9, r9
 	smultb  r6, r9, r9
 	.else
@@ -617,7 +617,7 @@ frappe_armv6_edge_row8:
 	.endm
 
 	@ The corner test of each edge pixel (r11), as isCornerV6; \same: every
-	@ pixel's 2T is full light's, else each looks its own up.
+	@ pixel's -2T is full light's, else each looks its own up.
 	.macro  FE8_CORNERS same
 	.if \same
 	ldr     r7, [lr, #2044]
@@ -644,12 +644,11 @@ frappe_armv6_edge_row8:
 	ldr     r7, [sp]
 	ldrh    r9, [r7, r9]
 	ldr     r7, [sp, #8]
-	ldr     r7, [r7, r9, lsl #3]        @ 2T of the pixel
+	ldr     r7, [r7, r9, lsl #3]        @ -2T of the pixel
 	.endif
 	FE8_ROW r1, 1
 	FE8_ROW r2, 0
 	FE8_ROW r3, 0
-	sub     r4, r4, r7
 	movs    r4, r4, asr #9              @ c
 	ble     .Lfe8_cn\@
 	cmp     r5, #0
@@ -834,7 +833,7 @@ bool edgeRowV6(const GradRows &rows, int w, const FrontEndParams &params, std::u
 	for (; x < x1; ++x) {
 		const std::int32_t m = mid[x];
 		const std::int32_t *t = lt.t[getSmoothed(rows.smooth, x)];
-		const u32 v = m > t[0] ? edgePixel(e, x, m, t[1]) : 0;
+		const u32 v = m > t[0] ? edgePixel(e, x, m, -t[1]) : 0;
 		out[x] = static_cast<std::uint8_t>(v);
 		any |= v;
 	}
