@@ -489,9 +489,9 @@ __attribute__((noinline)) u32 edgePixel(const EdgeRowCtx &e, int x, std::int32_t
  * (one LDM of pixels 8g .. 8g+10, USUB16 + SEL) gives a threshold no
  * pixel's is below, and the group is empty if the OR is not above that
  * ("hit" otherwise). Then, for each half whose OR is above it, non-maximum
- * suppression of its four pixels: a pixel above the group's threshold is
- * tested against its own (a table lookup), unless every pixel's is the
- * group's (the threshold of full light); |gx|, |gy| by SSUB16 + SEL on the
+ * suppression of its pixels above the group's threshold; a local maximum
+ * is then tested against its own (a table lookup), unless every pixel's
+ * is the group's (the threshold of full light); |gx|, |gy| by SSUB16 + SEL on the
  * pair and the direction tests by SMUSD / SMUSDX with (53, 128). Then the
  * corner test of each edge pixel as isCornerV6 (its three rows of three
  * pairs by LDM) against its own threshold, and the eight result bytes from
@@ -554,18 +554,14 @@ frappe_armv6_edge_row8:
 	str     lr, [r0, #48]
 	pop     {r0, r4-r11, pc}
 
-	@ Pixel at \off bytes from pm, bit \bit of the mask; \own: its
-	@ threshold is looked up (its smoothed value at \soff from r9), else r7.
+	@ Pixel at \off bytes from pm, bit \bit of the mask; \own: r7 is
+	@ only the group's least threshold, and a local maximum is held to its
+	@ own (its smoothed value at \soff from r9): after the NMS, as most
+	@ pixels above r7 are above their own too.
 	.macro  FE8_NMS off, bit, own=0, soff=0
 	ldr     r0, [r4, #\off]
 	cmp     r0, r7
 	ble     .Lfe8_n\@
-	.if \own
-	ldrh    r5, [r9, #\soff]
-	ldr     r5, [lr, r5, lsl #3]
-	cmp     r0, r5
-	ble     .Lfe8_n\@
-	.endif
 	ldr     r12, [r3, #\off]
 	ssub16  r5, r8, r12
 	sel     r5, r5, r12                 @ (|gx|, |gy|)
@@ -592,7 +588,15 @@ frappe_armv6_edge_row8:
 	cmp     r0, r5
 	ble     .Lfe8_n\@
 	cmp     r0, r6
+	.if \own
+	blt     .Lfe8_n\@
+	ldrh    r5, [r9, #\soff]
+	ldr     r5, [lr, r5, lsl #3]
+	cmp     r0, r5
+	orrgt   r11, r11, #\bit
+	.else
 	orrge   r11, r11, #\bit
+	.endif
 .Lfe8_n\@:
 	.endm
 
