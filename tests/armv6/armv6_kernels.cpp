@@ -513,22 +513,39 @@ int main(int argc, char **argv)
 		{ 4740, 12354 }, { 0, 0 }, { 1, 1 }, { 400, 1000 }, { 40000, 200000 },
 		{ -5, -7 }, { INT64_C(1) << 40, INT64_C(1) << 40 }, { 2080799, 12354 },
 	};
+	/* Light floors: absolute thresholds (128), the Detector's default
+	 * (16), none (0); the thresholds of dark pixels follow their light. */
+	const int lightFloors[] = { FrontEndParams::kLightReference, 16, 0 };
 	int imageCases = 0;
 	for (const auto &[w, h] : { std::pair{ 640, 480 }, std::pair{ 37, 23 }, std::pair{ 3, 3 }, std::pair{ 4, 17 },
 				   std::pair{ 17, 5 }, std::pair{ 161, 97 } }) {
 		for (int noise : { 0, 3, 12 }) {
-			const Gray g = constructed(w, h, noise, static_cast<unsigned>(w * 131 + h * 7 + noise));
-			for (const FrontEndParams &p : params) {
-				char what[96];
-				std::snprintf(what, sizeof what, "constructed %dx%d noise %d thr %" PRId64 "/%" PRId64, w, h,
-					      noise, p.edge_threshold_sq, p.corner_threshold);
-				compareFrontEnds(g, p, 1.0f, what);
-				++imageCases;
-			}
-			if (w == 640) {
-				compareFrontEnds(g, params[0], 0.5f, "constructed 640x480 at scale 0.5");
-				compareFrontEnds(g, params[0], 0.37f, "constructed 640x480 at scale 0.37");
-				imageCases += 2;
+			/* The frame, and the frame in a dim room (a sixth of its light). */
+			for (int gain : { 255, 40 }) {
+				Gray g = constructed(w, h, noise, static_cast<unsigned>(w * 131 + h * 7 + noise));
+				for (auto &v : g.px)
+					v = static_cast<std::uint8_t>(v * gain / 255);
+				for (FrontEndParams p : params)
+					for (int lightFloor : lightFloors) {
+						if (gain != 255 && lightFloor == FrontEndParams::kLightReference)
+							continue;
+						p.light_floor = lightFloor;
+						char what[128];
+						std::snprintf(what, sizeof what,
+							      "constructed %dx%d noise %d gain %d thr %" PRId64 "/%" PRId64
+							      " floor %d",
+							      w, h, noise, gain, p.edge_threshold_sq, p.corner_threshold,
+							      lightFloor);
+						compareFrontEnds(g, p, 1.0f, what);
+						++imageCases;
+					}
+				if (w == 640 && gain == 255) {
+					FrontEndParams p = params[0];
+					p.light_floor = 16;
+					compareFrontEnds(g, p, 0.5f, "constructed 640x480 at scale 0.5");
+					compareFrontEnds(g, p, 0.37f, "constructed 640x480 at scale 0.37");
+					imageCases += 2;
+				}
 			}
 		}
 	}
@@ -600,7 +617,15 @@ int main(int argc, char **argv)
 			CHECK(false, "cannot read %s (binary PGM, maxval 255)", argv[i]);
 			continue;
 		}
-		edges += compareFrontEnds(g, params[0], 1.0f, argv[i]);
+		for (int lightFloor : lightFloors) {
+			FrontEndParams p = params[0];
+			p.light_floor = lightFloor;
+			char what[320];
+			std::snprintf(what, sizeof what, "%s floor %d", argv[i], lightFloor);
+			const std::size_t n = compareFrontEnds(g, p, 1.0f, what);
+			if (lightFloor == 16)
+				edges += n;
+		}
 		dark += compareRegionMap(g, 41, argv[i]); /* Config's default 0.16, as an intensity */
 		++files;
 	}
