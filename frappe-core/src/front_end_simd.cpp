@@ -284,9 +284,13 @@ bool EdgeRow(const GradRows &rows, int w, const FrontEndParams &params, std::uin
 	auto edgeVector = [&](int x) FRAPPE_INLINE_LAMBDA {
 		const auto m = hn::LoadU(d32, mid + x);
 		auto bytes = hn::Zero(d8);
-		if (!hn::AllFalse(d32, hn::Lt(least, m))) {
-			const auto q = hn::Min(hn::Add(hn::PromoteTo(d32, hn::LoadU(d8, bright + x)), floor), reference);
-			const auto strong = hn::Lt(relative(edgeT, q), m);
+		/* Each pixel's own threshold only where some magnitude passes a
+		 * black pixel's; the suppression and corner test only where one
+		 * passes its own. */
+		const bool some = !hn::AllFalse(d32, hn::Lt(least, m));
+		const auto q = hn::Min(hn::Add(hn::PromoteTo(d32, hn::LoadU(d8, bright + x)), floor), reference);
+		const auto strong = hn::Lt(relative(edgeT, q), m);
+		if (some && !hn::AllFalse(d32, strong)) {
 			const auto twoT = hn::ShiftLeft<1>(relative(cornerT, q));
 			const auto p = pairs(1, x);
 			const auto absP = hn::Abs(p);
