@@ -57,6 +57,8 @@ void validate(const Config &c, const Dictionary &d)
 		fail("min_marker_side must be at least 4 pixels, got " + std::to_string(c.min_marker_side));
 	if (!(c.region_contrast >= 0.0f && c.region_contrast <= 1.0f))
 		fail("region_contrast must be in [0, 1], got " + std::to_string(c.region_contrast));
+	if (!(c.light_floor >= 0.0f && c.light_floor <= 1.0f))
+		fail("light_floor must be in [0, 1], got " + std::to_string(c.light_floor));
 	if (c.threads < 0 || c.threads > 256)
 		fail("threads must be in [0, 256], got " + std::to_string(c.threads));
 	if (c.max_pixels < 1 || c.max_pixels > (1LL << 30))
@@ -209,6 +211,7 @@ Detector::Detector(const Config &config) : impl_(std::make_unique<Impl>())
 	impl_->params.region_contrast = static_cast<int>(std::lround(config.region_contrast * 255.0f));
 	if (config.region_contrast > 0.0f)
 		impl_->params.region_contrast = std::max(1, impl_->params.region_contrast);
+	impl_->params.light_floor = static_cast<int>(std::lround(config.light_floor * 255.0f));
 	impl_->frontEnd = makeCpuFrontEnd(config.threads);
 }
 
@@ -247,7 +250,7 @@ void DetectorStages::frontEnd(Detector &detector, const ImageView &image, int sl
 		 * CPU's, from the full-resolution frame (the edge map's scale
 		 * is taken into account when its quads are mapped); empty when
 		 * region_contrast is 0. */
-		detail::regionMap(image, 1.0f, d.params.region_contrast, s.edges.regions, d.regionScratch);
+		detail::regionMap(image, 1.0f, d.params, s.edges.regions, d.regionScratch);
 	}
 	s.result.scale = s.edges.scale;
 	s.result.copy_bytes = d.frontEnd->lastCopyBytes();
