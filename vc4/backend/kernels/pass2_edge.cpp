@@ -57,8 +57,8 @@ constexpr Reg LANEOFF[6] = {B(12), B(13), B(14), B(15), B(16), B(17)};
 constexpr Reg LANEOFFN[3] = {B(18), B(19), B(20)};
 constexpr Reg OUTW = A(24), VPMROW = A(25), VDWTOG = A(26), EDST = A(27), ROWCNT = A(28),
 	      GRPCNT = A(29);
-// E' and T (uniforms), the edge test's (E' q >> 7) q and 2 T(q) of the sub-pixel, and 32.
-constexpr Reg ETHR = B(21), XE = B(22), CT = A(30), TQ2 = A(31), K32 = B(30);
+// T (a uniform; E' is in r5), the edge test's (E' q >> 7) q, T(q) on its way, 32 and 256.
+constexpr Reg CT = B(21), XE = B(22), TA = A(30), TB = B(31), K32 = B(30), K256 = A(31);
 constexpr Reg COLMASK = B(23), MASKACC = B(24), VDWS = B(25),
 	      VDWSTRIDE = B(26), EPITCH4 = B(27), PITCH = B(28), MDST = B(29);
 
@@ -123,15 +123,11 @@ std::vector<Ins> decide(int j)
 	const Reg l = BV[1][j], r = BV[1][j + 2], u = BV[0][j + 1], d = BV[2][j + 1];
 	const Reg ul = BV[0][j], dr = BV[2][j + 2], ur = BV[0][j + 2], dl = BV[2][j];
 	std::vector<Ins> v;
-	// The thresholds at the centre's light q (byte 3 of its B): XE = (E' q >> 7) q,
-	// TQ2 = 2 T(q).
-	v.push_back(ins(mov(r0, bc[Unpack::B8D])));
-	v.push_back(ins(mul24(r1, r0, ETHR)));
-	v.push_back(ins(shr(r1, r1, imm(7)), mul24(r2, r0, CT)));
-	v.push_back(ins(shr(r2, r2, imm(7)), mul24(XE, r1, r0)));
-	v.push_back(ins(mul24(r2, r2, r0)));
-	v.push_back(ins(shr(r2, r2, imm(7))));
-	v.push_back(ins(shl(TQ2, r2, imm(1))));
+	// The thresholds at the centre's light q (byte 3 of its B, unpacked where read) ride in
+	// the MUL slots of the decisions: XE = (E' q >> 7) q in the direction tests (E' in r5),
+	// T(q) = ((T q >> 7) q) >> 7 in TA beside the edge test and the corner's a and b; only
+	// the three shifts and a second subtraction of T(q) take instructions of their own.
+	const Src q = bc[Unpack::B8D];
 	// Neighbours along the direction: prev in r1, next in r2.
 	v.push_back(ins(band(r3, bc, imm(3))));
 	if (l.file_b != r.file_b) {
@@ -140,26 +136,24 @@ std::vector<Ins> decide(int j)
 		v.push_back(ins(mov(r1, l)));
 		v.push_back(ins(mov(r2, r)));
 	}
-	v.push_back(ins(sub(reg::nop, r3, imm(1)).setFlags()));
+	v.push_back(ins(sub(reg::nop, r3, imm(1)).setFlags(), mul24(r0, q, r5)));
+	v.push_back(ins(shr(r0, r0, imm(7))));
 	v.push_back(ins(mov(r1, u).ifz(), mmov(r2, d).ifz()));    // 1: up, down
-	v.push_back(ins(sub(reg::nop, r3, imm(2)).setFlags()));
+	v.push_back(ins(sub(reg::nop, r3, imm(2)).setFlags(), mul24(XE, r0, q)));
 	v.push_back(ins(mov(r1, ul).ifz(), mmov(r2, dr).ifz()));  // 2: up-left, down-right
 	v.push_back(ins(sub(reg::nop, r3, imm(3)).setFlags()));
 	v.push_back(ins(mov(r1, ur).ifz(), mmov(r2, dl).ifz()));  // 3: up-right, down-left
 	// Edge: the sign bits of (prev - (B & ~3)) << 8, (next - (B & ~3) - 4) << 8 (the low
-	// 24 bits' differences, q shifted out) and XE - 128 m.
+	// 24 bits' differences: q's bytes shifted out, by mul24) and XE - 128 m.
 	v.push_back(ins(band(r0, bc, imm(-4))));
 	v.push_back(ins(sub(r1, r1, r0), mul24(r3, r0, K32))); // 128 m
 	v.push_back(ins(add(r0, r0, imm(4))));
-	v.push_back(ins(sub(r2, r2, r0)));
+	v.push_back(ins(sub(r2, r2, r0), mul24(TA, q, CT)));
 	v.push_back(ins(band(r1, r1, r2)));
-	v.push_back(ins(shl(r1, r1, imm(8))));
-	v.push_back(ins(sub(r2, XE, r3)));
-	v.push_back(ins(band(r1, r1, r2)));                      // edge: sign
-	// Corner: c in r0, a in r2, b in r3; the sign of (a^2 + b^2 - c^2) & -c.
-	v.push_back(ins(add(r0, SX[j], SY[j])));
-	v.push_back(ins(sub(r0, r0, TQ2)));
-	v.push_back(ins(asr(r0, r0, imm(9))));
+	v.push_back(ins(shr(TB, TA, imm(7))));
+	v.push_back(ins(sub(r2, XE, r3), mul24(r1, r1, K256)));
+	v.push_back(ins(band(r1, r1, r2), mul24(TA, TB, q)));    // edge: sign
+	// Corner: a in r2, b in r3, c in r0; the sign of (a^2 + b^2 - c^2) & -c.
 	v.push_back(ins(sub(r2, SX[j], SY[j])));
 	v.push_back(ins(sub(r3, imm(0), r2)));
 	v.push_back(ins(max(r2, r2, r3)));
@@ -167,7 +161,11 @@ std::vector<Ins> decide(int j)
 	v.push_back(ins(sub(r3, imm(0), SZ[j])));
 	v.push_back(ins(max(r3, r3, SZ[j])));
 	v.push_back(ins(shr(r3, r3, imm(8)), mul24(r2, r2, r2)));
-	v.push_back(ins(mul24(r3, r3, r3)));
+	v.push_back(ins(shr(TA, TA, imm(7)), mul24(r3, r3, r3))); // T(q)
+	v.push_back(ins(add(r0, SX[j], SY[j])));
+	v.push_back(ins(sub(r0, r0, TA)));
+	v.push_back(ins(sub(r0, r0, TA)));
+	v.push_back(ins(asr(r0, r0, imm(9))));
 	v.push_back(ins(add(r2, r2, r3), mul24(r3, r0, r0)));
 	v.push_back(ins(sub(r2, r2, r3)));                       // a^2 + b^2 - c^2
 	v.push_back(ins(sub(r3, imm(0), r0)));                   // -c
@@ -195,9 +193,10 @@ Built build()
 	b.op(shl(r1, r0, imm(10))); // Y = 8q at bit 7
 	b.op(add(VDWS, r2, r1));
 	b.op(mov(PITCH, b.uniform("grad_pitch")));
-	b.op(mov(ETHR, b.uniform("edge_thr")));
+	b.op(mov(reg::r5rep, b.uniform("edge_thr")));
 	b.op(mov(CT, b.uniform("corner_t")));
 	b.ldi(K32, 32);
+	b.ldi(K256, 256);
 	b.op(mov(VDWSTRIDE, b.uniform("vdw_stride")));
 	b.op(mov(EPITCH4, b.uniform("edge_pitch4")));
 	// Lane patterns (kernels.hpp): column c >= 1 is the run of sub-pixel c-1, 4 lane + 64
