@@ -19,10 +19,11 @@
 // the sums does not matter). The running sums keep two generations only (q = I + I',
 // G = hd + hd', F = hs - hs'), so the window needs no register rotation. The tensor's
 // vertical sums lag one more row: V(g-1) = S' + P(g), S = P' + P, P' = P.
-// The thresholds follow the light (front_end_cpu.cpp): q = min(p_0 + light_floor, 128) of
-// the smoothed row rides in B's byte 3 (a regfile-A pack), one row behind the smoothing
-// as B is (QN -> QP), and pass 2 scales both thresholds by it. v8adds saturates at 255,
-// above 128 whatever the floor (<= 128), so v8min(., 128) gives q exactly.
+// The thresholds follow the light (front_end_cpu.cpp): the light's q = min(p_0 +
+// light_floor, 128) (not the running sums' q above) of the smoothed row rides in B's byte 3
+// (a regfile-A pack), one row behind the smoothing as B is (QN -> QP), and pass 2 scales
+// both thresholds by it. v8adds saturates at 255, above 128 whatever the floor (the host
+// caps it at 128), so v8min(., 128) gives q exactly; both in MUL slots that were free.
 // The next row's gathers are issued as soon as this row's are popped, so a whole row of
 // work hides the TMU latency: 4 in flight at most (kTmuDepth 4: row R's last column goes
 // out after its first is popped), or 5 with the 8-deep build. Each output row (4 planes)
@@ -108,9 +109,10 @@ void rowOutput(Builder &b)
 {
 	// Interior: the row's mask (uniform stream: -1 for rows 1 .. h-2, else 0) and the
 	// column's.
+	// Row G-1's B goes to the VPM first, so that B(G) can be made in BPREV itself.
 	b.op(band(r0, COLMASK, reg::unif));
-	b.op(band(r2, r2, r0));
-	b.op(band(r3, r3, r0));
+	b.op(band(r2, r2, r0), mmov(reg::vw_setup, VPMW));
+	b.op(band(r3, r3, r0), mmov(reg::vpm_write, BPREV));
 	b.op(sub(r0, imm(0), r2));
 	b.op(max(r0, r2, r0));                          // |gx|
 	b.op(sub(r1, imm(0), r3));
@@ -129,15 +131,13 @@ void rowOutput(Builder &b)
 	b.op(mov(r2, imm(0)).ifnn());
 	b.op(add(r0, T[0], T[1]));
 	b.op(shl(r0, r0, imm(2)));
-	b.op(bor(r2, r0, r2));                          // B(G) = m << 2 | dir
+	b.op(bor(BPREV, r0, r2));                       // B(G) = m << 2 | dir
 	b.op(mov(r0, T[0]), mmov(r1, T[1]));
-	b.op(mov(r3, T[2]));
-	// Row G-1 to the VPM: B(G-1), then V = S' + P, S = P' + P, P' = P per product.
-	b.op(mov(reg::vw_setup, VPMW));
-	b.op(mov(reg::vpm_write, BPREV), mmov(BPREV, r2));
+	b.op(mov(Dst(BPREV)[Pack::B8D], QP), mmov(r3, T[2])); // q(G) in byte 3
+	// The rest of row G-1 to the VPM: V = S' + P, S = P' + P, P' = P per product.
 	b.op(add(reg::vpm_write, SXX, r0));
 	b.op(add(SXX, PXX, r0), mmov(PXX, r0));
-	b.op(add(reg::vpm_write, SYY, r1), mmov(Dst(BPREV)[Pack::B8D], QP)); // q(G) in B(G)'s byte 3
+	b.op(add(reg::vpm_write, SYY, r1));
 	b.op(add(SYY, PYY, r1), mmov(PYY, r1));
 	b.op(add(reg::vpm_write, SXY, r3));
 	b.op(add(SXY, PXY, r3), mmov(PXY, r3));
