@@ -30,9 +30,8 @@
 // gx = gy = 0 on the outermost rows and columns, as in the CPU's gradient rows. B keeps the
 // direction beside m, and q where pass 2 unpacks it for free (byte 3, regfile-A unpack
 // .8d); m's comparisons need the low 24 bits only (differences shifted left by 8, or
-// mul24, which reads 24 bits). Products go
-// through mul24 on |gx|, |gy| (24-bit unsigned operands) with the sign put back, so every
-// value is exact. Pass 2 reads a row above and below every row and a word left and right
+// mul24, which reads 24 bits). Products go through mul24 on |gx|, |gy| (24-bit unsigned
+// operands) with the sign put back, so every value is exact. Pass 2 reads a row above and below every row and a word left and right
 // of every group: the buffer needs a margin (gradMargin()) on both sides.
 //
 // Edge output: one byte per pixel (EdgeMap::kEdge | kCorner), rows of paddedWidth bytes.

@@ -5,7 +5,7 @@
 // Lane i holds pixels x0 + 4i + j, j = 0..3 (four sub-pixels), so the four result bytes
 // pack into the lane's word (regfile-A byte packs) and one 16-word VPM row is a 64-pixel
 // image row. The six columns c = 0..5 at x0 + 4i + c - 1 cover the 3x3 neighbourhoods
-// of all four sub-pixels. Plane 0 (B = m << 2 | dir) of rows y-1, y, y+1 is a window in
+// of all four sub-pixels. Plane 0 (B = q << 24 | m << 2 | dir) of rows y-1, y, y+1 is a window in
 // registers that moves down a row at a time, so a row gathers 24 words a lane for 64
 // pixels: plane 0 of row y+1 and the column sums Vxx, Vyy, Vxy of row y, per column.
 // Their per-lane addresses are a row base plus a lane pattern (kernels.hpp's interleaved
@@ -19,8 +19,9 @@
 // the light: q = byte 3 of the centre's B (pass 1 put it there; regfile-A unpack .8d),
 //   E(q) = ((E' q >> 7) q) >> 7, T(q) = ((T q >> 7) q) >> 7  (mul24: E' q < 2^29, T q < 2^30)
 //   edge   : m > E(q), m > m(prev), m >= m(next)
-//            (B(prev) < B & ~3 and B(next) < (B & ~3) + 4 on the low 24 bits: the
-//            differences' q bytes cancel mod 2^32 once shifted left by 8; m > E(q) as
+//            (B(prev) < B & ~3 and B(next) < (B & ~3) + 4 on the low 24 bits: those
+//            differences lie within +-2^23, so shifted left by 8 (mul24 by 256) the q
+//            bytes drop out and the sign is exact; m > E(q) as
 //            (E' q >> 7) q < 128 m, i.e. without the last shift, 128 m by mul24 of B & ~3,
 //            which reads its low 24 bits only)
 //   corner : c = (Sxx + Syy - 2T(q)) >> 9, a = |Sxx - Syy| >> 9, b = |Sxy| >> 8,
