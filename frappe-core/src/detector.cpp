@@ -211,7 +211,9 @@ Detector::Detector(const Config &config) : impl_(std::make_unique<Impl>())
 	impl_->params.region_contrast = static_cast<int>(std::lround(config.region_contrast * 255.0f));
 	if (config.region_contrast > 0.0f)
 		impl_->params.region_contrast = std::max(1, impl_->params.region_contrast);
-	impl_->params.light_floor = static_cast<int>(std::lround(config.light_floor * 255.0f));
+	/* Grey levels; kLightReference (0.5 or more) keeps the thresholds absolute. */
+	impl_->params.light_floor = std::min(static_cast<int>(std::lround(config.light_floor * 255.0f)),
+					     FrontEndParams::kLightReference);
 	impl_->frontEnd = makeCpuFrontEnd(config.threads);
 }
 
