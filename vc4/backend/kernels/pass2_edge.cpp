@@ -5,8 +5,8 @@
 // Lane i holds pixels x0 + 4i + j, j = 0..3 (four sub-pixels), so the four result bytes
 // pack into the lane's word (regfile-A byte packs) and one 16-word VPM row is a 64-pixel
 // image row. The six columns c = 0..5 at x0 + 4i + c - 1 cover the 3x3 neighbourhoods
-// of all four sub-pixels. Plane 0 (B = q << 24 | m << 2 | dir) of rows y-1, y, y+1 is a window in
-// registers that moves down a row at a time, so a row gathers 24 words a lane for 64
+// of all four sub-pixels. Plane 0 (B = q << 24 | m << 2 | dir) of rows y-1, y, y+1 is a
+// window in registers that moves down a row at a time, so a row gathers 24 words a lane for 64
 // pixels: plane 0 of row y+1 and the column sums Vxx, Vyy, Vxy of row y, per column.
 // Their per-lane addresses are a row base plus a lane pattern (kernels.hpp's interleaved
 // layout), and the tensor's horizontal sums are formed as the columns arrive:
