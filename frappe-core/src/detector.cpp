@@ -232,7 +232,11 @@ Detector::Detector(const Config &config) : impl_(std::make_unique<Impl>())
 		impl_->params.region_contrast = std::max(1, impl_->params.region_contrast);
 	impl_->params.light_floor = std::min(FrontEndParams::kLightReference,
 					     static_cast<int>(std::lround(config.light_floor * 255.0f)));
+	/* The second look corrects only what a clear read may: on the log
+	 * scale the weak cells of clutter and of other families' codes are
+	 * many, and they made wrong ids. */
 	impl_->logPolicy = impl_->policy;
+	impl_->logPolicy.maxTotal = impl_->policy.maxHamming;
 	if (impl_->params.light_floor < FrontEndParams::kLightReference)
 		impl_->logPolicy.tone.logFloor = static_cast<float>(std::max(1, impl_->params.light_floor));
 	impl_->frontEnd = makeCpuFrontEnd(config.threads);
