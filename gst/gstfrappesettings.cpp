@@ -30,6 +30,7 @@ namespace {
 constexpr gfloat kEdgeThresholdMin = 0.001f, kEdgeThresholdMax = 4.0f;
 constexpr gfloat kCornerThresholdMin = 0.0f, kCornerThresholdMax = 100.0f;
 constexpr gfloat kRegionContrastMin = 0.0f, kRegionContrastMax = 1.0f;
+constexpr gfloat kLightFloorMin = 0.0f, kLightFloorMax = 1.0f;
 constexpr gfloat kScaledSizeMin = 8.0f, kScaledSizeMax = 1000.0f;
 constexpr gint kMaxScaledFramesMax = 1000;
 /* The element's own: the pose's marker side in metres. */
@@ -125,6 +126,7 @@ bool Settings::samePipeline(const Settings &o) const
 {
 	return dictionary == o.dictionary && mode == o.mode && edgeThreshold == o.edgeThreshold &&
 	       cornerThreshold == o.cornerThreshold && regionContrast == o.regionContrast &&
+	       lightFloor == o.lightFloor &&
 	       maxHamming == o.maxHamming &&
 	       scaledSize == o.scaledSize && maxScaledFrames == o.maxScaledFrames &&
 	       backend == o.backend && pipelined == o.pipelined &&
@@ -143,6 +145,7 @@ frappe::Config Settings::config(bool staged) const
 	config.edge_threshold = edgeThreshold;
 	config.corner_threshold = cornerThreshold;
 	config.region_contrast = regionContrast;
+	config.light_floor = lightFloor;
 	config.max_hamming = std::min(maxHamming, dict.bits * dict.bits / 2);
 	config.scaled_size = scaledSize;
 	config.max_scaled_frames = maxScaledFrames;
@@ -198,6 +201,23 @@ void installProperties(GObjectClass *gobject_class)
 				   "that find blurred markers; lower finds fainter blurred markers but traces more "
 				   "clutter; 0 turns them off (edge candidates only, faster)",
 				   kRegionContrastMin, kRegionContrastMax, defaults.regionContrast, live));
+	/**
+	 * GstFrappeDetect:light-floor:
+	 *
+	 * Below mid-grey the edge, corner and region thresholds follow the local
+	 * brightness plus this floor, so that markers in a dim room or under
+	 * shadows keep their edges; 0.5 or more keeps them absolute.
+	 *
+	 * Since: 0.3
+	 */
+	g_object_class_install_property(
+		gobject_class, PROP_LIGHT_FLOOR,
+		g_param_spec_float("light-floor", "Light floor",
+				   "Below mid-grey the edge, corner and region thresholds follow the local "
+				   "brightness plus this floor (intensities in [0, 1]): markers in dim light and "
+				   "shadows; lower finds darker markers but lets sensor noise make edges; 0.5 or "
+				   "more keeps the thresholds absolute (the paper's)",
+				   kLightFloorMin, kLightFloorMax, defaults.lightFloor, live));
 	g_object_class_install_property(
 		gobject_class, PROP_MAX_HAMMING,
 		g_param_spec_int("max-hamming", "Max Hamming",
@@ -324,6 +344,9 @@ bool setValue(Settings &p, guint propId, const GValue *value, std::string &warni
 		break;
 	case PROP_REGION_CONTRAST:
 		p.regionContrast = g_value_get_float(value);
+		break;
+	case PROP_LIGHT_FLOOR:
+		p.lightFloor = g_value_get_float(value);
 		break;
 	case PROP_MAX_HAMMING:
 		p.maxHamming = g_value_get_int(value);
@@ -570,6 +593,9 @@ bool getProperty(const Settings &p, guint propId, GValue *value)
 		break;
 	case PROP_REGION_CONTRAST:
 		g_value_set_float(value, p.regionContrast);
+		break;
+	case PROP_LIGHT_FLOOR:
+		g_value_set_float(value, p.lightFloor);
 		break;
 	case PROP_MAX_HAMMING:
 		g_value_set_int(value, p.maxHamming);

@@ -29,6 +29,7 @@ enum Property {
 	PROP_EDGE_THRESHOLD,
 	PROP_CORNER_THRESHOLD,
 	PROP_REGION_CONTRAST,
+	PROP_LIGHT_FLOOR,
 	PROP_MAX_HAMMING,
 	PROP_SCALED_SIZE,
 	PROP_MAX_SCALED_FRAMES,
@@ -57,6 +58,7 @@ struct Settings {
 	gfloat edgeThreshold = kLibraryDefaults.edge_threshold;
 	gfloat cornerThreshold = kLibraryDefaults.corner_threshold;
 	gfloat regionContrast = kLibraryDefaults.region_contrast;
+	gfloat lightFloor = kLibraryDefaults.light_floor;
 	gint maxHamming = kLibraryDefaults.max_hamming;
 	gfloat scaledSize = kLibraryDefaults.scaled_size;
 	gint maxScaledFrames = kLibraryDefaults.max_scaled_frames;

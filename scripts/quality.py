@@ -35,6 +35,8 @@ import floors  # noqa: E402
 import measure  # noqa: E402
 import test_data  # noqa: E402
 
+LIGHT_BUCKETS = ['blinds', 'cast', 'lowlight', 'glare', 'overexposed']
+EXPOSURES = sorted(floors.EXPOSURE_POINTS)
 BLUR_BUCKETS = ['sharp (motion < 2 px, sigma < 1)', 'motion blur < 5 px', 'motion blur >= 5 px',
                 'defocus sigma < 1.5', 'defocus sigma >= 1.5']
 SIZE_BUCKETS = ['0-30', '30-60', '60-120', '120-9999']
@@ -114,6 +116,7 @@ def main():
             tasks.append(('bench', sub))
         tasks.append(('detect', sub))
     sweep_runs = {sub.name: measure.matrix_runs(sub, dictionaries, work) + measure.resolution_runs(sub, work)
+                  + measure.exposure_runs(sub, work, EXPOSURES, as_read=False)
                   for sub in synth}
 
     def do(task):
@@ -137,12 +140,14 @@ def main():
         for key, path in (('frappe', '-frappe.jsonl'), ('opencv', '-opencv.jsonl'), ('apriltag', '-apriltag-d1.jsonl')):
             if os.path.exists(stem(sub) + path):
                 scores[sub.name][key] = measure.score(scorer, sub.truth, stem(sub) + path)
-    resolution, cells, mismatched = {}, {}, []
+    resolution, exposure, cells, mismatched = {}, {}, {}, []
     codebook = measure.CodeBook(corrects)
     for sub in synth:
         runs = sweep_runs[sub.name]
-        res_runs = [r for r in runs if r[0] == sub.dictionary]
+        res_runs = [r for r in runs if r[0] == sub.dictionary and not r[2].startswith('light')]
         resolution[sub.name] = measure.score_resolution(scorer, sub, res_runs, work)
+        exposure[sub.name] = {float(r[2][5:]): measure.score(scorer, sub.truth, r[3])
+                              for r in runs if r[2].startswith('light')}
         for d, _, _, dets in runs:
             if d != sub.dictionary:
                 cells[(d, sub.name)] = measure.wrong_ids(scorer, codebook, sub, d, dets)
@@ -188,6 +193,32 @@ def main():
             if key in s:
                 rows.append(['  ' + title] + [sens(s[key], b) for b in BLUR_BUCKETS])
     p(table(['set / detector'] + BLUR_BUCKETS, rows))
+
+    p('\n## Sensitivity by lighting (the scorer\'s buckets, from each image\'s params.light)\n')
+    rows = []
+    for sub in synth:
+        s = scores[sub.name]
+        n = s['frappe'].get('sensitivity_by_light', {})
+        if not n:
+            continue
+        rows.append([short(sub.name) + ' (markers)'] + [n.get(b, (0, 0))[1] or '-' for b in LIGHT_BUCKETS])
+        for key, title in PEERS:
+            if key in s:
+                rows.append(['  ' + title] + [sens(s[key], b, 'sensitivity_by_light') for b in LIGHT_BUCKETS])
+    p(table(['set / detector'] + LIGHT_BUCKETS, rows))
+
+    p('\n## Any exposure: frappe\'s sensitivity (false positives) with the light scaled\n')
+    p('Each subset exposed G times as long in memory (frappe-sweep\'s lightG: v G plus sensor noise of 1.5 '
+      'grey levels, seeded, clipped); the issue holds 30%% within 3 points, 15%% within 10, 200%% within 3.\n')
+    rows = []
+    for sub in synth:
+        base = scores[sub.name]['frappe']
+        r = exposure[sub.name]
+        rows.append([short(sub.name), '%.3f (%d)' % (base['sensitivity'], base['fp'])]
+                    + ['%.3f (%d)' % (r[g]['sensitivity'], r[g]['fp']) for g in EXPOSURES]
+                    + ['%+.1f' % (100 * (r[g]['sensitivity'] - base['sensitivity'])) for g in EXPOSURES])
+    p(table(['set', '100%'] + ['%d%%' % round(100 * g) for g in EXPOSURES]
+            + ['points at %d%%' % round(100 * g) for g in EXPOSURES], rows))
 
     p('\n## Sensitivity by marker side, px (the truth\'s side_px)\n')
     rows = []

@@ -56,6 +56,9 @@ const char kUsage[] =
 	"      --corner-threshold C  Shi-Tomasi threshold for a corner (default 0.19)\n"
 	"      --region-contrast R  contrast for the dark-region candidates that find blurred\n"
 	"                          markers, intensities in [0,1]; 0 = off (default 0.16)\n"
+	"      --light-floor L     below mid-grey the thresholds follow the local brightness\n"
+	"                          plus L (intensities in [0,1]): markers in dim light and\n"
+	"                          shadows; 0.5 or more = absolute thresholds (default 0.063)\n"
 	"      --max-hamming H     bits read clearly that may be corrected (default: the\n"
 	"                          dictionary's careful default, see --dictionaries)\n"
 	"      --weak-margin W     a cell nearer the threshold than W (of half the contrast)\n"
@@ -248,6 +251,8 @@ Options parse(int argc, char **argv)
 			o.config.corner_threshold = parseNumber<float>(a, value());
 		} else if (a == "--region-contrast") {
 			o.config.region_contrast = parseNumber<float>(a, value());
+		} else if (a == "--light-floor") {
+			o.config.light_floor = parseNumber<float>(a, value());
 		} else if (a == "--max-hamming") {
 			o.config.max_hamming = parseNumber<int>(a, value());
 		} else if (a == "--weak-margin") {

@@ -173,7 +173,8 @@ bool Detector::Impl::skipCandidate(const detail::Quad &q, const std::array<Point
 {
 	const int bits = dict->bits;
 	const int traced = q.probeRead;
-	if (detail::surroundsMarker(tracedOutline, quadArea(tracedOutline), traced, bits, found, markerCentres))
+	if (detail::surroundsMarker(tracedOutline, quadArea(tracedOutline), q.fromShade ? -1 : traced, bits, found,
+				    markerCentres))
 		return true;
 	/* The probe's read at the traced outline decides two things before
 	 * refinement. A frame with more white cells than twice what decode
@@ -192,7 +193,9 @@ bool Detector::Impl::skipCandidate(const detail::Quad &q, const std::array<Point
 	const int mixedFrame = 2 * detail::allowedBorderErrors(bits);
 	const bool mixed = traced > mixedFrame && traced < whiteFrame();
 	if (q.fromRegion)
-		return mixed || q.probeContrast < static_cast<float>(params.region_contrast);
+		return mixed || q.probeContrast < static_cast<float>(params.relativeRegionContrast(
+					       static_cast<int>(std::lround(q.probeLevel - 0.5f * q.probeContrast)),
+					       static_cast<int>(std::lround(q.probeLevel + 0.5f * q.probeContrast))));
 	return mixed && sidesAtLeast(tracedOutline, 4.0f * static_cast<float>(bits + 2));
 }
 
@@ -224,22 +227,27 @@ Detector::Impl::Reading Detector::Impl::placeCandidate(const ImageView &image, d
 	return r;
 }
 
-/* Warps and binarises a refined candidate large enough to read. */
-void Detector::Impl::sampleRefined(Reading &r, const detail::Quad &q, std::size_t k, Result &res,
+/* Warps and binarises a refined candidate large enough to read, on the
+ * policy's scale (a batch's samples are grey levels: a copy is rescaled). */
+void Detector::Impl::sampleRefined(Reading &r, const detail::Quad &q, std::size_t k, const detail::DecodePolicy &pol,
 				   StageTimer &timer)
 {
 	r.samples = &warped;
 	if (!r.refined || !bigEnough(q.corners, r.minSide))
 		return;
-	++res.candidates;
 	r.counted = true;
 	timer.lap(Stage::Warp);
 	if (r.inBatch) {
 		const int j = batch.place[k];
 		r.refined = batch.warpedOk[static_cast<std::size_t>(j)] != 0;
 		r.samples = &batch.samples[static_cast<std::size_t>(j)];
+		if (r.refined && !pol.tone.linear()) {
+			warped = *r.samples;
+			pol.tone.apply(warped);
+			r.samples = &warped;
+		}
 	} else {
-		r.refined = detail::warpMarker(r.block.view, q.corners, dict->bits, warped);
+		r.refined = detail::warpMarker(r.block.view, q.corners, dict->bits, warped, pol.tone);
 	}
 	timer.lap(Stage::Decode);
 	if (r.refined)
@@ -249,15 +257,15 @@ void Detector::Impl::sampleRefined(Reading &r, const detail::Quad &q, std::size_
 /* No dark frame inside the outline, or a white one: this may be the outline
  * of the quiet zone (the marker's own outline merged with its code's edges,
  * as on small or blurred markers). The marker would lie one cell inside. */
-void Detector::Impl::readInset(Reading &r, detail::Quad &q, Result &res, StageTimer &timer)
+void Detector::Impl::readInset(Reading &r, detail::Quad &q, const detail::DecodePolicy &pol, StageTimer &timer)
 {
 	timer.lap(Stage::Refine);
 	q.corners = r.outline;
-	const bool inset = detail::insetQuad(r.block.view, q.corners, dict->bits, warped);
+	const bool inset = detail::insetQuad(r.block.view, q.corners, dict->bits, warped, pol.tone);
 	r.readable = inset && bigEnough(q.corners, r.minSide);
 	if (!r.readable)
 		return;
-	res.candidates += r.counted ? 0 : 1;
+	r.counted = true;
 	timer.lap(Stage::Decode);
 	r.samples = &warped;
 	r.b = detail::binarise(warped, dict->bits);
@@ -265,7 +273,7 @@ void Detector::Impl::readInset(Reading &r, detail::Quad &q, Result &res, StageTi
 
 /* Decodes a sampled candidate, trying what else may read when its samples
  * do not; on a read at the traced outline, q takes that outline. */
-detail::MarkerRead Detector::Impl::decodeCandidate(const Reading &r, detail::Quad &q)
+detail::MarkerRead Detector::Impl::decodeCandidate(const Reading &r, detail::Quad &q, const detail::DecodePolicy &pol)
 {
 	const ImageView &img = r.block.view;
 	const int bits = dict->bits;
@@ -277,23 +285,23 @@ detail::MarkerRead Detector::Impl::decodeCandidate(const Reading &r, detail::Qua
 		 * their neighbours: read the cells at their centres, at the
 		 * refined corners, else at the traced ones. */
 		if (bigEnough(q.corners, r.minSide))
-			read = detail::readCellCentres(img, q.corners, *codes, policy, warped);
+			read = detail::readCellCentres(img, q.corners, *codes, pol, warped);
 		if (!read.ok() && r.refined && bigEnough(r.outline, r.minSide)) {
-			read = detail::readCellCentres(img, r.outline, *codes, policy, warped);
+			read = detail::readCellCentres(img, r.outline, *codes, pol, warped);
 			if (read.ok())
 				q.corners = r.outline;
 		}
 		return read;
 	}
 	if (detail::readable(r.b, bits))
-		read = detail::readMarker(img, q.corners, *codes, policy, *r.samples, r.b);
+		read = detail::readMarker(img, q.corners, *codes, pol, *r.samples, r.b);
 	if (!read.ok() && r.refined && r.b.border_errors < whiteFrame()) {
 		/* Refinement can pull a blurred marker's sides onto its code's
 		 * edges; the traced outline may still read. */
-		if (detail::warpMarker(img, r.outline, bits, warped)) {
+		if (detail::warpMarker(img, r.outline, bits, warped, pol.tone)) {
 			const detail::Binarised bt = detail::binarise(warped, bits);
 			if (detail::readable(bt, bits)) {
-				read = detail::readMarker(img, r.outline, *codes, policy, warped, bt);
+				read = detail::readMarker(img, r.outline, *codes, pol, warped, bt);
 				if (read.ok())
 					q.corners = r.outline;
 			}
@@ -303,7 +311,7 @@ detail::MarkerRead Detector::Impl::decodeCandidate(const Reading &r, detail::Qua
 		/* Blur of about a cell (a blurred marker, or a small one
 		 * upsampled) reaches the quarter-cell samples of cells of any
 		 * size. */
-		read = detail::readCellCentres(img, q.corners, *codes, policy, warped);
+		read = detail::readCellCentres(img, q.corners, *codes, pol, warped);
 	}
 	return read;
 }
@@ -326,11 +334,26 @@ bool Detector::Impl::readCandidate(const ImageView &image, Slot &slot, std::size
 	r.refined = r.inBatch ? batch.refined[k] != 0
 			      : q.probeRead < whiteFrame() &&
 					refineQuad(r.block.view, slot, q, std::max(search / ff, kSearch), r.f);
-	sampleRefined(r, q, k, slot.result, timer);
-	if (!r.refined || r.b.border_errors >= whiteFrame())
-		readInset(r, q, slot.result, timer);
-	timer.lap(Stage::Decode);
-	const detail::MarkerRead read = decodeCandidate(r, q);
+	/* Read on grey levels; where that fails, once more on the log scale
+	 * (Tone), from the same refined corners: a marker under a shadow's
+	 * stripes or in a dim room. */
+	const Reading refined = r;
+	const std::array<Point2f, 4> refinedCorners = q.corners;
+	auto readWith = [&](const detail::DecodePolicy &pol) {
+		sampleRefined(r, q, k, pol, timer);
+		if (!r.refined || r.b.border_errors >= whiteFrame())
+			readInset(r, q, pol, timer);
+		timer.lap(Stage::Decode);
+		return decodeCandidate(r, q, pol);
+	};
+	detail::MarkerRead read = readWith(policy);
+	const bool counted = r.counted;
+	if (!read.ok() && !logPolicy.tone.linear()) {
+		r = refined;
+		q.corners = refinedCorners;
+		read = readWith(logPolicy);
+	}
+	slot.result.candidates += counted || r.counted;
 	if (!read.ok())
 		return false;
 	if (r.f > 1) {

@@ -24,9 +24,15 @@ struct Quad {
 	int probeRead = -1;
 	/// With probeRead: the spread of the grey levels it sampled.
 	float probeContrast = 0.0f;
+	/// With probeRead: the grey level midway between its darkest and
+	/// brightest samples (the contrast a region needs follows it).
+	float probeLevel = 0.0f;
 	/// Where the quad came from: the edge map, or the region map (whose
 	/// outline lies up to a region pixel inside the marker's).
 	bool fromRegion = false;
+	/// From the shade map (EdgeMap::shades; fromRegion too): read after
+	/// every other candidate, and only where no marker was read.
+	bool fromShade = false;
 	/// The probe read it as a marker (and the tracer sealed its inside):
 	/// kept first when a frame has more candidates than it may read.
 	bool probeDecoded = false;

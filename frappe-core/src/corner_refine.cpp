@@ -89,6 +89,15 @@ inline int centroid16(int moment2, int mass)
 	return moment2 < 0 ? -q : q;
 }
 
+/* A profile clips when its bright end is at least kSaturated: past it the
+ * sensor tells nothing. (Not at the dark end: a dim frame's blacks lie
+ * near 0 with noise, and cutting their falls only adds noise.) */
+constexpr int kSaturated = 250;
+inline bool clippedProfile(int bright)
+{
+	return bright >= kSaturated;
+}
+
 constexpr int kMinWindow16 = 32;
 /* RefineWindow::symmetric's window (window16: a fall at 16 k + 8 counts
  * min(16, window16 - its distance from c16) / 16) for falls spanning
@@ -189,6 +198,16 @@ void MeasureColumns(Columns &c)
 			hi = hn::IfThenElse(stop, mv, hi);
 		}
 		hi = hn::Min(hi, hn::Add(best, hn::Set(d, c.run + 1)));
+		/* clippedProfile(p(lo)): both sides cut to the shorter. */
+		{
+			auto pLo = zero;
+			for (int m = m0; m <= m1; ++m)
+				pLo = hn::IfThenElse(hn::Eq(hn::Set(d, m), lo), hn::PromoteTo(d, hn::LoadU(d8, &c.p[m - m0][i])), pLo);
+			const auto clipped = hn::Gt(pLo, hn::Set(d, kSaturated - 1));
+			const auto reach = hn::Min(hn::Sub(best, lo), hn::Sub(hi, best));
+			lo = hn::IfThenElse(clipped, hn::Sub(best, reach), lo);
+			hi = hn::IfThenElse(clipped, hn::Add(best, reach), hi);
+		}
 
 		/* The falls from lo to hi, and their centroid in 1/16 pixel. */
 		const auto lo1 = hn::Sub(lo, one);
@@ -297,6 +316,15 @@ inline int measureColumn(Pixel p, int kLo, int kHi, const RefineWindow &win, int
 	prev = p(hi);
 	for (int next; hi <= best + kRun && prev > (next = p(hi + 1)); prev = next)
 		++hi;
+	/* Where the light clips (a white at the sensor's ceiling) the
+	 * profile's falls end early on the bright side and their centroid
+	 * leans to the dark: both sides cut to the shorter one, symmetric
+	 * about the steepest pair (clippedProfile()). */
+	if (clippedProfile(p(lo))) {
+		const int reach = std::min(best - lo, hi - best);
+		lo = best - reach;
+		hi = best + reach;
+	}
 	/* falls[i] at lo + i; hi is one past the last. */
 	int falls[2 * kMaxRun + 2];
 	int mass = 0, moment2 = 0;

@@ -13,10 +13,36 @@
 
 namespace frappe::detail {
 
-bool warpMarker(const ImageView &image, const std::array<Point2f, 4> &corners, int bits,
-		WarpedMarker &out)
+float Tone::apply(float v) const
 {
-	return warpToGrid(image, corners, (bits + 2) * kSamplesPerCell, out);
+	if (linear())
+		return v;
+	return 255.0f * std::log1p(std::max(v, 0.0f) / logFloor) / std::log1p(255.0f / logFloor);
+}
+
+float Tone::invert(float v) const
+{
+	if (linear())
+		return v;
+	return logFloor * std::expm1(v / 255.0f * std::log1p(255.0f / logFloor));
+}
+
+void Tone::apply(WarpedMarker &w) const
+{
+	if (linear())
+		return;
+	const float k = 1.0f / logFloor, norm = 255.0f / std::log1p(255.0f * k);
+	for (int i = 0; i < w.side * w.side; ++i)
+		w.samples[static_cast<std::size_t>(i)] = norm * std::log1p(std::max(w.samples[static_cast<std::size_t>(i)], 0.0f) * k);
+}
+
+bool warpMarker(const ImageView &image, const std::array<Point2f, 4> &corners, int bits,
+		WarpedMarker &out, Tone tone)
+{
+	if (!warpToGrid(image, corners, (bits + 2) * kSamplesPerCell, out))
+		return false;
+	tone.apply(out);
+	return true;
 }
 
 namespace {
@@ -69,7 +95,7 @@ bool warpToGridScalar(const ImageView &image, const std::array<Point2f, 4> &corn
 }
 
 bool warpCellCentres(const ImageView &image, const std::array<Point2f, 4> &corners, int bits, float sharpening,
-		     WarpedMarker &out, float *reference)
+		     WarpedMarker &out, float *reference, Tone tone)
 {
 	const auto H = Homography::fromUnitSquare(corners);
 	if (!H)
@@ -83,6 +109,7 @@ bool warpCellCentres(const ImageView &image, const std::array<Point2f, 4> &corne
 	WarpedMarker grid;
 	if (!warpToGrid(image, grown, side, grid, true))
 		return false;
+	tone.apply(grid);
 	out.side = cells;
 	/* The grey level between the black border and the ring around it. */
 	float border = 0.0f, ring = 0.0f;
@@ -112,7 +139,7 @@ bool warpCellCentres(const ImageView &image, const std::array<Point2f, 4> &corne
 }
 
 bool insetQuad(const ImageView &image, std::array<Point2f, 4> &corners, int bits,
-	       WarpedMarker &out)
+	       WarpedMarker &out, Tone tone)
 {
 	const auto H = Homography::fromUnitSquare(corners);
 	if (!H)
@@ -126,7 +153,7 @@ bool insetQuad(const ImageView &image, std::array<Point2f, 4> &corners, int bits
 	}
 	if (!refineCorners(image, inner, std::max(1.5f, 1.2f * cell)))
 		return false;
-	if (!warpMarker(image, inner, bits, out))
+	if (!warpMarker(image, inner, bits, out, tone))
 		return false;
 	corners = inner;
 	return true;

@@ -15,9 +15,28 @@ namespace frappe::detail {
 /// Samples per cell side: each bit is the mean of 2x2 samples.
 constexpr int kSamplesPerCell = 2;
 
+
 /// The warped samples of one candidate: (bits + 2) cells a side, 2x2 samples
 /// a cell (16x16 for 6x6 codes).
 using WarpedMarker = CandidateSamples;
+
+/// The scale a candidate's samples are read on. Grey levels first; then,
+/// where the light is dim or changes across the marker (a blind's stripes,
+/// a cast shadow's edge), a log scale: light that multiplies every grey
+/// level (a shadow, a dim room) only shifts it there, so one threshold
+/// between black and white holds across a shadow's edge.
+struct Tone {
+	/// 0: grey levels. Otherwise the grey level added before the log,
+	/// which keeps the darkest levels' noise from being magnified without
+	/// bound: v -> 255 ln(1 + v / floor) / ln(1 + 255 / floor), 0 .. 255.
+	float logFloor = 0.0f;
+	bool linear() const { return logFloor <= 0.0f; }
+	float apply(float v) const;
+	/// apply()'s inverse: the grey level of a value on this scale.
+	float invert(float v) const;
+	/// Every sample of `w` through apply(), in place.
+	void apply(WarpedMarker &w) const;
+};
 
 /// Warps the quad into `side` x `side` samples (CandidateSamples' grid):
 /// the fixed-point warp of frappe/fixed_warp.h (integer grey levels) where
@@ -35,13 +54,13 @@ bool warpToGridScalar(const ImageView &image, const std::array<Point2f, 4> &corn
 /// the sample grid of a marker with `bits` bits a side. False when the quad
 /// is degenerate.
 bool warpMarker(const ImageView &image, const std::array<Point2f, 4> &corners, int bits,
-		WarpedMarker &out);
+		WarpedMarker &out, Tone tone = {});
 
 /// Treats `corners` as the outline of a one-cell quiet zone: moves them one
 /// cell inwards, re-measures the sides there and warps the result. False
 /// when the inner outline cannot be measured.
 bool insetQuad(const ImageView &image, std::array<Point2f, 4> &corners, int bits,
-	       WarpedMarker &out);
+	       WarpedMarker &out, Tone tone = {});
 
 /// Reads a marker's cells at their centres, one sample each, from a grid
 /// that also covers the ring of cells around the marker, and sharpens each
@@ -54,7 +73,7 @@ bool insetQuad(const ImageView &image, std::array<Point2f, 4> &corners, int bits
 /// the grey level halfway between the mean of the border cells and that of
 /// the ring outside them. False when the quad is degenerate.
 bool warpCellCentres(const ImageView &image, const std::array<Point2f, 4> &corners, int bits, float sharpening,
-		     WarpedMarker &out, float *reference = nullptr);
+		     WarpedMarker &out, float *reference = nullptr, Tone tone = {});
 
 /// The bits of a warped marker, read as in the dictionary files with the
 /// grid's top-left cell first.

@@ -12,6 +12,7 @@
 #include <string>
 
 #include "detector_impl.h"
+#include "front_end_rows.h"
 #include "quad_geometry.h"
 #include "utf8.h"
 
@@ -61,6 +62,8 @@ void validate(const Config &c, const Dictionary &d)
 		fail("min_marker_side must be at least 4 pixels, got " + std::to_string(c.min_marker_side));
 	if (!(c.region_contrast >= 0.0f && c.region_contrast <= 1.0f))
 		fail("region_contrast must be in [0, 1], got " + std::to_string(c.region_contrast));
+	if (!(c.light_floor >= 0.0f && c.light_floor <= 1.0f))
+		fail("light_floor must be in [0, 1], got " + std::to_string(c.light_floor));
 	if (c.threads < 0 || c.threads > 256)
 		fail("threads must be in [0, 256], got " + std::to_string(c.threads));
 	if (c.max_pixels < 1 || c.max_pixels > (1LL << 30))
@@ -94,6 +97,7 @@ public:
 		const detail::Binarised b = detail::binarise(cellCentres_, dict_.bits);
 		quad.probeRead = b.border_errors;
 		quad.probeContrast = b.contrast;
+		quad.probeLevel = b.threshold;
 		/* Only an exact codeword: a wrong "yes" would hide whatever lies
 		 * inside the quad (markers on a dark panel, say), and with a small
 		 * dictionary and a generous max_hamming a third of all bit patterns
@@ -165,30 +169,38 @@ void Detector::Impl::trace(Slot &slot)
 	tp.border_margin = 1.0f;
 	TracedMarkerProbe probe(slot.image, scale, *codes, maxHamming);
 	tracer.trace(edges, tp, quads, &probe);
-	const TraceMap &regions = edges.regions;
-	if (regions.width > 0) {
-		/* Region borders have no corner pixels: every closed one is
-		 * fitted from its outline. Their quads join the edge ones in the
-		 * edge map's coordinates. */
+	/* Region borders have no corner pixels: every closed one is fitted
+	 * from its outline. Their quads join the edge ones in the edge map's
+	 * coordinates; the shade map's after the region map's, so that a
+	 * repeat of a region quad is dropped. */
+	for (const TraceMap *regions : { &edges.regions, &edges.shades }) {
+		if (regions->width == 0)
+			continue;
 		detail::TraceParams rtp = tp;
 		rtp.min_clusters = 0;
 		rtp.max_winding = 2.0f;
 		rtp.holes = false;
-		rtp.min_side = std::max(4.0f, config.min_marker_side * regions.scale);
-		TracedMarkerProbe regionProbe(slot.image, regions.scale, *codes, maxHamming);
-		regionTracer.trace(regions, rtp, regionQuads, &regionProbe);
-		const float toEdges = scale / regions.scale;
+		rtp.min_side = std::max(4.0f, config.min_marker_side * regions->scale);
+		TracedMarkerProbe regionProbe(slot.image, regions->scale, *codes, maxHamming);
+		regionTracer.trace(*regions, rtp, regionQuads, &regionProbe);
+		const float toEdges = scale / regions->scale;
 		for (detail::Quad q : regionQuads) {
 			for (Point2f &p : q.corners)
 				p = detail::toScaled(p, toEdges);
 			q.fromRegion = true;
+			q.fromShade = regions == &edges.shades;
 			quads.push_back(q);
 		}
 	}
 	detail::removeDuplicateQuads(quads, 2.5f, quadGrid);
 	/* Smallest first: a marker's own outline decodes before the outline of
-	 * its quiet zone, which can then be skipped. */
+	 * its quiet zone, which can then be skipped. The shade map's quads
+	 * last: they find the markers shadows hide from the others, and
+	 * where a marker was read already its own candidates' corners are
+	 * the better ones (finish() skips a shade quad around a marker). */
 	std::sort(quads.begin(), quads.end(), [](const detail::Quad &a, const detail::Quad &b) {
+		if (a.fromShade != b.fromShade)
+			return b.fromShade;
 		return quadArea(a.corners) < quadArea(b.corners);
 	});
 	slot.result.candidates_dropped = detail::capCandidates(quads, config.max_candidates);
@@ -218,6 +230,15 @@ Detector::Detector(const Config &config) : impl_(std::make_unique<Impl>())
 	impl_->params.region_contrast = static_cast<int>(std::lround(config.region_contrast * 255.0f));
 	if (config.region_contrast > 0.0f)
 		impl_->params.region_contrast = std::max(1, impl_->params.region_contrast);
+	impl_->params.light_floor = std::min(FrontEndParams::kLightReference,
+					     static_cast<int>(std::lround(config.light_floor * 255.0f)));
+	/* The second look corrects only what a clear read may: on the log
+	 * scale the weak cells of clutter and of other families' codes are
+	 * many, and they made wrong ids. */
+	impl_->logPolicy = impl_->policy;
+	impl_->logPolicy.maxTotal = impl_->policy.maxHamming;
+	if (impl_->params.light_floor < FrontEndParams::kLightReference)
+		impl_->logPolicy.tone.logFloor = static_cast<float>(std::max(1, impl_->params.light_floor));
 	impl_->frontEnd = makeCpuFrontEnd(config.threads);
 }
 
@@ -256,7 +277,19 @@ void DetectorStages::frontEnd(Detector &detector, const ImageView &image, int sl
 		 * CPU's, from the full-resolution frame (the edge map's scale
 		 * is taken into account when its quads are mapped); empty when
 		 * region_contrast is 0. */
-		detail::regionMap(image, 1.0f, d.params.region_contrast, s.edges.regions, d.regionScratch);
+		detail::regionMap(image, 1.0f, d.params, s.edges.regions, s.edges.shades, d.regionScratch);
+	} else if (d.params.makesShades() && !d.frontEnd->makesShadeMap()) {
+		/* A front end with a region map but no shade map (the QPUs'
+		 * today): the CPU's, from the frame the front end traced (its
+		 * region map made again, unused), so the markers are the CPU
+		 * front end's. */
+		ImageView traced = image;
+		if (s.edges.scale < 1.0f) {
+			d.shadeFrame.resize(static_cast<std::size_t>(s.edges.width) * s.edges.height);
+			detail::scaleNearest(image, s.edges.width, s.edges.height, d.shadeFrame.data());
+			traced = ImageView(d.shadeFrame.data(), s.edges.width, s.edges.height, s.edges.width);
+		}
+		detail::regionMap(traced, s.edges.scale, d.params, d.shadeRegions, s.edges.shades, d.regionScratch);
 	}
 	s.result.scale = s.edges.scale;
 	s.result.copy_bytes = d.frontEnd->lastCopyBytes();

@@ -47,6 +47,9 @@ struct FRAPPE_HIDDEN Detector::Impl {
 	std::unique_ptr<detail::CodeBook> codes;
 	int maxHamming = 0;
 	detail::DecodePolicy policy;
+	/* policy on the log scale (Tone), the second read of a candidate;
+	 * grey levels (no second read) when light_floor keeps thresholds absolute. */
+	detail::DecodePolicy logPolicy;
 	FrontEndParams params;
 	std::unique_ptr<FrontEnd> frontEnd;
 	std::unique_ptr<CandidateWarper> warper; /* nullptr: warp on the CPU, one by one */
@@ -73,6 +76,10 @@ struct FRAPPE_HIDDEN Detector::Impl {
 	detail::PointGrid markerGrid; /* dropNestedMarkers()'s, in finish() */
 	detail::PointGrid markerCentres; /* the frame's markers so far, for skipCandidate() */
 	detail::RegionScratch regionScratch; /* for a front end without a region map */
+	/* For a front end without a shade map: the frame it traced, scaled, and
+	 * the region map made beside the shades (not used). */
+	std::vector<std::uint8_t> shadeFrame;
+	TraceMap shadeRegions;
 	detail::WarpedMarker warped;
 	/* Candidates with large cells are read on the frame halved into blocks
 	 * of f pixels (readBlock()): a patch around the candidate, or the whole
@@ -111,9 +118,9 @@ struct FRAPPE_HIDDEN Detector::Impl {
 		std::array<Point2f, 4> outline; /* the traced one */
 		bool refined = false;   /* then: and warped */
 		bool readable = true;
-		bool counted = false;   /* in Result::candidates: once a quad */
 		detail::Binarised b;
 		const detail::WarpedMarker *samples = nullptr;
+		bool counted = false;   /* sampled for a read: one of Result::candidates */
 	};
 
 	void checkImage(const ImageView &image) const;
@@ -127,9 +134,10 @@ struct FRAPPE_HIDDEN Detector::Impl {
 	bool skipCandidate(const detail::Quad &q, const std::array<Point2f, 4> &tracedOutline,
 			   const std::vector<Marker> &found) const;
 	Reading placeCandidate(const ImageView &image, detail::Quad &q, const std::array<Point2f, 4> &tracedOutline);
-	void sampleRefined(Reading &r, const detail::Quad &q, std::size_t k, Result &res, detail::StageTimer &timer);
-	void readInset(Reading &r, detail::Quad &q, Result &res, detail::StageTimer &timer);
-	detail::MarkerRead decodeCandidate(const Reading &r, detail::Quad &q);
+	void sampleRefined(Reading &r, const detail::Quad &q, std::size_t k, const detail::DecodePolicy &pol,
+			   detail::StageTimer &timer);
+	void readInset(Reading &r, detail::Quad &q, const detail::DecodePolicy &pol, detail::StageTimer &timer);
+	detail::MarkerRead decodeCandidate(const Reading &r, detail::Quad &q, const detail::DecodePolicy &pol);
 	/* Border cells that make a white frame: three quarters of the
 	 * 4(n+1). */
 	int whiteFrame() const { return 3 * dict->bits + 3; }

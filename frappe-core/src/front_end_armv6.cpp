@@ -23,9 +23,11 @@
 #include <arm_acle.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cstddef>
 #include <cstdlib>
 #include <cstring>
+#include <mutex>
 
 namespace frappe::detail {
 
@@ -248,9 +250,11 @@ __attribute__((optimize("omit-frame-pointer"))) void gradientRowV6(const std::ui
 		 * vd = c - a, four columns a step in even and odd lanes (the
 		 * smoothed rows are already in lanes), stored per block of four
 		 * columns 4k .. 4k+3 as the four words
-		 *   sE = vs(4k, 4k+2), sO = vs(4k+1, 4k+3), dE, dO (likewise vd)
-		 * by one STM: 12 instructions per four columns. The blocks live
-		 * in tmp (2w + 16 values): w/4 + 1 blocks of 8 values. */
+		 *   sE = vs(4k, 4k+2), sO = vs(4k+1, 4k+3), dE = vd(4k, 4k+2),
+		 *   U = dE + dO = (vd(4k) + vd(4k+1), vd(4k+2) + vd(4k+3))
+		 * by one STM: 13 instructions per four columns (U saves pass 2
+		 * two). The blocks live in tmp (2w + 16 values): w/4 + 1 blocks
+		 * of 8 values. */
 		std::uint8_t *const blocks = reinterpret_cast<std::uint8_t *>(tmp);
 		const int words = w / 4;
 		{
@@ -264,6 +268,7 @@ __attribute__((optimize("omit-frame-pointer"))) void gradientRowV6(const std::ui
 				"ldmia   %[pb]!, {r8, r9}\n\t"     /* eb, ob */            \
 				"ssub16  r10, r6, r4\n\t"          /* dE */                \
 				"ssub16  r11, r7, r5\n\t"          /* dO */                \
+				"sadd16  r11, r10, r11\n\t"        /* U */                 \
 				"add     r4, r4, r6\n\t"                                   \
 				"add     r5, r5, r7\n\t"                                   \
 				"add     r8, r4, r8, lsl #1\n\t"   /* sE */                \
@@ -284,11 +289,13 @@ __attribute__((optimize("omit-frame-pointer"))) void gradientRowV6(const std::ui
 				: [end] "r"(aEnd)
 				: "r4", "r5", "r6", "r7", "r8", "r9", "r10", "r11", "cc", "memory");
 		}
-		/* The last columns (0 .. 3) in block `words`. */
+		/* The last columns (0 .. 3) in block `words`; an odd column's
+		 * U lane adds the even column before it. */
 		for (int i = 4 * words; i < w; ++i) {
+			auto vd = [&](int j) { return getSmoothed(c, j) - getSmoothed(a, j); };
 			const int pa = getSmoothed(a, i), pb = getSmoothed(b, i), pc = getSmoothed(c, i);
 			const std::int16_t v[2] = { static_cast<std::int16_t>(pa + 2 * pb + pc),
-						    static_cast<std::int16_t>(pc - pa) };
+						    static_cast<std::int16_t>((i & 1) ? vd(i - 1) + vd(i) : vd(i)) };
 			for (int q = 0; q < 2; ++q)
 				std::memcpy(blocks + 16 * (i >> 2) + 8 * q + 4 * (i & 1) + 2 * ((i >> 1) & 1), &v[q], 2);
 		}
@@ -296,10 +303,11 @@ __attribute__((optimize("omit-frame-pointer"))) void gradientRowV6(const std::ui
 		 * of block k+1 (N): with F(X) = (C_X.hi, N_X.lo), the columns
 		 * (4k+2, 4k+4) or (4k+3, 4k+5),
 		 *   gx(4k+1, 4k+3) = F(sE) - sE,   gx(4k+2, 4k+4) = F(sO) - sO,
-		 *   gy(4k+1, 4k+3) = dE + F(dE) + 2 dO,
-		 *   gy(4k+2, 4k+4) = dO + F(dO) + 2 F(dE);
+		 *   with V = dO + F(dE) = U - dE + F(dE):
+		 *   gy(4k+1, 4k+3) = dE + 2 dO + F(dE) = U + V,
+		 *   gy(4k+2, 4k+4) = dO + 2 F(dE) + F(dO) = V + F(U);
 		 * the (gx, gy) pair of a pixel is one PKHBT/PKHTB, gx^2 + gy^2
-		 * one SMUAD; pairs and magnitudes stored by STM. 30 instructions
+		 * one SMUAD; pairs and magnitudes stored by STM. 26 instructions
 		 * per four pixels, all loads and stores aligned. */
 		const int steps = (w - 2) / 4;
 		std::uint8_t *pp = pairs + 4;
@@ -321,17 +329,15 @@ __attribute__((optimize("omit-frame-pointer"))) void gradientRowV6(const std::ui
 			"lsr     r12, " C2 ", #16\n\t"                                     \
 			"orr     r12, r12, " N2 ", lsl #16\n\t"  /* F(dE) */              \
 			"lsr     lr, " C3 ", #16\n\t"                                      \
-			"orr     lr, lr, " N3 ", lsl #16\n\t"    /* F(dO) */              \
-			"sadd16  " C2 ", " C2 ", r12\n\t"                                  \
-			"sadd16  " C2 ", " C2 ", " C3 "\n\t"                               \
-			"sadd16  " C2 ", " C2 ", " C3 "\n\t"     /* gy odd */             \
-			"sadd16  " C3 ", " C3 ", lr\n\t"                                   \
-			"sadd16  " C3 ", " C3 ", r12\n\t"                                  \
-			"sadd16  " C3 ", " C3 ", r12\n\t"        /* gy even */            \
-			"pkhtb   r12, " C2 ", " C0 ", asr #16\n\t" /* pixel 4k+3 */       \
-			"pkhtb   lr, " C3 ", " C1 ", asr #16\n\t"  /* pixel 4k+4 */       \
-			"pkhbt   " C0 ", " C0 ", " C2 ", lsl #16\n\t" /* pixel 4k+1 */    \
-			"pkhbt   " C1 ", " C1 ", " C3 ", lsl #16\n\t" /* pixel 4k+2 */    \
+			"orr     lr, lr, " N3 ", lsl #16\n\t"    /* F(U) */               \
+			"ssub16  " C2 ", " C3 ", " C2 "\n\t"     /* dO */                 \
+			"sadd16  " C2 ", " C2 ", r12\n\t"        /* V */                  \
+			"sadd16  " C3 ", " C3 ", " C2 "\n\t"     /* gy odd */             \
+			"sadd16  " C2 ", " C2 ", lr\n\t"         /* gy even */            \
+			"pkhtb   r12, " C3 ", " C0 ", asr #16\n\t" /* pixel 4k+3 */       \
+			"pkhtb   lr, " C2 ", " C1 ", asr #16\n\t"  /* pixel 4k+4 */       \
+			"pkhbt   " C0 ", " C0 ", " C3 ", lsl #16\n\t" /* pixel 4k+1 */    \
+			"pkhbt   " C1 ", " C1 ", " C2 ", lsl #16\n\t" /* pixel 4k+2 */    \
 			"stmia   %[pp]!, {" C0 ", " C1 ", r12, lr}\n\t"                    \
 			"smuad   " C0 ", " C0 ", " C0 "\n\t"                               \
 			"smuad   " C1 ", " C1 ", " C1 "\n\t"                               \
@@ -388,16 +394,69 @@ inline bool isCornerV6(const std::int16_t *const pairRows[3], int x, std::int32_
 	return c * c > a * a + b * b;
 }
 
+/* The thresholds of each smoothed value p (FrontEndParams::relativeThreshold):
+ * t[p][0] the edge threshold (never below leastEdgeThreshold(), as the
+ * scalar rule tests both), t[p][1] minus twice the corner threshold (the
+ * corner sum's first addend). Both grow with p when light_floor >= 0. */
+struct LightTable {
+	std::int32_t edgeT, cornerT, floor;
+	std::int32_t t[256][2];
+};
+
+void fillLightTable(LightTable &tab, const FrontEndParams &params)
+{
+	const std::int32_t e = edgeThreshold(params), c = cornerThreshold(params);
+	const std::int32_t least = leastEdgeThreshold(params);
+	for (int p = 0; p < 256; ++p) {
+		tab.t[p][0] = std::max(least, params.relativeThreshold(e, p));
+		tab.t[p][1] = -2 * params.relativeThreshold(c, p);
+	}
+	tab.edgeT = e;
+	tab.cornerT = c;
+	tab.floor = params.light_floor;
+}
+
+/* A table is made once for each params a process uses (a detector has
+ * one), then read without a lock: a per-row table would cost more than
+ * the row's edge pass saves, thread_local a __tls_get_addr call a row in
+ * a shared library. Beyond kLightTables a row makes its own in `own`. */
+constexpr int kLightTables = 8;
+LightTable gLightTables[kLightTables];
+std::atomic<int> gLightTablesMade{ 0 };
+std::mutex gLightTablesLock;
+
+const LightTable &lightTable(const FrontEndParams &params, LightTable &own)
+{
+	const std::int32_t e = edgeThreshold(params), c = cornerThreshold(params), f = params.light_floor;
+	auto find = [&](int n) -> const LightTable * {
+		for (int i = 0; i < n; ++i) {
+			const LightTable &t = gLightTables[i];
+			if (t.edgeT == e && t.cornerT == c && t.floor == f)
+				return &t;
+		}
+		return nullptr;
+	};
+	if (const LightTable *t = find(gLightTablesMade.load(std::memory_order_acquire)))
+		return *t;
+	std::lock_guard<std::mutex> lock(gLightTablesLock);
+	const int n = gLightTablesMade.load(std::memory_order_relaxed);
+	if (const LightTable *t = find(n))
+		return *t;
+	LightTable &tab = n < kLightTables ? gLightTables[n] : own;
+	fillLightTable(tab, params);
+	if (n < kLightTables)
+		gLightTablesMade.store(n + 1, std::memory_order_release);
+	return tab;
+}
+
 struct EdgeRowCtx {
 	const std::int32_t *up, *mid, *down;
 	const std::int16_t *pairs[3];
-	std::int32_t twoT;
 };
 
-/* One pixel whose magnitude m is above the threshold: non-maximum
- * suppression along the gradient direction, then the corner test. Out of
- * line, so that the scan over the (mostly empty) row keeps its registers. */
-__attribute__((noinline)) u32 edgePixel(const EdgeRowCtx &e, int x, std::int32_t m)
+/* One pixel above its edge threshold: non-maximum suppression along the
+ * gradient direction, then the corner test against twoT. */
+__attribute__((noinline)) u32 edgePixel(const EdgeRowCtx &e, int x, std::int32_t m, std::int32_t twoT)
 {
 	const u32 p = pairAt(e.pairs[1], x);
 	const int gx = static_cast<std::int16_t>(p), gy = static_cast<std::int32_t>(p) >> 16;
@@ -418,118 +477,51 @@ __attribute__((noinline)) u32 edgePixel(const EdgeRowCtx &e, int x, std::int32_t
 	}
 	if (!(m > prev && m >= next))
 		return 0;
-	return isCornerV6(e.pairs, x, e.twoT) ? EdgeMap::kEdge | EdgeMap::kCorner : EdgeMap::kEdge;
-}
-
-/* The threshold test, direction and non-maximum suppression of the four
- * pixels x .. x+3, written out (~3 instructions a pixel below the
- * threshold, ~20 above): bit i set when pixel x+i is an edge. The direction
- * tests 256|gy| <= 106|gx| and 256|gx| <= 106|gy| as 128|gy| <= 53|gx| and
- * 128|gx| <= 53|gy|; in the diagonal case both are non-zero, so
- * (gx > 0) == (gy > 0) is gx ^ gy >= 0. */
-inline u32 nmsGroup(const EdgeRowCtx &e, int x, std::int32_t thr)
-{
-	const std::int32_t *pm = e.mid + x, *pu = e.up + x, *pd = e.down + x;
-	const std::uint8_t *pp = reinterpret_cast<const std::uint8_t *>(e.pairs[1]) + 4 * x;
-	const u32 c53 = 53;
-	u32 mask, m, gx, gy, sg, t;
-#define FRAPPE_NMS_PIXEL(OFF, BIT, NEXT)                                                   \
-	"ldr     %[m], [%[pm], #" OFF "]\n\t"                                              \
-	"cmp     %[m], %[thr]\n\t"                                                         \
-	"ble     " NEXT "f\n\t"                                                            \
-	"ldr     %[gx], [%[pp], #" OFF "]\n\t"                                             \
-	"asr     %[gy], %[gx], #16\n\t"                                                    \
-	"sxth    %[gx], %[gx]\n\t"                                                         \
-	"eor     %[sg], %[gx], %[gy]\n\t"                                                  \
-	"eor     %[t], %[gx], %[gx], asr #31\n\t"                                          \
-	"sub     %[gx], %[t], %[gx], asr #31\n\t"      /* |gx| */                          \
-	"eor     %[t], %[gy], %[gy], asr #31\n\t"                                          \
-	"sub     %[gy], %[t], %[gy], asr #31\n\t"      /* |gy| */                          \
-	"mul     %[t], %[gx], %[c53]\n\t"                                                  \
-	"cmp     %[t], %[gy], lsl #7\n\t"                                                  \
-	"bge     5" NEXT "f\n\t"                       /* horizontal */                    \
-	"mul     %[t], %[gy], %[c53]\n\t"                                                  \
-	"cmp     %[t], %[gx], lsl #7\n\t"                                                  \
-	"bge     6" NEXT "f\n\t"                       /* vertical */                      \
-	"cmp     %[sg], #0\n\t"                                                            \
-	"itt     ge\n\t"                                                                   \
-	"ldrge   %[gx], [%[pu], #" OFF " - 4]\n\t"     /* diagonal (gx > 0) == (gy > 0) */ \
-	"ldrge   %[gy], [%[pd], #" OFF " + 4]\n\t"                                         \
-	"itt     lt\n\t"                                                                   \
-	"ldrlt   %[gx], [%[pu], #" OFF " + 4]\n\t"     /* the other diagonal */            \
-	"ldrlt   %[gy], [%[pd], #" OFF " - 4]\n\t"                                         \
-	"b       7" NEXT "f\n"                                                              \
-	"5" NEXT ":\n\t"                                                                   \
-	"ldr     %[gx], [%[pm], #" OFF " - 4]\n\t"                                         \
-	"ldr     %[gy], [%[pm], #" OFF " + 4]\n\t"                                         \
-	"b       7" NEXT "f\n"                                                              \
-	"6" NEXT ":\n\t"                                                                   \
-	"ldr     %[gx], [%[pu], #" OFF "]\n\t"                                             \
-	"ldr     %[gy], [%[pd], #" OFF "]\n"                                                \
-	"7" NEXT ":\n\t"                                                                   \
-	"cmp     %[m], %[gx]\n\t"                      /* m > prev */                      \
-	"ble     " NEXT "f\n\t"                                                            \
-	"cmp     %[m], %[gy]\n\t"                      /* m >= next */                     \
-	"it      ge\n\t"                                                                   \
-	"orrge   %[mask], %[mask], #" BIT "\n"                                              \
-	NEXT ":\n\t"
-	__asm__ volatile(
-		"mov     %[mask], #0\n\t"
-		FRAPPE_NMS_PIXEL("0", "1", "1")
-		FRAPPE_NMS_PIXEL("4", "2", "2")
-		FRAPPE_NMS_PIXEL("8", "4", "3")
-		FRAPPE_NMS_PIXEL("12", "8", "4")
-		: [mask] "=&r"(mask), [m] "=&r"(m), [gx] "=&r"(gx), [gy] "=&r"(gy), [sg] "=&r"(sg), [t] "=&r"(t)
-		: [pm] "r"(pm), [pu] "r"(pu), [pd] "r"(pd), [pp] "r"(pp), [thr] "r"(thr), [c53] "r"(c53)
-		: "cc", "memory");
-#undef FRAPPE_NMS_PIXEL
-	return mask;
-}
-
-/* The four result bytes of the pixels x .. x+3; out of line, so that the
- * scan over the (mostly empty) row keeps its registers. */
-__attribute__((noinline)) u32 edgeGroup(const EdgeRowCtx &e, int x, std::int32_t thr)
-{
-	u32 v = 0;
-	for (u32 edges = nmsGroup(e, x, thr); edges; edges &= edges - 1) {
-		const int i = __builtin_ctz(edges);
-		v |= (isCornerV6(e.pairs, x + i, e.twoT) ? EdgeMap::kEdge | EdgeMap::kCorner : EdgeMap::kEdge)
-		     << (8 * i);
-	}
-	return v;
+	return isCornerV6(e.pairs, x, twoT) ? EdgeMap::kEdge | EdgeMap::kCorner : EdgeMap::kEdge;
 }
 
 /* The edge pass over the groups of eight pixels of a row, in one assembly
  * function (GCC's code for the group work spilled): frappe_armv6_edge_row8.
  *
- * Scan: one LDM of eight magnitudes, their OR against the threshold, two
- * word stores of zeros: 15 instructions per eight pixels. A group whose OR
- * is above it ("hit"): for each half whose OR is above, non-maximum
- * suppression of its four pixels as in nmsGroup, but |gx|, |gy| by
- * SSUB16 + SEL on the pair and the direction tests by SMUSD / SMUSDX with
- * (53, 128); then the corner test of each edge pixel as isCornerV6 (its
- * three rows of three pairs by LDM), and the eight result bytes from two
- * 16-entry tables. */
+ * Scan: one LDM of eight magnitudes, their OR against the least threshold
+ * of any pixel, two word stores of zeros: 15 instructions per eight pixels.
+ * A group whose OR is above it: the least smoothed value of its pixels
+ * (one LDM of pixels 8g .. 8g+10, USUB16 + SEL) gives a threshold no
+ * pixel's is below, and the group is empty if the OR is not above that
+ * ("hit" otherwise). Then, for each half whose OR is above it, non-maximum
+ * suppression of its pixels above the group's threshold; a local maximum
+ * is then tested against its own (a table lookup), unless every pixel's
+ * is the group's (the threshold of full light); |gx|, |gy| by SSUB16 + SEL on the
+ * pair and the direction tests by SMUSD / SMUSDX with (53, 128). Then the
+ * corner test of each edge pixel as isCornerV6 (its three rows of three
+ * pairs by LDM) against its own threshold, and the eight result bytes from
+ * a 16-entry table. */
 struct EdgeRowAsm {
 	std::int32_t du, dd, dp1, k;	  ///< 0: up, down, pairs[1] minus mid (bytes); k = (53, 128)
-	std::int32_t dq0, dq1, dq2, twoT; ///< 16: pairs[r] minus mid plus 88 (bytes); 2T
-	const std::int32_t *pm;		  ///< 32: mid + first pixel of the first group
-	std::uint8_t *po;		  ///< 36: out + that pixel
+	std::int32_t dq0, dq1, dq2, unused; ///< 16: pairs[r] minus mid plus 88 (bytes)
+	const std::int32_t *pm;		  ///< 32: mid (groups from pixel 0)
+	std::uint8_t *po;		  ///< 36: out
 	const std::int32_t *end;	  ///< 40: pm + 8 * groups (groups >= 1)
-	std::int32_t thr;		  ///< 44
+	std::int32_t least;		  ///< 44: no pixel's edge threshold is below it
 	u32 any;			  ///< 48: out: the OR of the edge bits found
+	u32 sdelta;			  ///< 52: smoothed row - (mid + 32) / 2, as addresses
+	const std::int32_t *table;	  ///< 56: LightTable::t
 };
-static_assert(offsetof(EdgeRowAsm, pm) == 32 && offsetof(EdgeRowAsm, any) == 48);
+static_assert(offsetof(EdgeRowAsm, pm) == 32 && offsetof(EdgeRowAsm, any) == 48 &&
+	      offsetof(EdgeRowAsm, table) == 56);
 
 extern "C" void frappe_armv6_edge_row8(EdgeRowAsm *a);
 
 /* Registers. Scan: r4 pm (after the group once loaded), r5 po, r6 end,
- * r7 thr, r8 zero, lr any; r0-r3, r9-r12 the magnitudes. Hit: r4-r8 and
- * lr saved; r1 up, r2 down, r3 pairs (all at pm), r10 k, r11 mask, r0 m,
- * r12 the pair, r5 |pair| / previous, r6 next, r9 the upper half's OR.
- * Corners: r1-r3 the pairs rows (see dq), r7 2T, r8 corner bits, r11 the
- * edge bits left, r0 the lowest, r12 its CLZ, r4 Sxx + Syy, r5 Sxx - Syy,
- * r6 Sxy, r9 r10 lr one row's three pairs. */
+ * r7 least, r8 zero, lr any; r0-r3, r9-r12 the magnitudes. Hit: r4-r9 and
+ * lr saved (r9, the upper half's OR, read back from the stack); r9 the
+ * group's smoothed values (pixel 8g at 0: sdelta + pm / 2), lr the table, r7 the group's threshold, r1 up, r2 down, r3
+ * pairs (all at pm), r10 k, r11 mask, r0 m, r12 the pair, r5 |pair| /
+ * previous / the pixel's threshold, r6 next. Corners: the smoothed base,
+ * the edge bits and the table + 4 pushed; r1-r3 the pairs rows (see dq),
+ * r7 the pixel's -2T, r8 corner bits, r11 the edge bits left, r0 the
+ * lowest, r12 its CLZ, r4 Sxx + Syy - 2T, r5 Sxx - Syy, r6 Sxy, r9 r10 lr one
+ * row's three pairs. */
 __asm__(R"(
 	.text
 	.arm
@@ -562,7 +554,11 @@ frappe_armv6_edge_row8:
 	str     lr, [r0, #48]
 	pop     {r0, r4-r11, pc}
 
-	.macro  FE8_NMS off, bit
+	@ Pixel at \off bytes from pm, bit \bit of the mask; \own: r7 is
+	@ only the group's least threshold, and a local maximum is held to its
+	@ own (its smoothed value at \soff from r9): after the NMS, as most
+	@ pixels above r7 are above their own too.
+	.macro  FE8_NMS off, bit, own=0, soff=0
 	ldr     r0, [r4, #\off]
 	cmp     r0, r7
 	ble     .Lfe8_n\@
@@ -592,7 +588,15 @@ frappe_armv6_edge_row8:
 	cmp     r0, r5
 	ble     .Lfe8_n\@
 	cmp     r0, r6
+	.if \own
+	blt     .Lfe8_n\@
+	ldrh    r5, [r9, #\soff]
+	ldr     r5, [lr, r5, lsl #3]
+	cmp     r0, r5
+	orrgt   r11, r11, #\bit
+	.else
 	orrge   r11, r11, #\bit
+	.endif
 .Lfe8_n\@:
 	.endm
 
@@ -600,7 +604,7 @@ frappe_armv6_edge_row8:
 	sub     lr, \rp, r12, lsl #2
 	ldm     lr, {r9, r10, lr}
 	.if \first
-	smuad   r4, r9, r9
+	smlad   r4, r9, r9, r7              @ from -2T
 	smusd   r5, r9, r9
 	smultb  r6, r9, r9
 	.else
@@ -616,56 +620,41 @@ frappe_armv6_edge_row8:
 	smlatb  r6, lr, lr, r6
 	.endm
 
-.Lfe8_hit:                                  @ r0: OR of the lower half, r9: upper
-	push    {r4-r8, lr}
-	ldr     r12, [sp, #24]
-	ldm     r12, {r1, r2, r3, r10}
-	add     r1, r1, r4
-	add     r2, r2, r4
-	add     r3, r3, r4
-	mov     r11, #0
-	cmp     r0, r7
-	ble     .Lfe8_hi
-	FE8_NMS -32, 1
-	FE8_NMS -28, 2
-	FE8_NMS -24, 4
-	FE8_NMS -20, 8
-.Lfe8_hi:
-	cmp     r9, r7
-	ble     .Lfe8_nmsdone
-	FE8_NMS -16, 16
-	FE8_NMS -12, 32
-	FE8_NMS -8, 64
-	FE8_NMS -4, 128
-.Lfe8_nmsdone:
-	cmp     r11, #0                     @ also clears V for the loop below
-	bne     .Lfe8_corners
-	pop     {r4-r8, lr}
-	str     r8, [r5], #4
-	str     r8, [r5], #4
-	cmp     r4, r6
-	bne     .Lfe8_scan
-	b       .Lfe8_done
-
-.Lfe8_corners:
-	push    {r11}
-	ldr     r12, [sp, #28]
+	@ The corner test of each edge pixel (r11), as isCornerV6; \same: every
+	@ pixel's -2T is full light's, else each looks its own up.
+	.macro  FE8_CORNERS same
+	.if \same
+	ldr     r7, [lr, #2044]
+	push    {r11}                       @ a at [sp, #32]
+	ldr     r12, [sp, #32]
+	.else
+	add     lr, lr, #4
+	push    {r9, r11, lr}               @ smoothed base, edge bits, table + 4; a at [sp, #40]
+	ldr     r12, [sp, #40]
+	.endif
 	add     r12, r12, #16
-	ldm     r12, {r1, r2, r3, r7}
+	ldm     r12, {r1, r2, r3}
 	add     r1, r1, r4
 	add     r2, r2, r4
 	add     r3, r3, r4
 	mov     r8, #0
-.Lfe8_cl:                                   @ V is clear here (CMP with 0 or of two values below 2^31)
+.Lfe8_cl\@:                                 @ V is clear here (CMP with 0 or of two values below 2^31)
 	rsb     r12, r11, #0
 	and     r0, r11, r12                @ the lowest edge bit, pixel i
 	clz     r12, r0                     @ 31 - i
+	.if !\same
+	adr     r9, .Lfe8_soff
+	ldrb    r9, [r9, r12]
+	ldr     r7, [sp]
+	ldrh    r9, [r7, r9]
+	ldr     r7, [sp, #8]
+	ldr     r7, [r7, r9, lsl #3]        @ -2T of the pixel
+	.endif
 	FE8_ROW r1, 1
 	FE8_ROW r2, 0
 	FE8_ROW r3, 0
-	sub     r4, r4, r7
 	movs    r4, r4, asr #9              @ c
-	ble     .Lfe8_cn
+	ble     .Lfe8_cn\@
 	cmp     r5, #0
 	rsblt   r5, r5, #0
 	asr     r5, r5, #9                  @ a
@@ -677,10 +666,95 @@ frappe_armv6_edge_row8:
 	mul     r10, r4, r4
 	cmp     r10, r9
 	orrgt   r8, r8, r0
-.Lfe8_cn:
+.Lfe8_cn\@:
 	bics    r11, r11, r0
-	bne     .Lfe8_cl
+	bne     .Lfe8_cl\@
+	.if \same
 	pop     {r11}
+	b       .Lfe8_bytes
+	.else
+	pop     {r9, r11, lr}
+	.endif
+	.endm
+
+.Lfe8_hit:                                  @ r0: OR of the lower half, r9: upper, r1: both
+	push    {r4-r9, lr}                 @ a at [sp, #28], r9 at [sp, #20]
+	ldr     r12, [sp, #28]
+	add     r12, r12, #52
+	ldm     r12, {r2, r3}               @ sdelta, table
+	add     r9, r2, r4, lsr #1
+	ldm     r9, {r2, r5, r6, r7}        @ pixels 8g .. 8g+7
+	usub16  r10, r2, r5
+	sel     r2, r5, r2
+	usub16  r10, r6, r7
+	sel     r6, r7, r6
+	usub16  r10, r2, r6
+	sel     r2, r6, r2
+	uxth    r5, r2
+	cmp     r5, r2, lsr #16
+	movhi   r5, r2, lsr #16             @ the least smoothed value
+	ldr     r7, [r3, r5, lsl #3]        @ no pixel's threshold is below its
+	cmp     r1, r7
+	ble     .Lfe8_none
+	mov     lr, r3
+	ldr     r12, [sp, #28]
+	ldm     r12, {r1, r2, r3, r10}
+	add     r1, r1, r4
+	add     r2, r2, r4
+	add     r3, r3, r4
+	mov     r8, #0
+	mov     r11, #0
+	ldr     r12, [lr, #2040]            @ the threshold in full light, the greatest
+	cmp     r7, r12
+	beq     .Lfe8_same
+	cmp     r0, r7
+	ble     .Lfe8_hi
+	FE8_NMS -32, 1, 1, 0
+	FE8_NMS -28, 2, 1, 4
+	FE8_NMS -24, 4, 1, 2
+	FE8_NMS -20, 8, 1, 6
+.Lfe8_hi:
+	ldr     r0, [sp, #20]
+	cmp     r0, r7
+	ble     .Lfe8_nmsdone
+	FE8_NMS -16, 16, 1, 8
+	FE8_NMS -12, 32, 1, 12
+	FE8_NMS -8, 64, 1, 10
+	FE8_NMS -4, 128, 1, 14
+	b       .Lfe8_nmsdone
+.Lfe8_same:                                 @ every pixel's threshold is r7
+	cmp     r0, r7
+	ble     .Lfe8_samehi
+	FE8_NMS -32, 1
+	FE8_NMS -28, 2
+	FE8_NMS -24, 4
+	FE8_NMS -20, 8
+.Lfe8_samehi:
+	ldr     r0, [sp, #20]
+	cmp     r0, r7
+	ble     .Lfe8_samedone
+	FE8_NMS -16, 16
+	FE8_NMS -12, 32
+	FE8_NMS -8, 64
+	FE8_NMS -4, 128
+	b       .Lfe8_samedone
+.Lfe8_nmsdone:
+	cmp     r11, #0                     @ also clears V for the corner loop
+	bne     .Lfe8_corners
+.Lfe8_none:
+	pop     {r4-r9, lr}
+	str     r8, [r5], #4
+	str     r8, [r5], #4
+	cmp     r4, r6
+	bne     .Lfe8_scan
+	b       .Lfe8_done
+.Lfe8_samedone:
+	cmp     r11, #0
+	beq     .Lfe8_none
+	FE8_CORNERS 1
+.Lfe8_corners:
+	FE8_CORNERS 0
+.Lfe8_bytes:
 	adr     r12, .Lfe8_spread
 	and     r0, r11, #15
 	ldr     r0, [r12, r0, lsl #2]
@@ -695,7 +769,7 @@ frappe_armv6_edge_row8:
 	ldr     r2, [r12, r2, lsl #2]
 	add     r1, r1, r2, lsl #1
 .Lfe8_out:
-	pop     {r4-r8, lr}
+	pop     {r4-r9, lr}
 	str     r0, [r5], #4
 	str     r1, [r5], #4
 	orr     lr, lr, r11
@@ -708,9 +782,12 @@ frappe_armv6_edge_row8:
 	.word   0x00010000, 0x00010001, 0x00010100, 0x00010101
 	.word   0x01000000, 0x01000001, 0x01000100, 0x01000101
 	.word   0x01010000, 0x01010001, 0x01010100, 0x01010101
+	.set    .Lfe8_soff, . - 24          @ indexed by 31 - i: pixel i's smoothed offset
+	.byte   14, 10, 12, 8, 6, 2, 4, 0
 	.size frappe_armv6_edge_row8, .-frappe_armv6_edge_row8
 	.purgem FE8_NMS
 	.purgem FE8_ROW
+	.purgem FE8_CORNERS
 )"
 #if defined(__thumb__)
 	"\t.thumb\n"
@@ -721,20 +798,23 @@ bool edgeRowV6(const GradRows &rows, int w, const FrontEndParams &params, std::u
 {
 	out[0] = 0;
 	out[w - 1] = 0;
-	/* m >= 0 and m < 2^31: clamping the threshold keeps m > thr. */
-	const std::int32_t thr = static_cast<std::int32_t>(
-		std::clamp<std::int64_t>(params.edge_threshold_sq, -1, INT32_MAX));
-	const EdgeRowCtx e{ rows.mag[0], rows.mag[1], rows.mag[2], { rows.gx[0], rows.gx[1], rows.gx[2] },
-			    2 * static_cast<std::int32_t>(params.corner_threshold) };
+	LightTable own;
+	const LightTable &lt = lightTable(params, own);
+	const EdgeRowCtx e{ rows.mag[0], rows.mag[1], rows.mag[2], { rows.gx[0], rows.gx[1], rows.gx[2] } };
 	const std::int32_t *mid = rows.mag[1];
 	const int x1 = w - 1;
 	int x = 1;
 	u32 any = 0;
-	if (const int groups = (x1 - 1) / 8; groups > 0) {
+	/* Groups of eight from pixel 0, as the smoothed row's blocks: pixels 0
+	 * and w-1 (magnitude 0) are never edges while no threshold is
+	 * negative. A group's least smoothed value has the least threshold of
+	 * its pixels: thresholds rise with the light (light_floor >= 0). */
+	if (const int groups = w / 8; groups > 0 && params.light_floor >= 0 && lt.t[0][0] >= 0) {
 		auto bytesFromMid = [&](const void *p) {
 			return static_cast<std::int32_t>(reinterpret_cast<std::intptr_t>(p) -
 							 reinterpret_cast<std::intptr_t>(mid));
 		};
+		auto address = [](const void *p) { return static_cast<u32>(reinterpret_cast<std::uintptr_t>(p)); };
 		EdgeRowAsm a{ bytesFromMid(e.up),
 			      bytesFromMid(e.down),
 			      bytesFromMid(e.pairs[1]),
@@ -742,41 +822,33 @@ bool edgeRowV6(const GradRows &rows, int w, const FrontEndParams &params, std::u
 			      bytesFromMid(e.pairs[0]) + 88,
 			      bytesFromMid(e.pairs[1]) + 88,
 			      bytesFromMid(e.pairs[2]) + 88,
-			      e.twoT,
-			      mid + 1,
-			      out + 1,
-			      mid + 1 + 8 * groups,
-			      thr,
-			      0 };
+			      0,
+			      mid,
+			      out,
+			      mid + 8 * groups,
+			      lt.t[0][0],
+			      0,
+			      address(rows.smooth) - (address(mid) + 32) / 2,
+			      &lt.t[0][0] };
 		frappe_armv6_edge_row8(&a);
-		x = 1 + 8 * groups;
+		x = 8 * groups;
 		any = a.any;
-	}
-	for (; x + 4 <= x1; x += 4) {
-		/* Most pixels are far below the threshold: the OR of four
-		 * non-negative magnitudes bounds their maximum. */
-		const std::int32_t m0 = mid[x], m1 = mid[x + 1], m2 = mid[x + 2], m3 = mid[x + 3];
-		u32 v = 0;
-		if ((m0 | m1 | m2 | m3) > thr) {
-			v = edgeGroup(e, x, thr);
-			any |= v;
-		}
-		store32(out + x, v);
 	}
 	for (; x < x1; ++x) {
 		const std::int32_t m = mid[x];
-		const u32 v = m > thr ? edgePixel(e, x, m) : 0;
+		const std::int32_t *t = lt.t[getSmoothed(rows.smooth, x)];
+		const u32 v = m > t[0] ? edgePixel(e, x, m, -t[1]) : 0;
 		out[x] = static_cast<std::uint8_t>(v);
 		any |= v;
 	}
 	return any != 0;
 }
-
 } // namespace
 
-/* A tile's sixteen bytes by one LDM (edge rows are word aligned when the
- * width is a multiple of four): 8 instructions a tile, GCC's loop 14. The
- * occupancy bytes are 0 or 1, so storing 1 is ORing. */
+/* Two tiles' 32 bytes by one LDM (edge rows are word aligned when the
+ * width is a multiple of four): 12 instructions per two tiles, the loop of
+ * one tile a step 16, GCC's 28. The occupancy bytes are 0 or 1, so storing
+ * 1 is ORing. */
 __attribute__((optimize("omit-frame-pointer"))) void markTilesV6(const std::uint8_t *edgeRow, int w, std::uint8_t *tileRow)
 {
 	const int tiles = w / EdgeMap::kTile;
@@ -784,31 +856,44 @@ __attribute__((optimize("omit-frame-pointer"))) void markTilesV6(const std::uint
 		markTilesScalar(edgeRow, w, tileRow);
 		return;
 	}
+	static_assert(EdgeMap::kTile == 16);
 	const std::uint8_t *p = edgeRow;
 	std::uint8_t *t = tileRow;
-	const std::uint8_t *const end = edgeRow + EdgeMap::kTile * tiles;
-	static_assert(EdgeMap::kTile == 16);
-	/* LDM takes its registers in ascending order: named ones. */
-	register u32 a __asm__("r4"), b __asm__("r5"), c __asm__("r6"), d __asm__("r7");
-	/* Unified syntax for the conditional store (GCC's inline asm is
-	 * divided in ARM state; it switches back after the block); the IT is
-	 * for Thumb-2 and assembles to nothing in ARM state. */
-	__asm__ volatile(".syntax unified\n\t"
-			 "1:\n\t"
-			 "ldmia   %[p]!, {%[a], %[b], %[c], %[d]}\n\t"
-			 "orr     %[a], %[a], %[b]\n\t"
-			 "orr     %[c], %[c], %[d]\n\t"
-			 "orrs    %[a], %[a], %[c]\n\t"
-			 "it      ne\n\t"
-			 "strbne  %[one], [%[t]]\n\t"
-			 "add     %[t], %[t], #1\n\t"
-			 "cmp     %[p], %[end]\n\t"
-			 "bne     1b"
-			 : [p] "+r"(p), [t] "+r"(t), [a] "=&r"(a), [b] "=&r"(b), [c] "=&r"(c), [d] "=&r"(d)
-			 : [end] "r"(end), [one] "r"(1u)
-			 : "cc", "memory");
+	if (tiles >= 2) {
+		const std::uint8_t *const end = edgeRow + 2 * EdgeMap::kTile * (tiles / 2);
+		/* Unified syntax for the conditional stores (GCC's inline asm
+		 * is divided in ARM state; it switches back after the block);
+		 * the ITs are for Thumb-2 and assemble to nothing in ARM state. */
+		__asm__ volatile(".syntax unified\n\t"
+				 "1:\n\t"
+				 "ldmia   %[p]!, {r4-r11}\n\t"
+				 "orr     r4, r4, r5\n\t"
+				 "orr     r6, r6, r7\n\t"
+				 "orr     r8, r8, r9\n\t"
+				 "orr     r10, r10, r11\n\t"
+				 "orrs    r4, r4, r6\n\t"
+				 "it      ne\n\t"
+				 "strbne  %[one], [%[t]]\n\t"
+				 "orrs    r8, r8, r10\n\t"
+				 "it      ne\n\t"
+				 "strbne  %[one], [%[t], #1]\n\t"
+				 "add     %[t], %[t], #2\n\t"
+				 "cmp     %[p], %[end]\n\t"
+				 "bne     1b"
+				 : [p] "+r"(p), [t] "+r"(t)
+				 : [end] "r"(end), [one] "r"(1u)
+				 : "r4", "r5", "r6", "r7", "r8", "r9", "r10", "r11", "cc", "memory");
+	}
+	if (tiles & 1) {
+		std::uint32_t v[4];
+		std::memcpy(v, p, 16);
+		if (v[0] | v[1] | v[2] | v[3])
+			*t = 1;
+		p += EdgeMap::kTile;
+		++t;
+	}
 	if (EdgeMap::kTile * tiles < w)
-		markTilesScalar(end, w - EdgeMap::kTile * tiles, t);
+		markTilesScalar(p, w - EdgeMap::kTile * tiles, t);
 }
 
 const RowKernels &armv6RowKernels()

@@ -22,6 +22,15 @@
 //   and in 32-bit integers (the QPU multiplies 24 x 24 bits):
 //   c = (Sxx + Syy - 2T) >> 9, a = |Sxx - Syy| >> 9, b = |Sxy| >> 8
 //   (arithmetic shifts), corner when c > 0 and c*c > a*a + b*b.
+//   Both thresholds follow the light below mid-grey: at a pixel whose
+//   smoothed value is p, with q = min(p + light_floor, 128),
+//     edge_threshold_sq becomes E(q) = (((E' q) >> 7) q) >> 7, E' =
+//     min(edge_threshold_sq, 2^22) (no magnitude reaches 2^21), and
+//     corner_threshold T(q) = (((T q) >> 7) q) >> 7,
+//   so a marker whose black and white are a fifth of full light's keeps
+//   a fifth of its gradient and is held to a fifth of the threshold: a
+//   dim room, a shadow. light_floor keeps the thresholds of the darkest
+//   pixels above sensor noise; 128 or more gives the paper's absolute ones.
 // The region map (EdgeMap::regions, region_map.cpp), from the same frame s
 // (scaled when the edge map is), W x H, at w = W/2, h = H/2 (rounded down;
 // none when either is below 3 or region_contrast is 0):
@@ -29,8 +38,13 @@
 //   tiles of 4 x 4 r pixels (the last row and column of tiles may be
 //   partial): lo and hi, the least and greatest r over the 3 x 3 tiles
 //   around a pixel's tile (those that exist)
-//   dark: hi - lo >= region_contrast and r < (lo + hi + 1) >> 1, never on
-//   the outermost row and column of the map.
+//   dark: hi - lo >= C(lo, hi) and r < (lo + hi + 1) >> 1, never on the
+//   outermost row and column of the map, where the contrast follows the
+//   light as the thresholds do: C = (region_contrast *
+//   min(lo + hi + 2 light_floor, 256) + 255) >> 8.
+// The shade map (EdgeMap::shades), when light_floor < 128: the same map
+// but for the midpoint, dark where hi - lo >= C(lo, hi) and
+// (r + 4)^2 < (lo + 4)(hi + 4).
 #include <algorithm>
 #include <cstdlib>
 #include <thread>
@@ -73,6 +87,7 @@ public:
 	void run(const ImageView &image, float scale, const FrontEndParams &params,
 		 EdgeMap &out) override;
 	bool makesRegionMap() const override { return true; }
+	bool makesShadeMap() const override { return true; }
 
 private:
 	void runBand(const detail::BandJob &job);
@@ -109,6 +124,7 @@ void CpuFrontEnd::run(const ImageView &image, float scale, const FrontEndParams 
 	if (w < 3 || h < 3) {
 		std::fill(out.pixels.begin(), out.pixels.end(), 0);
 		out.regions.resize(0, 0);
+		out.shades.resize(0, 0);
 		return;
 	}
 
@@ -146,7 +162,7 @@ void CpuFrontEnd::run(const ImageView &image, float scale, const FrontEndParams 
 		band(0);
 	else
 		pool_.run(bands, band);
-	detail::regionMapFromMeans(w, h, out.scale, params.region_contrast, out.regions, regionScratch_);
+	detail::regionMapFromMeans(w, h, out.scale, params, out.regions, out.shades, regionScratch_);
 }
 
 /* Edge rows y0 .. y1-1 (1 <= y0, y1 <= h-1), and the means rows of the job. */

@@ -104,12 +104,13 @@ bool edgeSpan(const GradRows &rows, int x0, int x1, const FrontEndParams &params
 	const std::int32_t *down = rows.mag[2];
 	const std::int16_t *gxr = rows.gx[1];
 	const std::int16_t *gyr = rows.gy[1];
-	const std::int64_t thr = params.edge_threshold_sq;
+	const std::int32_t edgeT = edgeThreshold(params), cornerT = cornerThreshold(params);
+	const std::int32_t least = leastEdgeThreshold(params);
 	bool any = false;
 	for (int x = x0; x < x1; ++x) {
 		const std::int32_t m = mid[x];
 		std::uint8_t v = 0;
-		if (m > thr) {
+		if (m > least && m > params.relativeThreshold(edgeT, rows.smooth[x])) {
 			const int gx = gxr[x], gy = gyr[x];
 			const int ax = std::abs(gx), ay = std::abs(gy);
 			std::int32_t prev, next;
@@ -128,7 +129,7 @@ bool edgeSpan(const GradRows &rows, int x0, int x1, const FrontEndParams &params
 			}
 			if (m > prev && m >= next) {
 				v = EdgeMap::kEdge;
-				if (isCorner(rows, x, params.corner_threshold))
+				if (isCorner(rows, x, params.relativeThreshold(cornerT, rows.smooth[x])))
 					v |= EdgeMap::kCorner;
 				any = true;
 			}

@@ -19,6 +19,9 @@ struct GradRows {
 	const std::int16_t *gx[3];
 	const std::int16_t *gy[3];
 	const std::int32_t *mag[3];
+	/// The middle row smoothed (smoothRow's), whose brightness scales the
+	/// thresholds; in the ARMv6 kernels' lane-split layout there.
+	const std::uint8_t *smooth = nullptr;
 };
 
 /// Per-thread scratch: rings of smoothed rows and of gradient rows.
@@ -62,6 +65,25 @@ void gradientRow(const std::uint8_t *a, const std::uint8_t *b, const std::uint8_
 
 /// The gradient row of the outermost image rows: all zero (2w values of gx).
 void zeroGradientRow(int w, std::int16_t *gx, std::int16_t *gy, std::int32_t *mag);
+
+/// The edge threshold the contract compares with: edge_threshold_sq capped
+/// where no magnitude reaches (2^22), so that relativeThreshold() stays in
+/// 32 bits.
+inline std::int32_t edgeThreshold(const FrontEndParams &params)
+{
+	return static_cast<std::int32_t>(std::clamp<std::int64_t>(params.edge_threshold_sq, -1, std::int64_t{ 1 } << 22));
+}
+/// corner_threshold as the contract uses it (validate() keeps it below 2^23).
+inline std::int32_t cornerThreshold(const FrontEndParams &params)
+{
+	return static_cast<std::int32_t>(std::clamp<std::int64_t>(params.corner_threshold, 0, (std::int64_t{ 1 } << 23) - 1));
+}
+/// The least edge threshold of any pixel (that of a black one): magnitudes
+/// at or below it are never edges.
+inline std::int32_t leastEdgeThreshold(const FrontEndParams &params)
+{
+	return params.relativeThreshold(edgeThreshold(params), 0);
+}
 
 /// Non-maximum suppression, edge threshold and corner test of the middle
 /// row. Writes w bytes; returns whether any pixel is an edge.
@@ -195,6 +217,7 @@ void runBandRows(const Kernels &k, const BandJob &job)
 			{ s.gx[(y - 1) % 3].data(), s.gx[y % 3].data(), s.gx[next % 3].data() },
 			{ s.gy[(y - 1) % 3].data(), s.gy[y % 3].data(), s.gy[next % 3].data() },
 			{ s.mag[(y - 1) % 3].data(), s.mag[y % 3].data(), s.mag[next % 3].data() },
+			smoothed(y),
 		};
 		std::uint8_t *edgeRow = out.pixels.data() + static_cast<std::size_t>(y) * w;
 		const bool any = k.edge(rows, w, params, edgeRow);

@@ -237,9 +237,17 @@ bool EdgeRow(const GradRows &rows, int w, const FrontEndParams &params, std::uin
 	const std::int32_t *down = rows.mag[2];
 	const std::int16_t *pr[3] = { rows.gx[0], rows.gx[1], rows.gx[2] };
 	auto pairs = [&](int r, int x) { return hn::LoadU(d16, pr[r] + 2 * x); };
-	/* Thresholds beyond the largest magnitude can never pass. */
-	const auto thr = hn::Set(d32, static_cast<std::int32_t>(
-					      std::min<std::int64_t>(params.edge_threshold_sq, 1 << 30)));
+	/* The thresholds of each pixel follow its smoothed brightness
+	 * (FrontEndParams::relativeThreshold); none is below a black pixel's. */
+	const std::uint8_t *bright = rows.smooth;
+	const auto least = hn::Set(d32, leastEdgeThreshold(params));
+	const auto edgeT = hn::Set(d32, edgeThreshold(params));
+	const auto cornerT = hn::Set(d32, cornerThreshold(params));
+	const auto floor = hn::Set(d32, params.light_floor);
+	const auto reference = hn::Set(d32, FrontEndParams::kLightReference);
+	auto relative = [&](const auto &t, const auto &q) FRAPPE_INLINE_LAMBDA {
+		return hn::ShiftRight<7>(hn::Mul(hn::ShiftRight<7>(hn::Mul(t, q)), q));
+	};
 	/* As pairs: 106|gx| - 256|gy| >= 0 is horizontal, 106|gy| - 256|gx|
 	 * >= 0 vertical (the scalar rule's 256|gy| <= 106|gx| and so on). */
 	auto pair = [&](std::int16_t lo, std::int16_t hi) {
@@ -251,7 +259,6 @@ bool EdgeRow(const GradRows &rows, int w, const FrontEndParams &params, std::uin
 	const auto lowHalf = hn::BitCast(d16, hn::Set(d32, 0xFFFF));
 	const auto zero = hn::Zero(d32);
 	const auto gyPositive = hn::Set(d32, 0xFFFF); /* P > 0xFFFF exactly when gy > 0 */
-	const auto twoT = hn::Set(d32, 2 * static_cast<std::int32_t>(params.corner_threshold));
 
 	bool any = false;
 	out[0] = 0;
@@ -276,9 +283,15 @@ bool EdgeRow(const GradRows &rows, int w, const FrontEndParams &params, std::uin
 	/* Classifies the N pixels from x. */
 	auto edgeVector = [&](int x) FRAPPE_INLINE_LAMBDA {
 		const auto m = hn::LoadU(d32, mid + x);
-		const auto strong = hn::Lt(thr, m);
 		auto bytes = hn::Zero(d8);
-		if (!hn::AllFalse(d32, strong)) {
+		/* Each pixel's own threshold only where some magnitude passes a
+		 * black pixel's; the suppression and corner test only where one
+		 * passes its own. */
+		const bool some = !hn::AllFalse(d32, hn::Lt(least, m));
+		const auto q = hn::Min(hn::Add(hn::PromoteTo(d32, hn::LoadU(d8, bright + x)), floor), reference);
+		const auto strong = hn::Lt(relative(edgeT, q), m);
+		if (some && !hn::AllFalse(d32, strong)) {
+			const auto twoT = hn::ShiftLeft<1>(relative(cornerT, q));
 			const auto p = pairs(1, x);
 			const auto absP = hn::Abs(p);
 			const auto horizontal = PairDot(d32, absP, kHorizontal);
@@ -352,7 +365,7 @@ bool EdgeRow(const GradRows &rows, int w, const FrontEndParams &params, std::uin
 	for (; x + 4 * N <= w - 1; x += 4 * N) {
 		const auto m01 = hn::Max(hn::LoadU(d32, mid + x), hn::LoadU(d32, mid + x + N));
 		const auto m23 = hn::Max(hn::LoadU(d32, mid + x + 2 * N), hn::LoadU(d32, mid + x + 3 * N));
-		if (hn::AllFalse(d32, hn::Lt(thr, hn::Max(m01, m23)))) {
+		if (hn::AllFalse(d32, hn::Lt(least, hn::Max(m01, m23)))) {
 			hn::StoreU(hn::Zero(du8), du8, out + x);
 			continue;
 		}

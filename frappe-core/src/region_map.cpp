@@ -248,26 +248,37 @@ void halveImage(const ImageView &src, std::uint8_t *out)
 		decimateRow(src.row(2 * y), src.row(2 * y + 1), w, out + static_cast<std::size_t>(y) * w);
 }
 
-void regionMap(const ImageView &src, float srcScale, int minContrast, TraceMap &out, RegionScratch &s)
+void regionMap(const ImageView &src, float srcScale, const FrontEndParams &params, TraceMap &out,
+	       TraceMap &shades, RegionScratch &s)
 {
-	if (!makesRegionMap(src.width, src.height, minContrast)) {
+	if (!makesRegionMap(src.width, src.height, params.region_contrast)) {
 		out.resize(0, 0);
+		shades.resize(0, 0);
 		return;
 	}
 	s.decimated.resize(static_cast<std::size_t>(src.width / 2) * (src.height / 2));
 	halveImage(src, s.decimated.data());
-	regionMapFromMeans(src.width, src.height, srcScale, minContrast, out, s);
+	regionMapFromMeans(src.width, src.height, srcScale, params, out, shades, s);
 }
 
-void regionMapFromMeans(int width, int height, float srcScale, int minContrast, TraceMap &out, RegionScratch &s)
+void regionMapFromMeans(int width, int height, float srcScale, const FrontEndParams &params, TraceMap &out,
+			TraceMap &shades, RegionScratch &s)
 {
 	const int w = width / 2, h = height / 2;
-	if (!makesRegionMap(width, height, minContrast)) {
+	if (!makesRegionMap(width, height, params.region_contrast)) {
 		out.resize(0, 0);
+		shades.resize(0, 0);
 		return;
 	}
 	out.resize(w, h);
 	out.scale = srcScale / 2.0f;
+	const bool shaded = params.makesShades();
+	if (shaded) {
+		shades.resize(w, h);
+		shades.scale = out.scale;
+	} else {
+		shades.resize(0, 0);
+	}
 	constexpr int T = kRegionTile;
 	const int tx = (w + T - 1) / T, ty = (h + T - 1) / T;
 	const std::size_t nt = static_cast<std::size_t>(tx) * ty;
@@ -330,15 +341,36 @@ void regionMapFromMeans(int width, int height, float srcScale, int minContrast, 
 	spreadTilesScalar(s.tileMin.data(), s.tileMax.data(), tx, ty, s.spread.data());
 #endif
 
-	std::fill(out.tiles.begin(), out.tiles.end(), 0);
-	std::fill_n(out.pixels.data(), w, 0);
-	std::fill_n(out.pixels.data() + static_cast<std::size_t>(h - 1) * w, w, 0);
+	for (TraceMap *map : { &out, &shades }) {
+		if (map->width == 0)
+			continue;
+		std::fill(map->tiles.begin(), map->tiles.end(), 0);
+		std::fill_n(map->pixels.data(), w, 0);
+		std::fill_n(map->pixels.data() + static_cast<std::size_t>(h - 1) * w, w, 0);
+	}
 	constexpr int ET = TraceMap::kTile;
 	std::uint8_t *mid = s.mid.data();
+	if (shaded)
+		s.shadeMid.resize(s.mid.size());
+	std::uint8_t *shadeMid = s.shadeMid.data();
 #ifndef FRAPPE_HAVE_ARMV6_REGION
 	std::uint8_t *acc = s.lo.data(); /* the OR of a tile row's dark rows */
-	bool accAny = false;
+	bool accAny = false, shadeAny = false;
 	std::fill_n(acc, w, 0);
+	if (shaded)
+		s.shadeAcc.assign(static_cast<std::size_t>(w), 0);
+	std::uint8_t *shadeAcc = s.shadeAcc.data();
+	/* Each tile row's tile mask from the OR of its dark rows. */
+	auto markTileRow = [&](TraceMap &map, std::uint8_t *rowOr, int y) {
+		std::uint8_t *tileRow = map.tiles.data() + static_cast<std::size_t>(y / ET) * map.tiles_x;
+		for (int t = 0; t < map.tiles_x; ++t) {
+			std::uint8_t any = 0;
+			for (int x = t * ET; x < std::min(w, (t + 1) * ET); ++x)
+				any |= rowOr[x];
+			tileRow[t] = any;
+		}
+		std::fill_n(rowOr, w, 0);
+	};
 #endif
 	for (int j = 0; j < ty; ++j) {
 		/* The threshold of each tile of this row: the midpoint, rounded
@@ -348,33 +380,52 @@ void regionMapFromMeans(int width, int height, float srcScale, int minContrast, 
 		const std::uint8_t *tmax = s.tileMax.data() + static_cast<std::size_t>(j) * tx;
 		for (int i = 0; i < tx; ++i) {
 			const int lo = tmin[i], hi = tmax[i];
-			const std::uint32_t m = hi - lo >= minContrast ? static_cast<std::uint32_t>((lo + hi + 1) >> 1) : 0u;
+			const std::uint32_t m = hi - lo >= params.relativeRegionContrast(lo, hi)
+							? static_cast<std::uint32_t>((lo + hi + 1) >> 1)
+							: 0u;
 			const std::uint32_t word = m * 0x01010101u;
 			std::memcpy(mid + i * T, &word, 4); /* mid has room for whole tiles */
+			if (shaded) {
+				const std::uint32_t g = m ? static_cast<std::uint32_t>(FrontEndParams::shadeThreshold(lo, hi)) : 0u;
+				const std::uint32_t gword = g * 0x01010101u;
+				std::memcpy(shadeMid + i * T, &gword, 4);
+			}
 		}
 		mid[0] = mid[w - 1] = 0; /* the outermost columns are never dark */
+		if (shaded)
+			shadeMid[0] = shadeMid[w - 1] = 0;
 		for (int y = std::max(1, j * T); y < std::min(h - 1, (j + 1) * T); ++y) {
 			std::uint8_t *o = out.pixels.data() + static_cast<std::size_t>(y) * w;
 #ifdef FRAPPE_HAVE_ARMV6_REGION
 			/* Each row marks its tiles itself: no row of ORs. */
 			darkRowV6(dec + static_cast<std::size_t>(y) * w, mid, w, o,
 				  out.tiles.data() + static_cast<std::size_t>(y / ET) * out.tiles_x);
+			if (shaded)
+				darkRowV6(dec + static_cast<std::size_t>(y) * w, shadeMid, w,
+					  shades.pixels.data() + static_cast<std::size_t>(y) * w,
+					  shades.tiles.data() + static_cast<std::size_t>(y / ET) * shades.tiles_x);
 #else
 			if (darkRow(dec + static_cast<std::size_t>(y) * w, mid, w, o)) {
 				for (int x = 0; x < w; ++x)
 					acc[x] |= o[x];
 				accAny = true;
 			}
-			if (accAny && ((y + 1) % ET == 0 || y + 1 == h - 1)) {
-				std::uint8_t *tileRow = out.tiles.data() + static_cast<std::size_t>(y / ET) * out.tiles_x;
-				for (int t = 0; t < out.tiles_x; ++t) {
-					std::uint8_t any = 0;
-					for (int x = t * ET; x < std::min(w, (t + 1) * ET); ++x)
-						any |= acc[x];
-					tileRow[t] = any;
+			if (shaded) {
+				std::uint8_t *so = shades.pixels.data() + static_cast<std::size_t>(y) * w;
+				if (darkRow(dec + static_cast<std::size_t>(y) * w, shadeMid, w, so)) {
+					for (int x = 0; x < w; ++x)
+						shadeAcc[x] |= so[x];
+					shadeAny = true;
 				}
-				std::fill_n(acc, w, 0);
+			}
+			const bool tileRowEnds = (y + 1) % ET == 0 || y + 1 == h - 1;
+			if (accAny && tileRowEnds) {
+				markTileRow(out, acc, y);
 				accAny = false;
+			}
+			if (shadeAny && tileRowEnds) {
+				markTileRow(shades, shadeAcc, y);
+				shadeAny = false;
 			}
 #endif
 		}

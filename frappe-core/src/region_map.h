@@ -23,12 +23,16 @@ constexpr int kRegionTile = 4;
 struct RegionScratch {
 	std::vector<std::uint8_t> decimated; ///< the half-resolution image
 	std::vector<std::uint8_t> tileMin, tileMax, lo, mid, level, spread;
+	std::vector<std::uint8_t> shadeMid, shadeAcc; ///< the shade map's thresholds and row ORs
 };
 
-/// Fills `out` with the dark pixels of `src` at half its resolution;
-/// out.scale = srcScale / 2. Leaves `out` empty (0 x 0) when minContrast is
-/// 0 or `src` is too small for a 3 x 3 map.
-void regionMap(const ImageView &src, float srcScale, int minContrast, TraceMap &out, RegionScratch &scratch);
+/// Fills `out` with the dark pixels of `src` at half its resolution, and
+/// `shades` with those of the shade map (EdgeMap::shades);
+/// out.scale = shades.scale = srcScale / 2. Leaves `out` empty (0 x 0) when
+/// region_contrast is 0 or `src` is too small for a 3 x 3 map, `shades`
+/// also when params.makesShades() is false.
+void regionMap(const ImageView &src, float srcScale, const FrontEndParams &params, TraceMap &out,
+	       TraceMap &shades, RegionScratch &scratch);
 
 /// Whether regionMap() makes a map of a src.width x src.height frame.
 inline bool makesRegionMap(int width, int height, int minContrast)
@@ -39,8 +43,8 @@ inline bool makesRegionMap(int width, int height, int minContrast)
 /// regionMap() from the frame's 2x2 means already made (scratch.decimated,
 /// width / 2 x height / 2, as decimateRow makes them): the CPU front end
 /// makes them as it reads the frame's rows.
-void regionMapFromMeans(int width, int height, float srcScale, int minContrast, TraceMap &out,
-			RegionScratch &scratch);
+void regionMapFromMeans(int width, int height, float srcScale, const FrontEndParams &params, TraceMap &out,
+			TraceMap &shades, RegionScratch &scratch);
 
 /// out, (src.width / 2) x (src.height / 2) = decimateRow() of each pair of
 /// src's rows: the image at half resolution, as the region map makes it.

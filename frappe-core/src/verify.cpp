@@ -28,6 +28,16 @@ constexpr int kAmbiguityGap = 2;
  * take back what a blur of about a cell spreads into the neighbours. */
 constexpr float kSharpening = 0.25f;
 
+/* On the log scale a light grey beside black ink reads as white: a quiet
+ * zone read there must also hold a cell at least half as light, in grey
+ * levels, as the code's lightest (paper under the same light within a
+ * factor of two; a panel on a mid-grey wall is no marker). */
+constexpr float kPaperWhite = 0.5f;
+
+/* A cell whose mean is at least this grey level clips: what lies under it
+ * may be black ink under glare. */
+constexpr float kClipped = 250.0f;
+
 /* A candidate's payload must span at least this many grey levels (the
  * detector's rule for every read). */
 constexpr float kMinContrast = 10.0f;
@@ -57,13 +67,33 @@ double clearCellsChance(const Dictionary &dict, int clear, int errors)
 
 } // namespace
 
-CellRead readCells(const WarpedMarker &w, int bits, const Binarised &b, float weakMargin)
+bool quietZoneIsPaper(const QuietZone &q, const Binarised &b, Tone tone)
+{
+	if (tone.linear() || q.seen < 8)
+		return true;
+	const float white = tone.invert(b.threshold + 0.5f * b.contrast);
+	return q.brightest >= kPaperWhite * white;
+}
+
+CellRead readCells(const WarpedMarker &w, int bits, const Binarised &b, float weakMargin, Tone tone)
 {
 	const int cells = bits + 2;
 	const int k = std::max(1, w.side / cells);
 	const float thr = b.threshold;
 	const float clear = kStraddle * b.contrast;
 	const float half = 0.5f * b.contrast;
+	auto mean = [&](int cx, int cy) {
+		float sum = 0.0f;
+		for (int y = 0; y < k; ++y)
+			for (int x = 0; x < k; ++x)
+				sum += w.at(cx * k + x, cy * k + y);
+		return sum / static_cast<float>(k * k);
+	};
+	/* Glare: a black border cell at the sensor's ceiling. */
+	const float clip = tone.apply(kClipped);
+	bool glare = false;
+	for (int c = 0; c < cells && !glare; ++c)
+		glare = mean(c, 0) >= clip || mean(c, cells - 1) >= clip || mean(0, c) >= clip || mean(cells - 1, c) >= clip;
 	CellRead out;
 	out.margin = 1.0f;
 	for (int cy = 0; cy < cells; ++cy) {
@@ -81,7 +111,8 @@ CellRead readCells(const WarpedMarker &w, int bits, const Binarised &b, float we
 			if (cx == 0 || cy == 0 || cx > bits || cy > bits)
 				continue;
 			const float mean = sum / static_cast<float>(k * k);
-			const float margin = half > 0.0f ? std::min(std::abs(mean - thr) / half, 1.0f) : 0.0f;
+			const float margin = glare && mean >= clip ? 0.0f
+				: half > 0.0f ? std::min(std::abs(mean - thr) / half, 1.0f) : 0.0f;
 			out.margin = std::min(out.margin, margin);
 			out.weak = (out.weak << 1) | (margin < weakMargin ? 1u : 0u);
 		}
@@ -101,7 +132,7 @@ int clearErrors(const Dictionary &dict, std::uint64_t code, std::uint64_t weak, 
 }
 
 QuietZone readQuietZone(const ImageView &image, const std::array<Point2f, 4> &corners, int bits,
-			const Binarised &b)
+			const Binarised &b, Tone tone)
 {
 	const float threshold = b.threshold, black = b.threshold - kStraddle * b.contrast;
 	QuietZone out;
@@ -116,7 +147,9 @@ QuietZone readQuietZone(const ImageView &image, const std::array<Point2f, 4> &co
 		if (!(p.x >= 0.0f && p.y >= 0.0f && p.x <= maxX && p.y <= maxY))
 			return;
 		++out.seen;
-		const float v = sampleBilinear(image, p.x, p.y);
+		const float grey = sampleBilinear(image, p.x, p.y);
+		out.brightest = std::max(out.brightest, grey);
+		const float v = tone.apply(grey);
 		out.light += v > threshold;
 		out.dark += v < black;
 	};
@@ -269,7 +302,7 @@ MarkerRead readMarker(const ImageView &image, const std::array<Point2f, 4> &corn
 		out.rejection = Rejection::BorderNotBlack;
 		return out;
 	}
-	const CellRead cells = readCells(w, dict.bits, b, policy.weakMargin);
+	const CellRead cells = readCells(w, dict.bits, b, policy.weakMargin, policy.tone);
 	out.margin = cells.margin;
 	if (out.decoded.hamming > policy.maxHamming &&
 	    clearErrors(dict, b.code, cells.weak, out.decoded) > policy.maxHamming) {
@@ -283,17 +316,18 @@ MarkerRead readMarker(const ImageView &image, const std::array<Point2f, 4> &corn
 		 * that chance reads often must still sit on real cells, as judged
 		 * by samples a quarter cell from their edges. */
 		WarpedMarker quarters;
-		if (!warpMarker(image, corners, dict.bits, quarters)) {
+		if (!warpMarker(image, corners, dict.bits, quarters, policy.tone)) {
 			out.rejection = Rejection::CellsDisagree;
 			return out;
 		}
-		agreement = readCells(quarters, dict.bits, binarise(quarters, dict.bits), policy.weakMargin);
+		agreement = readCells(quarters, dict.bits, binarise(quarters, dict.bits), policy.weakMargin, policy.tone);
 	}
 	if (!cellsAgree(agreement, dict.bits, scrutiny)) {
 		out.rejection = Rejection::CellsDisagree;
 		return out;
 	}
-	if (!quietZoneIsLight(readQuietZone(image, corners, dict.bits, b), scrutiny)) {
+	const QuietZone quiet = readQuietZone(image, corners, dict.bits, b, policy.tone);
+	if (!quietZoneIsLight(quiet, scrutiny) || !quietZoneIsPaper(quiet, b, policy.tone)) {
 		out.rejection = Rejection::NoQuietZone;
 		return out;
 	}
@@ -306,7 +340,7 @@ MarkerRead readCellCentres(const ImageView &image, const std::array<Point2f, 4> 
 {
 	const int bits = codes.dictionary().bits;
 	float reference = 0.0f;
-	if (!warpCellCentres(image, corners, bits, kSharpening, scratch, &reference))
+	if (!warpCellCentres(image, corners, bits, kSharpening, scratch, &reference, policy.tone))
 		return {};
 	const Binarised b = binarise(scratch, bits);
 	const float lo = b.threshold - 0.5f * b.contrast, hi = b.threshold + 0.5f * b.contrast;
@@ -319,7 +353,7 @@ MarkerRead readCellCentres(const ImageView &image, const std::array<Point2f, 4> 
 	 * quarter-cell samples of large ones; the clearly read cells alone
 	 * must still single out a code. */
 	const Dictionary &dict = codes.dictionary();
-	const std::uint64_t weak = readCells(scratch, bits, b, policy.weakMargin).weak;
+	const std::uint64_t weak = readCells(scratch, bits, b, policy.weakMargin, policy.tone).weak;
 	const int clear = bits * bits - std::popcount(weak);
 	if (clearCellsChance(dict, clear, clearErrors(dict, b.code, weak, r.decoded)) > kWeakReadChance)
 		r.rejection = Rejection::WeakRead;

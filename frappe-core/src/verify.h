@@ -31,8 +31,11 @@ struct CellRead {
 };
 
 /// Reads the cells of `w` against b's threshold and contrast; code cells
-/// with a margin below `weakMargin` are weak.
-CellRead readCells(const WarpedMarker &w, int bits, const Binarised &b, float weakMargin);
+/// with a margin below `weakMargin` are weak. Glare: where a border cell
+/// (black ink) clips, so may any code cell, and every code cell that clips
+/// is unknown (weak, margin 0), left to the code's distance. `tone` is the
+/// scale the samples are on.
+CellRead readCells(const WarpedMarker &w, int bits, const Binarised &b, float weakMargin, Tone tone = {});
 
 /// The bits corrected to reach d's codeword that were read clearly (not
 /// weak).
@@ -44,12 +47,13 @@ struct QuietZone {
 	int light = 0; ///< ring cells lighter than the threshold
 	int dark = 0;  ///< ring cells clearly darker than it, as dark as a black cell
 	int seen = 0;  ///< ring cells inside the image (all others are unknown)
+	float brightest = 0.0f; ///< the lightest ring cell, in grey levels whatever the tone
 };
 
 /// Samples the centre of each of the 4 (bits + 3) cells one cell outside
 /// the border of the quad `corners`, against b's threshold and contrast.
 QuietZone readQuietZone(const ImageView &image, const std::array<Point2f, 4> &corners, int bits,
-			const Binarised &b);
+			const Binarised &b, Tone tone = {});
 
 /// Border cells that may read white before a candidate is rejected: blur
 /// and small cells brighten the frame next to the quiet zone, a corner may
@@ -85,6 +89,11 @@ Scrutiny scrutinyFor(const Dictionary &dict, int hamming);
 /// Always true when too little of the ring is in the image.
 bool quietZoneIsLight(const QuietZone &q, Scrutiny scrutiny = Scrutiny::Strict);
 
+/// On the log scale (Tone), where a light grey beside black ink reads as
+/// white, the ring's lightest cell must also be at least half as light, in
+/// grey levels, as the code's lightest sample; always true on grey levels.
+bool quietZoneIsPaper(const QuietZone &q, const Binarised &b, Tone tone);
+
 /// Few cells read on both sides of the threshold: one in eight of the
 /// code's number of cells, one in four under tolerant scrutiny (small
 /// cells at the edge of a marker's sharpness).
@@ -115,6 +124,7 @@ struct DecodePolicy {
 	int maxHamming = 0;       ///< bits read clearly that may be corrected
 	int maxTotal = 0;         ///< bits corrected in all, weak reads included
 	float weakMargin = 0.0f;  ///< a code cell's margin below this is a weak read
+	Tone tone;                ///< the scale samples are read on
 };
 
 /// Why a candidate is not a marker.

@@ -66,6 +66,7 @@ class Detector:
         scaled_size: float = 28.0,
         max_scaled_frames: int = 5,
         region_contrast: float = 0.16,
+        light_floor: float = 0.063,
         corner_cluster_radius: float = 4.0,
         min_marker_side: float = 10.0,
         max_pixels: int = 67108864,

@@ -193,6 +193,7 @@ py::dict PyDetector::configDict() const
 	d["scaled_size"] = config_.scaled_size;
 	d["max_scaled_frames"] = config_.max_scaled_frames;
 	d["region_contrast"] = config_.region_contrast;
+	d["light_floor"] = config_.light_floor;
 	d["corner_cluster_radius"] = config_.corner_cluster_radius;
 	d["min_marker_side"] = config_.min_marker_side;
 	d["max_pixels"] = config_.max_pixels;
@@ -203,7 +204,7 @@ py::dict PyDetector::configDict() const
 
 PyDetector *makeDetector(py::handle dictionary, const std::string &mode, float edge_threshold,
 			 float corner_threshold, int max_hamming, float weak_margin, float scaled_size,
-			 int max_scaled_frames, float region_contrast, float corner_cluster_radius,
+			 int max_scaled_frames, float region_contrast, float light_floor, float corner_cluster_radius,
 			 float min_marker_side, long long max_pixels, int max_candidates, int threads)
 {
 	DictionaryRef dict = dictionaryArg(dictionary);
@@ -220,6 +221,7 @@ PyDetector *makeDetector(py::handle dictionary, const std::string &mode, float e
 	c.scaled_size = scaled_size;
 	c.max_scaled_frames = max_scaled_frames;
 	c.region_contrast = region_contrast;
+	c.light_floor = light_floor;
 	c.corner_cluster_radius = corner_cluster_radius;
 	c.min_marker_side = min_marker_side;
 	c.max_pixels = max_pixels;
@@ -255,7 +257,7 @@ detect in parallel; with mode='ascale' one detector per video stream.)doc")
 		     py::arg("corner_threshold") = d.corner_threshold, py::arg("max_hamming") = d.max_hamming,
 		     py::arg("weak_margin") = d.weak_margin, py::arg("scaled_size") = d.scaled_size,
 		     py::arg("max_scaled_frames") = d.max_scaled_frames,
-		     py::arg("region_contrast") = d.region_contrast,
+		     py::arg("region_contrast") = d.region_contrast, py::arg("light_floor") = d.light_floor,
 		     py::arg("corner_cluster_radius") = d.corner_cluster_radius,
 		     py::arg("min_marker_side") = d.min_marker_side, py::arg("max_pixels") = d.max_pixels,
 		     py::arg("max_candidates") = d.max_candidates, py::arg("threads") = d.threads)

@@ -393,7 +393,8 @@ void checkLabels(std::size_t n, int misalign)
 }
 
 /* The documented rule of the region map, pixel by pixel. */
-std::vector<std::uint8_t> slowRegionMap(const Gray &g, int minContrast, int &w, int &h)
+std::vector<std::uint8_t> slowRegionMap(const Gray &g, int minContrast, int lightFloor, int &w, int &h,
+					bool shade = false)
 {
 	w = g.w / 2;
 	h = g.h / 2;
@@ -417,20 +418,38 @@ std::vector<std::uint8_t> slowRegionMap(const Gray &g, int minContrast, int &w, 
 							hi = std::max(hi, r[static_cast<std::size_t>(yy) * w + xx]);
 						}
 			out[static_cast<std::size_t>(y) * w + x] =
-				hi - lo >= minContrast && r[static_cast<std::size_t>(y) * w + x] < ((lo + hi + 1) >> 1);
+				hi - lo >= ((minContrast * std::min(lo + hi + 2 * lightFloor, 256) + 255) >> 8) &&
+				(shade ? (r[static_cast<std::size_t>(y) * w + x] + 4) * (r[static_cast<std::size_t>(y) * w + x] + 4) <
+						 (lo + 4) * (hi + 4)
+				       : r[static_cast<std::size_t>(y) * w + x] < ((lo + hi + 1) >> 1));
 		}
 	return out;
 }
 
 /* The whole region map (this build's: the ARMv6 kernels) against the rule,
  * pixels and tile mask; the number of dark pixels. */
-std::size_t compareRegionMap(const Gray &g, int contrast, const char *what)
+std::size_t compareRegionMap(const Gray &g, int contrast, const char *what, int lightFloor = 16)
 {
 	int w, h;
-	const auto want = slowRegionMap(g, contrast, w, h);
-	TraceMap map;
+	const auto want = slowRegionMap(g, contrast, lightFloor, w, h);
+	const auto wantShades = slowRegionMap(g, contrast, lightFloor, w, h, true);
+	TraceMap map, shades;
 	RegionScratch scratch;
-	regionMap(ImageView(g.px.data(), g.w, g.h, g.w), 1.0f, contrast, map, scratch);
+	frappe::FrontEndParams params;
+	params.region_contrast = contrast;
+	params.light_floor = lightFloor;
+	regionMap(ImageView(g.px.data(), g.w, g.h, g.w), 1.0f, params, map, shades, scratch);
+	if (w >= 3 && h >= 3 && lightFloor < 128) {
+		CHECK(shades.pixels == wantShades, "%s: shade map pixels", what);
+		for (int ty = 0; ty < shades.tiles_y; ++ty)
+			for (int tx = 0; tx < shades.tiles_x; ++tx) {
+				bool any = false;
+				for (int y = ty * 16; y < std::min(h, ty * 16 + 16); ++y)
+					for (int x = tx * 16; x < std::min(w, tx * 16 + 16); ++x)
+						any = any || wantShades[static_cast<std::size_t>(y) * w + x];
+				CHECK(!shades.tileEmpty(tx, ty) == any, "%s: shade tile %d,%d", what, tx, ty);
+			}
+	}
 	if (w < 3 || h < 3) {
 		CHECK(map.width == 0, "%s: a map of a frame too small", what);
 		return 0;
@@ -494,22 +513,39 @@ int main(int argc, char **argv)
 		{ 4740, 12354 }, { 0, 0 }, { 1, 1 }, { 400, 1000 }, { 40000, 200000 },
 		{ -5, -7 }, { INT64_C(1) << 40, INT64_C(1) << 40 }, { 2080799, 12354 },
 	};
+	/* Light floors: absolute thresholds (128), the Detector's default
+	 * (16), none (0); the thresholds of dark pixels follow their light. */
+	const int lightFloors[] = { FrontEndParams::kLightReference, 16, 0 };
 	int imageCases = 0;
 	for (const auto &[w, h] : { std::pair{ 640, 480 }, std::pair{ 37, 23 }, std::pair{ 3, 3 }, std::pair{ 4, 17 },
 				   std::pair{ 17, 5 }, std::pair{ 161, 97 } }) {
 		for (int noise : { 0, 3, 12 }) {
-			const Gray g = constructed(w, h, noise, static_cast<unsigned>(w * 131 + h * 7 + noise));
-			for (const FrontEndParams &p : params) {
-				char what[96];
-				std::snprintf(what, sizeof what, "constructed %dx%d noise %d thr %" PRId64 "/%" PRId64, w, h,
-					      noise, p.edge_threshold_sq, p.corner_threshold);
-				compareFrontEnds(g, p, 1.0f, what);
-				++imageCases;
-			}
-			if (w == 640) {
-				compareFrontEnds(g, params[0], 0.5f, "constructed 640x480 at scale 0.5");
-				compareFrontEnds(g, params[0], 0.37f, "constructed 640x480 at scale 0.37");
-				imageCases += 2;
+			/* The frame, and the frame in a dim room (a sixth of its light). */
+			for (int gain : { 255, 40 }) {
+				Gray g = constructed(w, h, noise, static_cast<unsigned>(w * 131 + h * 7 + noise));
+				for (auto &v : g.px)
+					v = static_cast<std::uint8_t>(v * gain / 255);
+				for (FrontEndParams p : params)
+					for (int lightFloor : lightFloors) {
+						if (gain != 255 && lightFloor == FrontEndParams::kLightReference)
+							continue;
+						p.light_floor = lightFloor;
+						char what[128];
+						std::snprintf(what, sizeof what,
+							      "constructed %dx%d noise %d gain %d thr %" PRId64 "/%" PRId64
+							      " floor %d",
+							      w, h, noise, gain, p.edge_threshold_sq, p.corner_threshold,
+							      lightFloor);
+						compareFrontEnds(g, p, 1.0f, what);
+						++imageCases;
+					}
+				if (w == 640 && gain == 255) {
+					FrontEndParams p = params[0];
+					p.light_floor = 16;
+					compareFrontEnds(g, p, 0.5f, "constructed 640x480 at scale 0.5");
+					compareFrontEnds(g, p, 0.37f, "constructed 640x480 at scale 0.37");
+					imageCases += 2;
+				}
 			}
 		}
 	}
@@ -581,7 +617,15 @@ int main(int argc, char **argv)
 			CHECK(false, "cannot read %s (binary PGM, maxval 255)", argv[i]);
 			continue;
 		}
-		edges += compareFrontEnds(g, params[0], 1.0f, argv[i]);
+		for (int lightFloor : lightFloors) {
+			FrontEndParams p = params[0];
+			p.light_floor = lightFloor;
+			char what[320];
+			std::snprintf(what, sizeof what, "%s floor %d", argv[i], lightFloor);
+			const std::size_t n = compareFrontEnds(g, p, 1.0f, what);
+			if (lightFloor == 16)
+				edges += n;
+		}
 		dark += compareRegionMap(g, 41, argv[i]); /* Config's default 0.16, as an intensity */
 		++files;
 	}

@@ -314,6 +314,7 @@ int main(int argc, char **argv)
 	std::string dictName = "aruco_mip_36h12", list, outF, outO, outA;
 	int repeat = 5, threads = 1;
 	float regionContrast = frappe::Config{}.region_contrast;
+	float lightFloor = frappe::Config{}.light_floor;
 	bool extras = true;
 	for (int i = 1; i < argc; ++i) {
 		const std::string a = argv[i];
@@ -340,11 +341,13 @@ int main(int argc, char **argv)
 			outA = value();
 		else if (a == "--region-contrast")
 			regionContrast = std::stof(value());
+		else if (a == "--light-floor")
+			lightFloor = std::stof(value());
 		else if (a == "--no-extras")
 			extras = false;
 		else {
 			std::cerr << "usage: frappe-bench --dictionary D --list L [--repeat N] [--threads T] "
-				     "[--out-frappe F] [--out-opencv O] [--out-apriltag PREFIX] [--region-contrast C] [--no-extras]\n";
+				     "[--out-frappe F] [--out-opencv O] [--out-apriltag PREFIX] [--region-contrast C] [--light-floor L] [--no-extras]\n";
 			return 2;
 		}
 	}
@@ -379,6 +382,7 @@ int main(int argc, char **argv)
 	cfg.dictionary = dictName;
 	cfg.threads = threads;
 	cfg.region_contrast = regionContrast;
+	cfg.light_floor = lightFloor;
 	frappe::Detector frappeDet(cfg);
 	const auto cvDict = opencvDictionary(*dict, std::min(5, frappeDet.maxHamming()));
 	auto params = cv::aruco::DetectorParameters::create();

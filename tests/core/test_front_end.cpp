@@ -2,9 +2,12 @@
 // The CPU front end on small constructed images: where the edges and the
 // corners of a square fall, the tile mask, and independence from stride,
 // threads and padding.
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
+#include <random>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -33,7 +36,156 @@ Image square(int w, int h, int x0, int y0, int x1, int y1, int padding = 0)
 	return img;
 }
 
+/* The front end's contract (front_end_cpu.cpp) written out literally, one
+ * pixel at a time, without the kernels' row rings or shortcuts: the edge
+ * map bytes of the interior of `img` (the outermost rows and columns are
+ * zero). */
+std::vector<std::uint8_t> contractEdgeMap(const Image &src, const FrontEndParams &prm)
+{
+	const int w = src.width, h = src.height;
+	auto px = [&](int x, int y) {
+		x = std::clamp(x, 0, w - 1);
+		y = std::clamp(y, 0, h - 1);
+		return static_cast<int>(src.pixels[static_cast<std::size_t>(y) * src.stride + x]);
+	};
+	std::vector<int> p(static_cast<std::size_t>(w) * h), gx(p.size()), gy(p.size());
+	std::vector<std::int64_t> m(p.size(), 0);
+	for (int y = 0; y < h; ++y)
+		for (int x = 0; x < w; ++x) {
+			int s = 0;
+			for (int dy = -1; dy <= 1; ++dy)
+				for (int dx = -1; dx <= 1; ++dx)
+					s += (2 - std::abs(dx)) * (2 - std::abs(dy)) * px(x + dx, y + dy);
+			p[static_cast<std::size_t>(y) * w + x] = (s + 8) >> 4;
+		}
+	auto P = [&](int x, int y) { return p[static_cast<std::size_t>(y) * w + x]; };
+	for (int y = 1; y < h - 1; ++y)
+		for (int x = 1; x < w - 1; ++x) {
+			const std::size_t i = static_cast<std::size_t>(y) * w + x;
+			gx[i] = (P(x + 1, y - 1) + 2 * P(x + 1, y) + P(x + 1, y + 1)) - (P(x - 1, y - 1) + 2 * P(x - 1, y) + P(x - 1, y + 1));
+			gy[i] = (P(x - 1, y + 1) + 2 * P(x, y + 1) + P(x + 1, y + 1)) - (P(x - 1, y - 1) + 2 * P(x, y - 1) + P(x + 1, y - 1));
+			m[i] = static_cast<std::int64_t>(gx[i]) * gx[i] + static_cast<std::int64_t>(gy[i]) * gy[i];
+		}
+	auto M = [&](int x, int y) { return m[static_cast<std::size_t>(y) * w + x]; };
+	/* The thresholds at brightness p: t (min(p + floor, 128) / 128)^2 in
+	 * the contract's two truncating steps. */
+	auto scaled = [&](std::int64_t t, int b) {
+		const std::int64_t q = std::min(b + prm.light_floor, 128);
+		return (((t * q) >> 7) * q) >> 7;
+	};
+	const std::int64_t E = std::min<std::int64_t>(prm.edge_threshold_sq, std::int64_t{ 1 } << 22);
+	std::vector<std::uint8_t> out(p.size(), 0);
+	for (int y = 2; y < h - 2; ++y)
+		for (int x = 2; x < w - 2; ++x) {
+			const std::size_t i = static_cast<std::size_t>(y) * w + x;
+			if (!(m[i] > scaled(E, P(x, y))))
+				continue;
+			const int ax = std::abs(gx[i]), ay = std::abs(gy[i]);
+			std::int64_t prev, next;
+			if (256 * ay <= 106 * ax) {
+				prev = M(x - 1, y);
+				next = M(x + 1, y);
+			} else if (256 * ax <= 106 * ay) {
+				prev = M(x, y - 1);
+				next = M(x, y + 1);
+			} else if ((gx[i] > 0) == (gy[i] > 0)) {
+				prev = M(x - 1, y - 1);
+				next = M(x + 1, y + 1);
+			} else {
+				prev = M(x + 1, y - 1);
+				next = M(x - 1, y + 1);
+			}
+			if (!(m[i] > prev && m[i] >= next))
+				continue;
+			out[i] = EdgeMap::kEdge;
+			std::int64_t sxx = 0, syy = 0, sxy = 0;
+			for (int dy = -1; dy <= 1; ++dy)
+				for (int dx = -1; dx <= 1; ++dx) {
+					const std::size_t j = static_cast<std::size_t>(y + dy) * w + x + dx;
+					sxx += gx[j] * gx[j];
+					syy += gy[j] * gy[j];
+					sxy += gx[j] * gy[j];
+				}
+			const std::int64_t T = scaled(prm.corner_threshold, P(x, y));
+			const std::int64_t c = (sxx + syy - 2 * T) >> 9, a = std::abs(sxx - syy) >> 9, b = std::abs(sxy) >> 8;
+			if (c > 0 && c * c > a * a + b * b)
+				out[i] |= EdgeMap::kCorner;
+		}
+	return out;
+}
+
 } // namespace
+
+/* The CPU front end (this CPU's best kernels and the scalar ones) against
+ * the contract written out literally, at every light floor: absolute
+ * thresholds (128), the default (16) and none (0), on frames from dim to
+ * bright. The outermost two rows and columns of the frame are left out:
+ * the literal form does not replicate smoothed rows there. */
+TEST(FrontEnd, FollowsTheDocumentedContractInAnyLight)
+{
+	std::mt19937 rng(29);
+	int edges = 0, corners = 0, relative = 0;
+	for (int lightFloor : { 128, 16, 0 }) {
+		FrontEndParams prm = defaultParams();
+		prm.light_floor = lightFloor;
+		for (int gain : { 255, 60, 12 }) {
+			/* Squares of random grey on a ramp, with noise: edges of every
+			 * strength and direction, at every brightness. */
+			Image img(97, 61, 0, 3);
+			std::uniform_int_distribution<int> noise(-3, 3);
+			for (int y = 0; y < img.height; ++y)
+				for (int x = 0; x < img.width; ++x) {
+					const int block = ((x / 9) * 7 + (y / 7) * 13) % 17;
+					const int v = (block * 15 + x) * gain / 300 + noise(rng);
+					img.at(x, y) = static_cast<std::uint8_t>(std::clamp(v, 0, 255));
+				}
+			const auto want = contractEdgeMap(img, prm);
+			for (const detail::BandKernels *k : { &detail::bestBandKernels(), &detail::scalarBandKernels() }) {
+				EdgeMap em;
+				detail::makeCpuFrontEnd(1, *k)->run(img.view(), 1.0f, prm, em);
+				for (int y = 2; y < img.height - 2; ++y)
+					for (int x = 2; x < img.width - 2; ++x) {
+						const std::size_t i = static_cast<std::size_t>(y) * img.width + x;
+						ASSERT_EQ(em.at(x, y), want[i]) << k->name << " at " << x << "," << y << " floor "
+										<< lightFloor << " gain " << gain;
+					}
+			}
+			for (std::size_t i = 0; i < want.size(); ++i) {
+				edges += want[i] & EdgeMap::kEdge;
+				corners += (want[i] & EdgeMap::kCorner) != 0;
+			}
+			if (lightFloor < 128 && gain == 12)
+				relative += static_cast<int>(std::count(want.begin(), want.end(), EdgeMap::kEdge));
+		}
+	}
+	EXPECT_GT(edges, 3000);
+	EXPECT_GT(corners, 100);
+	/* The dim frames have edges only because the thresholds follow the light. */
+	EXPECT_GT(relative, 200);
+}
+
+/* A square whose black and white differ by 12 grey levels in a dim frame
+ * (black 6, white 18): edges all round at the default light floor, none
+ * where the thresholds are absolute (the paper's). */
+TEST(FrontEnd, ADimSquareKeepsItsEdges)
+{
+	Image img(64, 48, 6);
+	for (int y = 12; y < 36; ++y)
+		for (int x = 16; x < 48; ++x)
+			img.at(x, y) = 18;
+	auto count = [&](int lightFloor) {
+		FrontEndParams prm = defaultParams();
+		prm.light_floor = lightFloor;
+		EdgeMap em;
+		makeCpuFrontEnd(1)->run(img.view(), 1.0f, prm, em);
+		int n = 0;
+		for (std::uint8_t v : em.pixels)
+			n += v & EdgeMap::kEdge;
+		return n;
+	};
+	EXPECT_EQ(count(128), 0);
+	EXPECT_GE(count(defaultParams().light_floor), 2 * (32 + 24) - 8);
+}
 
 /* frappe::simdTarget() names the kernels that really run: on aarch64 NEON
  * even where Highway's run-time check would not offer it (Debian 12's
@@ -70,6 +222,11 @@ TEST(FrontEnd, ParamsFollowTheConfig)
 	/* (0.27 * 255)^2 = 4740.2 and 0.19 * 255^2 = 12354.75 */
 	EXPECT_EQ(p.edge_threshold_sq, 4740);
 	EXPECT_EQ(p.corner_threshold, 12354);
+	/* 0.063 * 255 = 16.07 */
+	EXPECT_EQ(p.light_floor, 16);
+	Config absolute;
+	absolute.light_floor = 0.9f;
+	EXPECT_EQ(Detector(absolute).frontEndParams().light_floor, FrontEndParams::kLightReference);
 }
 
 TEST(FrontEnd, EdgesOfASquareLieOnItsBoundary)
@@ -225,7 +382,10 @@ void expectVectorKernelsMatchScalar(const char *target)
 	FrontEndParams loose = defaultParams();
 	loose.edge_threshold_sq = 10;
 	loose.corner_threshold = 0;
-	const FrontEndParams paramsList[] = { defaultParams(), loose };
+	FrontEndParams absolute = defaultParams(), dark = defaultParams();
+	absolute.light_floor = FrontEndParams::kLightReference;
+	dark.light_floor = 0;
+	const FrontEndParams paramsList[] = { defaultParams(), loose, absolute, dark };
 
 	std::mt19937 rng(11);
 	int compared = 0, edges = 0, corners = 0;
@@ -261,7 +421,7 @@ void expectVectorKernelsMatchScalar(const char *target)
 	/* The comparison must have covered edges and corners, not blank maps. */
 	EXPECT_GT(edges, 10000);
 	EXPECT_GT(corners, 1000);
-	EXPECT_EQ(compared, 18 * 3 * 2);
+	EXPECT_EQ(compared, 18 * 3 * 4);
 }
 
 TEST(FrontEnd, VectorKernelsMatchTheScalarOnesByteForByte)

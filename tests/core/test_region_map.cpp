@@ -32,7 +32,8 @@ std::vector<std::uint8_t> randomBytes(std::size_t n, std::mt19937 &rng)
 }
 
 /* The documented rule, pixel by pixel. */
-std::vector<std::uint8_t> slowRegionMap(const Image &img, int minContrast, int &w, int &h)
+std::vector<std::uint8_t> slowRegionMap(const Image &img, int minContrast, int lightFloor, int &w, int &h,
+					bool shade = false)
 {
 	w = img.width / 2;
 	h = img.height / 2;
@@ -56,7 +57,13 @@ std::vector<std::uint8_t> slowRegionMap(const Image &img, int minContrast, int &
 							lo = std::min(lo, r[yy * w + xx]);
 							hi = std::max(hi, r[yy * w + xx]);
 						}
-			out[y * w + x] = hi - lo >= minContrast && r[y * w + x] < ((lo + hi + 1) >> 1) ? 1 : 0;
+			/* The contrast follows the light below mid-grey. */
+			const int need = (minContrast * std::min(lo + hi + 2 * lightFloor, 256) + 255) >> 8;
+			/* The region map: below the midpoint; the shade map: below the
+			 * geometric mean, with 4 added. */
+			const int v = r[y * w + x];
+			const bool below = shade ? (v + 4) * (v + 4) < (lo + 4) * (hi + 4) : v < ((lo + hi + 1) >> 1);
+			out[y * w + x] = hi - lo >= need && below ? 1 : 0;
 		}
 	return out;
 }
@@ -153,24 +160,35 @@ TEST(RegionMap, FollowsTheDocumentedRuleAtOddSizesAndStrides)
 			for (int y = 0; y < H; ++y)
 				for (int x = 0; x < W; ++x)
 					img.at(x, y) = static_cast<std::uint8_t>(((x / 7 + y / 5) * 53 + rng() % 40) & 0xFF);
-			for (int contrast : { 1, 40, 200 }) {
+			for (auto [contrast, lightFloor] : { std::pair{ 1, 128 }, { 40, 128 }, { 200, 128 }, { 40, 16 }, { 200, 0 }, { 41, 16 } }) {
 				int w, h;
-				const auto want = slowRegionMap(img, contrast, w, h);
-				TraceMap map;
+				TraceMap map, shades;
 				detail::RegionScratch scratch;
-				detail::regionMap(img.view(), 1.0f, contrast, map, scratch);
-				ASSERT_EQ(map.width, w);
-				ASSERT_EQ(map.height, h);
-				EXPECT_EQ(map.pixels, want) << target << " " << W << "x" << H << " contrast " << contrast;
-				EXPECT_FLOAT_EQ(map.scale, 0.5f);
-				for (int ty = 0; ty < map.tiles_y; ++ty)
-					for (int tx = 0; tx < map.tiles_x; ++tx) {
-						bool any = false;
-						for (int y = ty * 16; y < std::min(h, ty * 16 + 16); ++y)
-							for (int x = tx * 16; x < std::min(w, tx * 16 + 16); ++x)
-								any = any || want[y * w + x];
-						EXPECT_EQ(!map.tileEmpty(tx, ty), any) << target << " tile " << tx << "," << ty;
-					}
+				FrontEndParams params;
+				params.region_contrast = contrast;
+				params.light_floor = lightFloor;
+				detail::regionMap(img.view(), 1.0f, params, map, shades, scratch);
+				/* The shade map exactly when the thresholds follow the light. */
+				EXPECT_EQ(shades.width > 0, lightFloor < 128);
+				for (bool shade : { false, true }) {
+					const TraceMap &got = shade ? shades : map;
+					if (shade && lightFloor >= 128)
+						continue;
+					const auto want = slowRegionMap(img, contrast, lightFloor, w, h, shade);
+					ASSERT_EQ(got.width, w);
+					ASSERT_EQ(got.height, h);
+					EXPECT_EQ(got.pixels, want) << target << " " << W << "x" << H << " contrast " << contrast
+								    << " light floor " << lightFloor << (shade ? " shades" : "");
+					EXPECT_FLOAT_EQ(got.scale, 0.5f);
+					for (int ty = 0; ty < got.tiles_y; ++ty)
+						for (int tx = 0; tx < got.tiles_x; ++tx) {
+							bool any = false;
+							for (int y = ty * 16; y < std::min(h, ty * 16 + 16); ++y)
+								for (int x = tx * 16; x < std::min(w, tx * 16 + 16); ++x)
+									any = any || want[y * w + x];
+							EXPECT_EQ(!got.tileEmpty(tx, ty), any) << target << " tile " << tx << "," << ty;
+						}
+				}
 			}
 		}
 	});
@@ -191,6 +209,7 @@ TEST(RegionMap, FrontEndBandsMakeTheSameMap)
 			for (float scale : { 1.0f, 0.6f }) {
 				FrontEndParams params;
 				params.region_contrast = 40;
+				params.light_floor = 16;
 				EdgeMap edges;
 				makeCpuFrontEnd(threads)->run(img.view(), scale, params, edges);
 				/* The reference, from the frame the front end traced. */
@@ -199,14 +218,16 @@ TEST(RegionMap, FrontEndBandsMakeTheSameMap)
 					detail::scaleNearest(img.view(), edges.width, edges.height, src.pixels.data());
 				else
 					src = img;
-				TraceMap want;
+				TraceMap want, wantShades;
 				detail::RegionScratch scratch;
-				detail::regionMap(src.view(), edges.scale, 40, want, scratch);
+				detail::regionMap(src.view(), edges.scale, params, want, wantShades, scratch);
 				EXPECT_EQ(edges.regions.width, want.width) << W << "x" << H;
 				EXPECT_EQ(edges.regions.pixels, want.pixels)
 					<< W << "x" << H << " threads " << threads << " scale " << scale;
 				EXPECT_EQ(edges.regions.tiles, want.tiles) << W << "x" << H;
 				EXPECT_FLOAT_EQ(edges.regions.scale, want.scale);
+				EXPECT_EQ(edges.shades.pixels, wantShades.pixels) << W << "x" << H << " shades";
+				EXPECT_EQ(edges.shades.tiles, wantShades.tiles) << W << "x" << H << " shades";
 			}
 	}
 }
@@ -216,10 +237,17 @@ TEST(RegionMap, EmptyWhenOffOrTooSmall)
 	Image img(5, 100, 0);
 	TraceMap map;
 	detail::RegionScratch scratch;
-	detail::regionMap(img.view(), 1.0f, 40, map, scratch);
+	FrontEndParams params;
+	params.region_contrast = 40;
+	params.light_floor = 16;
+	TraceMap shades;
+	detail::regionMap(img.view(), 1.0f, params, map, shades, scratch);
 	EXPECT_EQ(map.width, 0);
+	EXPECT_EQ(shades.width, 0);
 	Image big(64, 64, 0);
-	detail::regionMap(big.view(), 1.0f, 0, map, scratch);
+	params.region_contrast = 0;
+	detail::regionMap(big.view(), 1.0f, params, map, shades, scratch);
+	EXPECT_EQ(shades.width, 0);
 	EXPECT_EQ(map.width, 0);
 }
 

@@ -177,6 +177,31 @@ TEST(CellRead, MarginIsTheWeakestCodeCell)
 	EXPECT_EQ(detail::readCells(w, d.bits, b, 0.29f).weak, 0u);
 }
 
+/* Glare: where a border cell (black ink) clips, a clipped code cell may be
+ * black under the glare: it is unknown (weak, margin 0). Without glare on
+ * the border a clipped white cell is read as white. */
+TEST(CellRead, ClippedCellsUnderGlareAreUnknown)
+{
+	const Dictionary &d = *findDictionary("aruco_mip_36h12");
+	detail::WarpedMarker w = gridOf(d.codes[5], d.bits);
+	setCell(w, 3, 2, 255, 255, 255, 255); /* a clipped code cell */
+	detail::Binarised b = detail::binarise(w, d.bits);
+	detail::CellRead c = detail::readCells(w, d.bits, b, 0.3f);
+	const int bit = d.bits * d.bits - 1 - ((2 - 1) * d.bits + (3 - 1));
+	EXPECT_EQ(c.weak & (1ull << bit), 0u) << "no glare on the border: a white cell";
+	setCell(w, 0, 4, 252, 255, 253, 255); /* glare on the border */
+	b = detail::binarise(w, d.bits);
+	c = detail::readCells(w, d.bits, b, 0.3f);
+	EXPECT_NE(c.weak & (1ull << bit), 0u);
+	EXPECT_FLOAT_EQ(c.margin, 0.0f);
+	/* The same on the log scale. */
+	const detail::Tone tone{ 16.0f };
+	for (float &v : w.samples)
+		v = tone.apply(v);
+	b = detail::binarise(w, d.bits);
+	EXPECT_NE(detail::readCells(w, d.bits, b, 0.3f, tone).weak & (1ull << bit), 0u);
+}
+
 TEST(CellRead, SamplesOnBothSidesOfTheThresholdStraddle)
 {
 	const Dictionary &d = *findDictionary("aruco_mip_36h12");

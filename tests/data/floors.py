@@ -22,6 +22,8 @@ class Floor:
     fp: Limit = None      # max false positives (the scorer's: all unmatched detections)
     mae: Limit = None     # max corner mean error of matched markers, px
     large: Limit = None   # min sensitivity of the markers of 60 px or more
+    light: Optional[dict] = None  # {effect: Limit}: min sensitivity of the markers
+                                  # of the images with that lighting (params.light)
 
 
 # Frappe at defaults, single thread, on each synthetic subset with its own
@@ -43,7 +45,40 @@ SETS = {
     'synth/apriltag_16h5':      Floor(sens=(0.97, 0.98), fp=(0, 0)),
     'synth/seq01':              Floor(sens=(0.97, 0.97), fp=(2, 2)),
     'synth/seq02':              Floor(sens=(0.97, 0.97), fp=(2, 2)),
+    # Hard light (issue 29): the thresholds follow the light, reads on a log
+    # scale where grey levels fail.
+    # Enforced a little under today's measure (above the issue's targets).
+    'synth/lighting':           Floor(sens=(0.87, 0.78), fp=(1, 1), mae=(0.30, 0.30),
+                                      light={'lowlight': (0.84, 0.60), 'blinds': (0.79, 0.75),
+                                             'cast': (0.85, 0.75), 'glare': (0.86, 0.75),
+                                             'overexposed': (0.93, 0.75)}),
+    'synth/lighting-apriltag36h11': Floor(sens=(0.82, 0.78), fp=(1, 1), mae=(0.36, 0.36),
+                                          light={'lowlight': (0.73, 0.60), 'blinds': (0.77, 0.75),
+                                                 'cast': (0.76, 0.75), 'glare': (0.77, 0.75),
+                                                 'overexposed': (0.90, 0.75)}),
 }
+
+# Any exposure (issue 29): each synthetic subset exposed G times as long
+# (frappe-sweep's lightG: v G plus sensor noise of 1.5 grey levels, seeded,
+# clipped), in points (0.01) below its own sensitivity as read at most, and
+# without a false positive. EXPOSURE_ENFORCED holds, per subset, the points
+# enforced where the target is not met yet (a missing entry: the target).
+EXPOSURE_POINTS = {0.3: 3, 0.15: 10, 2.0: 3}
+# Not met yet: at 200% light small blurred markers' black cells, lifted over
+# the midpoint of the clipped range, read white (docs/quality.md, hard
+# light); the lighting subsets, already dim or clipped, darkened or
+# brightened again.
+EXPOSURE_ENFORCED = {
+    ('synth/images', 2.0): 7, ('synth/apriltag36h11', 2.0): 6, ('synth/blur', 2.0): 16,
+    ('synth/blur-apriltag36h11', 2.0): 14, ('synth/4x4_50', 2.0): 14, ('synth/6x6_250', 2.0): 9,
+    ('synth/apriltag_16h5', 2.0): 12,
+    ('synth/lighting', 0.15): 34, ('synth/lighting', 0.3): 14, ('synth/lighting', 2.0): 8,
+    ('synth/lighting-apriltag36h11', 0.15): 29, ('synth/lighting-apriltag36h11', 0.3): 14,
+    ('synth/lighting-apriltag36h11', 2.0): 12,
+}
+# False positives allowed where the target of none is not met yet: a 15 px
+# marker of synth/images read as another id at 30% (hamming 5, margin 0.03).
+EXPOSURE_FP_ENFORCED = {('synth/images', 0.3): 1, ('synth/lighting', 2.0): 1}
 
 # Photographs: every marker of the folders with source ground truth found
 # (detector-labelled folders are incomplete: not counted), and in every folder
@@ -86,6 +121,9 @@ RESOLUTION = {
     'synth/apriltag_16h5':      (0.96,      0.96,       0.96,      0.95),
     'synth/seq01':              (None,      None,       None,      None),
     'synth/seq02':              (None,      None,       None,      None),
+    # Hard light upsampled loses 3-7 points: not met yet.
+    'synth/lighting':           (0.85,      0.84,       0.83,      0.84),
+    'synth/lighting-apriltag36h11': (0.77,  0.78,       0.75,      0.75),
 }
 
 

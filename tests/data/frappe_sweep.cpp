@@ -10,12 +10,19 @@
 // Each run writes OUT.jsonl in frappe-detect's --out format (one line per
 // listed image, the path as listed, so the lines score against the original
 // truth once its corners are scaled). SCALE is a whole factor, 1 = the image
-// as read; INTERP is linear or nearest. For a whole factor both of OpenCV's
+// as read; INTERP is linear or nearest, or lightG (SCALE 1) for the image
+// exposed G times as long (0.15, 2, ...): round(v G + n), n drawn from
+// N(0, 1.5^2) (sensor noise) seeded by the image's line in the list,
+// clipped to 0..255; the truth is the original's. For a whole factor both of OpenCV's
 // resize modes put output pixel x at input x' = (x + 0.5) / s - 0.5, so
 // truth corners scale as x' = (x + 0.5) s - 0.5. Detection is frappe-detect's
 // at defaults: a Detector of the default Config, single thread, CPU front
 // end; `time_ms` is that one detection.
+#include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <random>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
@@ -38,6 +45,7 @@ struct Run {
 	std::string dictionary, out;
 	int scale = 1;
 	int interp = cv::INTER_LINEAR;
+	double light = 0.0; /* > 0: an exposed copy, no resampling */
 	std::unique_ptr<frappe::Detector> detector;
 	std::ofstream file;
 };
@@ -77,8 +85,13 @@ Run parseRun(const std::string &spec)
 		r.interp = cv::INTER_LINEAR;
 	else if (f[2] == "nearest")
 		r.interp = cv::INTER_NEAREST;
-	else
-		usage("the interpolation of --run '" + spec + "' is not linear or nearest");
+	else if (f[2].rfind("light", 0) == 0) {
+		char *end = nullptr;
+		r.light = std::strtod(f[2].c_str() + 5, &end);
+		if (end == f[2].c_str() + 5 || *end || !(r.light > 0.0 && r.light <= 16.0) || r.scale != 1)
+			usage("the exposure of --run '" + spec + "' is not lightG with 0 < G <= 16 at scale 1");
+	} else
+		usage("the interpolation of --run '" + spec + "' is not linear, nearest or lightG");
 	if (r.out.empty())
 		usage("--run '" + spec + "' has no output file");
 	return r;
@@ -115,6 +128,22 @@ void writeLine(std::ofstream &out, const std::string &image, const std::vector<f
 		out << ", \"error\": \"" << escape(error) << "\"";
 	std::snprintf(buf, sizeof(buf), ", \"time_ms\": %.4f}\n", ms);
 	out << buf;
+}
+
+/* The image exposed `light` times as long, with sensor noise of 1.5 grey
+ * levels, the same for every run and every machine's standard library
+ * (a fixed generator, Box-Muller by hand). */
+void expose(const cv::Mat &gray, double light, unsigned seed, cv::Mat &out)
+{
+	out.create(gray.rows, gray.cols, CV_8UC1);
+	std::mt19937 rng(seed * 2654435761u + 12345u);
+	auto uniform = [&] { return (static_cast<double>(rng()) + 0.5) / 4294967296.0; };
+	for (int y = 0; y < gray.rows; ++y)
+		for (int x = 0; x < gray.cols; ++x) {
+			const double n = 1.5 * std::sqrt(-2.0 * std::log(uniform())) * std::cos(6.283185307179586 * uniform());
+			const long v = std::lround(gray.at<std::uint8_t>(y, x) * light + n);
+			out.at<std::uint8_t>(y, x) = static_cast<std::uint8_t>(std::clamp(v, 0L, 255L));
+		}
 }
 
 } // namespace
@@ -160,11 +189,14 @@ int main(int argc, char **argv)
 	 * allocated (and faulted in) again for every image. */
 	std::map<std::pair<int, int>, cv::Mat> copies;
 	std::set<std::pair<int, int>> made;
+	std::map<double, cv::Mat> exposed;
+	unsigned line = 0;
 	for (std::string path; std::getline(in, path);) {
 		if (path.empty() || path[0] == '#')
 			continue;
 		const cv::Mat gray = cv::imread(path, cv::IMREAD_GRAYSCALE);
 		made.clear();
+		++line;
 		for (Run &r : runs) {
 			std::string error;
 			std::vector<frappe::Marker> markers;
@@ -173,8 +205,10 @@ int main(int argc, char **argv)
 				error = "cannot decode " + path + " as an image";
 			} else {
 				const std::pair<int, int> key{ r.scale, r.interp };
-				cv::Mat &img = copies[key];
-				if (r.scale == 1)
+				cv::Mat &img = r.light > 0.0 ? exposed[r.light] : copies[key];
+				if (r.light > 0.0)
+					expose(gray, r.light, line, img);
+				else if (r.scale == 1)
 					img = gray;
 				else if (made.insert(key).second)
 					cv::resize(gray, img, cv::Size(gray.cols * r.scale, gray.rows * r.scale), 0, 0, r.interp);

@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 SOURCE_ROOT = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..'))
 
 SYNTH = ['images', 'apriltag36h11', 'blur', 'blur-apriltag36h11', '4x4_50', '6x6_250',
-         'apriltag_16h5', 'seq01', 'seq02']
+         'apriltag_16h5', 'seq01', 'seq02', 'lighting', 'lighting-apriltag36h11']
 # Upsampled copies: (factor, interpolation), built by frappe-sweep in memory.
 VARIANTS = [(2, 'linear'), (2, 'nearest'), (3, 'linear'), (3, 'nearest')]
 # The truth's family names that are not frappe's dictionary names.
@@ -278,6 +278,23 @@ def resolution_runs(sub, workdir):
     runs = [(sub.dictionary, 1, 'linear', stem + '-1x.jsonl')]
     runs += [(sub.dictionary, s, i, '%s-%dx-%s.jsonl' % (stem, s, i)) for s, i in VARIANTS]
     return runs
+
+
+def exposure_runs(sub, workdir, lights, as_read=True):
+    """frappe-sweep runs of the subset's dictionary as read (the first,
+    unless as_read is False) and exposed each of `lights` times as long
+    (frappe-sweep's lightG)."""
+    stem = os.path.join(workdir, sub.name.replace('/', '-'))
+    runs = [(sub.dictionary, 1, 'linear', stem + '-1x.jsonl')] if as_read else []
+    runs += [(sub.dictionary, 1, 'light%g' % g, '%s-light%g.jsonl' % (stem, g)) for g in lights]
+    return runs
+
+
+def light_sensitivity(res, effect):
+    """Sensitivity of the markers of the images lit with `effect` (the
+    truth's params.light), from the scorer's breakdown; None when none."""
+    tp, n = res.get('sensitivity_by_light', {}).get(effect, (0, 0))
+    return (tp / n if n else None), tp, n
 
 
 def score_resolution(scorer, sub, runs, workdir):

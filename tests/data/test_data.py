@@ -5,8 +5,8 @@ usage: test_data.py FRAPPE_DETECT FRAPPE_SWEEP SHARED_DIR CHECK
 
 CHECK is a synthetic subset (synth/images, synth/blur, ...: frappe-detect with
 the subset's dictionary), real (the photographs), wrong-ids (every built-in
-dictionary over the other families' subsets) or resolution (every subset
-upsampled 2x and 3x). Each check prints its measurement, the enforced floor
+dictionary over the other families' subsets), resolution (every subset
+upsampled 2x and 3x) or exposure (every subset darkened and brightened). Each check prints its measurement, the enforced floor
 and the issue's target. Exits 77 (skipped) when the shared folder is absent,
 as on a user's machine. Scoring is shared/tools/eval.py's (needs numpy).
 """
@@ -61,6 +61,10 @@ def check_set(report, name, res):
         sens, tp, n = measure.large_sensitivity(res)
         assert n, '%s has no markers of 60 px or more' % name
         report.at_least(name + ' sensitivity, markers >= 60 px', sens, f.large, '%.4f (%d/%d)' % (sens, tp, n))
+    for effect, limit in sorted((f.light or {}).items()):
+        sens, tp, n = measure.light_sensitivity(res, effect)
+        assert n, '%s has no images lit with %s' % (name, effect)
+        report.at_least('%s sensitivity, %s' % (name, effect), sens, limit, '%.4f (%d/%d)' % (sens, tp, n))
 
 
 def check_real(report, name, res):
@@ -104,6 +108,20 @@ def check_resolution(report, name, results):
                         '%.4f (1x %.4f)' % (res['sensitivity'], base), fmt='%.4g')
 
 
+def check_exposure(report, name, results):
+    """Each exposure's sensitivity within its points of the subset as read,
+    and no false positive."""
+    base = results[1.0]['sensitivity']
+    for g, points in sorted(floors.EXPOSURE_POINTS.items()):
+        res = results[g]
+        enforced = floors.EXPOSURE_ENFORCED.get((name, g), points)
+        report.at_least('%s at %d%% light, sensitivity' % (name, round(100 * g)), res['sensitivity'],
+                        (base - enforced / 100.0, base - points / 100.0),
+                        '%.4f (1x %.4f)' % (res['sensitivity'], base), fmt='%.4g')
+        report.at_most('%s at %d%% light, false positives' % (name, round(100 * g)), res['fp'],
+                       (floors.EXPOSURE_FP_ENFORCED.get((name, g), 0), 0), fmt='%d')
+
+
 def measure_wrong_ids(sweep, scorer, codebook, subsets, dictionaries, tmp):
     """{(dictionary, subset name): WrongIds} for every dictionary but each
     subset's own."""
@@ -143,6 +161,14 @@ def main():
             assert not missing, 'floors.WRONG_IDS_PER_300 and the built-in dictionaries differ: %s' % missing
             cells = measure_wrong_ids(sweep, scorer, measure.CodeBook(corrects), subsets, sorted(corrects), tmp)
             check_wrong_ids(report, cells, subsets)
+        elif check == 'exposure':
+            for sub in measure.synth_subsets(shared):
+                runs = measure.exposure_runs(sub, tmp, sorted(floors.EXPOSURE_POINTS))
+                measure.run_sweep(sweep, sub, runs, tmp)
+                results = {1.0: measure.score(scorer, sub.truth, runs[0][3])}
+                for (_, _, i, dets), g in zip(runs[1:], sorted(floors.EXPOSURE_POINTS)):
+                    results[g] = measure.score(scorer, sub.truth, dets)
+                check_exposure(report, sub.name, results)
         elif check == 'resolution':
             for sub in measure.synth_subsets(shared):
                 runs = measure.resolution_runs(sub, tmp)

@@ -84,6 +84,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t *data, std::size_t size
 	c.scaled_size = number(in, 28.0f);
 	c.max_scaled_frames = in.get<std::int16_t>();
 	c.region_contrast = number(in, 0.16f);
+	c.light_floor = number(in, 0.063f);
 	c.corner_cluster_radius = number(in, 4.0f);
 	c.min_marker_side = number(in, 10.0f);
 	c.threads = in.get<std::int8_t>() % 4;

@@ -7,7 +7,7 @@ of an unknown license)."""
 import subprocess
 import sys
 
-PROPERTIES = ["dictionary", "mode", "edge-threshold", "corner-threshold", "region-contrast", "max-hamming",
+PROPERTIES = ["dictionary", "mode", "edge-threshold", "corner-threshold", "region-contrast", "light-floor", "max-hamming",
               "scaled-size", "max-scaled-frames", "annotate", "post-messages", "pipelined",
               "backend", "marker-size", "camera-matrix", "distortion", "calibration-file",
               "marker-sizes", "dictionary-file", "stats"]

@@ -72,6 +72,7 @@ TEST(Settings, DetectorPropertiesFollowTheLibrary)
 	checkFloat(el, "edge-threshold", &frappe::Config::edge_threshold, false);
 	checkFloat(el, "corner-threshold", &frappe::Config::corner_threshold, true);
 	checkFloat(el, "region-contrast", &frappe::Config::region_contrast, true);
+	checkFloat(el, "light-floor", &frappe::Config::light_floor, true);
 	checkFloat(el, "scaled-size", &frappe::Config::scaled_size, true);
 
 	auto *frames = G_PARAM_SPEC_INT(el.spec("max-scaled-frames"));

@@ -11,7 +11,6 @@
 #include <exception>
 #include <fstream>
 #include <functional>
-#include <future>
 #include <string>
 #include <thread>
 
@@ -21,29 +20,50 @@
 
 namespace frappe::test {
 
+/* Runs `work` on a thread and waits up to `seconds` for it, polling: no
+ * std::future, whose timed wait libstdc++ lacks on ARMv6 (no futex
+ * atomics there). When it has not finished, `unblock` sets it free. True
+ * when it finished in time. */
+inline bool finishedWithin(double seconds, const std::function<void()> &work, const std::function<void()> &unblock)
+{
+	std::atomic<bool> done{ false };
+	std::thread worker([&] {
+		work();
+		done = true;
+	});
+	const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+	while (!done && std::chrono::steady_clock::now() < end)
+		std::this_thread::sleep_for(std::chrono::milliseconds(5));
+	const bool finished = done;
+	if (!finished)
+		unblock();
+	worker.join();
+	return finished;
+}
+
 inline std::string readingFifo(const std::string &fifo, const std::function<void(const std::string &)> &read)
 {
 	::unlink(fifo.c_str());
 	if (::mkfifo(fifo.c_str(), 0600) != 0)
 		return "mkfifo failed";
-	auto outcome = std::async(std::launch::async, [&]() -> std::string {
-		try {
-			read(fifo);
-			return "read without an error";
-		} catch (const std::exception &e) {
-			return e.what();
-		}
-	});
 	std::string what;
-	if (outcome.wait_for(std::chrono::seconds(3)) == std::future_status::ready) {
-		what = outcome.get();
-	} else {
-		const int fd = ::open(fifo.c_str(), O_WRONLY | O_NONBLOCK);
-		if (fd >= 0)
-			::close(fd);
-		outcome.wait();
+	const bool finished = finishedWithin(
+		3.0,
+		[&] {
+			try {
+				read(fifo);
+				what = "read without an error";
+			} catch (const std::exception &e) {
+				what = e.what();
+			}
+		},
+		[&] {
+			const int fd = ::open(fifo.c_str(), O_WRONLY | O_NONBLOCK);
+			if (fd >= 0)
+				::close(fd);
+		});
+	if (!finished)
 		what = "blocked";
-	}
 	::unlink(fifo.c_str());
 	return what;
 }

@@ -81,6 +81,16 @@ struct Config {
 	/// to strongly blurred markers). Range [0, 1].
 	float region_contrast = 0.16f;
 
+	/// Dim light: below mid-grey the edge, corner and region thresholds
+	/// scale with the local brightness plus this floor (intensities in
+	/// [0, 1]), so that a marker in a dim room, under a blind's shadow or
+	/// a cast shadow keeps the edges and the dark region it has in full
+	/// light (the exact rule: front_end_cpu.cpp). The floor keeps sensor
+	/// noise in the darkest pixels from making edges: lower finds markers
+	/// in darker scenes at the price of more clutter traced there; 0.5 or
+	/// more keeps every threshold absolute (the paper's). Range [0, 1].
+	float light_floor = 0.063f;
+
 	/// Corner pixels closer than this (pixels, at the traced resolution)
 	/// belong to one corner cluster.
 	float corner_cluster_radius = 4.0f;

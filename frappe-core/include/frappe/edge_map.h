@@ -5,6 +5,7 @@
 
 #include "frappe/export.h"
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -27,6 +28,51 @@ struct FrontEndParams {
 	/// around it differ by at least this much (8-bit grey levels) and it
 	/// lies below their midpoint; 0: no region map.
 	int region_contrast = 0;
+	/// Below mid-grey the three thresholds above scale with the local
+	/// brightness (relativeThreshold(), the contract at the top of
+	/// front_end_cpu.cpp): the grey level added to a brightness before it
+	/// is compared with kLightReference. kLightReference or more: the
+	/// thresholds are absolute, as in the paper.
+	int light_floor = kLightReference;
+
+	/// The brightness (8-bit grey level) at and above which the
+	/// thresholds are the absolute ones.
+	static constexpr int kLightReference = 128;
+	/// A squared-gradient threshold `t` (edge or corner, 0 <= t < 2^23) at
+	/// a pixel of smoothed brightness `p`: t ((p + light_floor) / 128)^2,
+	/// capped at t, in two exact 32-bit steps (the QPU multiplies 24 x 24
+	/// bits).
+	std::int32_t relativeThreshold(std::int32_t t, int p) const
+	{
+		const std::int32_t q = std::min(p + light_floor, kLightReference);
+		return (((t * q) >> 7) * q) >> 7;
+	}
+	/// The region map's contrast for tile extremes lo and hi: region_contrast
+	/// scaled by (lo + hi + 2 light_floor) / 256, capped at it, rounded up.
+	int relativeRegionContrast(int lo, int hi) const
+	{
+		const int sum = std::min(lo + hi + 2 * light_floor, 2 * kLightReference);
+		return (region_contrast * sum + 255) >> 8;
+	}
+	/// Whether the map of shaded regions (EdgeMap::shades) is made: with
+	/// the region map, when the thresholds follow the light.
+	bool makesShades() const { return region_contrast > 0 && light_floor < kLightReference; }
+	/// The grey level added before the shade map's product (kept small: a
+	/// shadowed white must stay above the geometric mean of a shadowed
+	/// black and a lit white).
+	static constexpr int kShadeFloor = 4;
+	/// The shade map's threshold for tile extremes lo and hi that pass the
+	/// contrast test: the least r with (r + 4)^2 >= (lo + 4)(hi + 4), so
+	/// that r is dark exactly when (r + 4)^2 < (lo + 4)(hi + 4).
+	static int shadeThreshold(int lo, int hi)
+	{
+		const int p = (lo + kShadeFloor) * (hi + kShadeFloor);
+		int r = 0;
+		for (int bit = 256; bit > 0; bit >>= 1) /* the greatest r with (r + 4)^2 < p, plus one */
+			if ((r + bit + kShadeFloor) * (r + bit + kShadeFloor) < p)
+				r += bit;
+		return (r + kShadeFloor) * (r + kShadeFloor) < p ? r + 1 : r;
+	}
 };
 
 /// A byte map the contour tracer follows: foreground pixels have bit 0
@@ -64,6 +110,13 @@ struct EdgeMap : TraceMap {
 	/// region inside the outline stays whole. Empty (width 0) when region
 	/// candidates are off or the frame is too small for them.
 	TraceMap regions;
+	/// The same dark regions judged on a log scale (the rule at the top of
+	/// front_end_cpu.cpp: a pixel is dark below the geometric mean of the
+	/// extremes around it, not their midpoint): across a blind's stripes a
+	/// white in shadow stays light beside a black in the light, so the
+	/// marker's black border is one region. Made with the region map when
+	/// FrontEndParams::makesShades(); empty (width 0) otherwise.
+	TraceMap shades;
 };
 
 /// Scaled frame size for a scale factor: the same rounding everywhere.
@@ -82,9 +135,12 @@ public:
 	/// Fills `out` (resizing it) for `image` sampled at `scale` (<= 1).
 	virtual void run(const ImageView &image, float scale, const FrontEndParams &params,
 			 EdgeMap &out) = 0;
-	/// Whether run() fills out.regions too; otherwise the Detector adds
-	/// the CPU's region map.
+	/// Whether run() fills out.regions and out.shades too; otherwise the
+	/// Detector adds the CPU's.
 	virtual bool makesRegionMap() const { return false; }
+	/// Whether run() fills out.shades when it fills out.regions; otherwise
+	/// the Detector adds the CPU's shade map (FrontEndParams::makesShades()).
+	virtual bool makesShadeMap() const { return false; }
 	/// Bytes of the last frame the front end copied into memory of its
 	/// own before reading them (0 when it read the frame in place, as the
 	/// CPU does), so that a zero-copy path can be checked and logged.

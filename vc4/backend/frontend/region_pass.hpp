@@ -78,10 +78,11 @@ public:
 	/// Both launches over the allocated geometry, `launch(code, uniforms, programs, counts)`
 	/// running one; then out = the region map at scale / 2 (empty when there is none).
 	template <class Launch>
-	void run(const RegionSource &src, int contrast, float scale, Launch &&launch, PassCounts counts[2],
-	         TraceMap &out)
+	void run(const RegionSource &src, const FrontEndParams &params, float scale, Launch &&launch,
+	         PassCounts counts[2], TraceMap &out)
 	{
 		const Layout &l = layout_;
+		const int contrast = params.region_contrast;
 		if (!makesMap(l.width, l.height, contrast)) {
 			out.resize(0, 0);
 			counts[0] = counts[1] = {};
@@ -104,7 +105,7 @@ public:
 				kernels::regionSourceRows(rows, src.bus, src.stride, src.height, src.step_y, h, static_cast<int>(y0));
 				u1 = put(put(put(u1, m), rows), more);
 				const kernels::RegionDarkUniforms d{
-					static_cast<uint32_t>(contrast), x0, static_cast<uint32_t>((w + 3) / 4 - 1),
+					contrastWord(contrast), floor2(params), x0, static_cast<uint32_t>((w + 3) / 4 - 1),
 					static_cast<uint32_t>(w - 2), out_.bus + y0 * pitch + x0, stride, 4 * pitch,
 					mask_.bus + 64 * b};
 				uint32_t tileRows[kernels::kRegionTileRows];
@@ -139,6 +140,16 @@ public:
 	}
 
 private:
+	// The contrast within the kernel's 24-bit multiply: from 65281 on, any tile with
+	// lo + hi + 2 floor > 0 needs hi - lo > 255 either way, and one with 0 needs 0.
+	static uint32_t contrastWord(int contrast) { return static_cast<uint32_t>(std::min(contrast, 65536)); }
+	// 2 floor, the floor capped at 128 (the sum is capped at 256 either way; >= 0: the
+	// front end keeps negative floors on the CPU).
+	static uint32_t floor2(const FrontEndParams &params)
+	{
+		return 2u * static_cast<uint32_t>(std::clamp(params.light_floor, 0, FrontEndParams::kLightReference));
+	}
+
 	// Sizes for a scaled width x height frame (map: width / 2 x height / 2).
 	struct Layout {
 		int width = 0, height = 0;

@@ -155,8 +155,9 @@ public:
 		g.src_h = image.height;
 		g.w = scale < 1.0f ? scaledLength(image.width, scale) : image.width;
 		g.h = scale < 1.0f ? scaledLength(image.height, scale) : image.height;
-		if (g.w < 3 || g.h < 3 || g.w > kMaxQpuWidth) {
-			// Nothing for the QPUs (an all-zero map) or wider than the VDW stride allows.
+		if (g.w < 3 || g.h < 3 || g.w > kMaxQpuWidth || params.light_floor < 0) {
+			// Nothing for the QPUs (an all-zero map), wider than the VDW stride allows, or a
+			// negative light floor (q < 0: the kernels' mul24 and v8adds take it unsigned).
 			counted_ = false;
 			backend_.context->forget(image);
 			if (!cpu_)
@@ -174,9 +175,11 @@ public:
 
 		const uint32_t stepX = static_cast<uint32_t>((static_cast<uint64_t>(g.src_w) * 65536u + g.w / 2) / g.w);
 		const uint32_t stepY = static_cast<uint32_t>((static_cast<uint64_t>(g.src_h) * 65536u + g.h / 2) / g.h);
-		const int64_t thr = std::clamp<int64_t>(params.edge_threshold_sq, -1, int64_t{1} << 22);
-		const uint32_t edgeThr = static_cast<uint32_t>(thr) << 2 | 3u;
-		const uint32_t cornerC = 2u * static_cast<uint32_t>(static_cast<int32_t>(params.corner_threshold));
+		// E' and T as the contract clamps them (E' = -1 acts as 0: an edge has m > m(prev) >= 0),
+		// the floor at 128 (q = min(p + floor, 128) either way).
+		const auto edgeThr = static_cast<uint32_t>(std::clamp<int64_t>(params.edge_threshold_sq, 0, int64_t{1} << 22));
+		const auto cornerT = static_cast<uint32_t>(std::clamp<int64_t>(params.corner_threshold, 0, (int64_t{1} << 23) - 1));
+		const auto floor = static_cast<uint32_t>(std::min(params.light_floor, FrontEndParams::kLightReference));
 		const uint32_t pitch = g.gradPitch(), pw = g.paddedW();
 		const uint32_t grad = buf_.grad.bus + g.gradMargin();
 		const unsigned tiles = g.tiles();
@@ -189,7 +192,7 @@ public:
 		for (unsigned p = 0; p < programs[0]; ++p) {
 			const kernels::GradientUniforms head{static_cast<uint32_t>(g.src_w - 1), stepX,
 				static_cast<uint32_t>(g.w - 1), pitch,
-				isa::VdwStride{.stride = static_cast<uint16_t>(pitch / 4 - 64)}.word()};
+				isa::VdwStride{.stride = static_cast<uint16_t>(pitch / 4 - 64)}.word(), floor};
 			uint8_t *at = put(buf_.unif[0][p].cpu.data(), &head, sizeof(head));
 			for (unsigned u = p; u < units[0]; u += kPrograms) {
 				const uint32_t band = u / strips, strip = u % strips;
@@ -206,7 +209,7 @@ public:
 		}
 		// Pass 2: half tiles in raster order, unit u on program u % 12.
 		for (unsigned p = 0; p < programs[1]; ++p) {
-			const kernels::EdgeUniforms head{pitch, edgeThr, cornerC,
+			const kernels::EdgeUniforms head{pitch, edgeThr, cornerT,
 				isa::VdwStride{.stride = static_cast<uint16_t>(pw - 64)}.word(), 4 * pw};
 			uint8_t *at = put(buf_.unif[1][p].cpu.data(), &head, sizeof(head));
 			for (unsigned u = p; u < units[1]; u += kPrograms) {
@@ -290,7 +293,7 @@ private:
 				jobs[p] = {unif[p], code};
 			backend_.run(std::span<const JobType>(jobs.data(), programs), c);
 		};
-		region_.run(src, params.region_contrast, out.scale, launch, counts_.region, out.regions);
+		region_.run(src, params, out.scale, launch, counts_.region, out.regions);
 	}
 
 	static uint8_t *put(uint8_t *at, const void *words, size_t bytes)

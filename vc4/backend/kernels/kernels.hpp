@@ -22,14 +22,16 @@
 // 4-row VDW stores one image row of a pass-1 strip:
 //   byte offset of plane k at (x, y) = y * gradPitch + k * gradPitch / 4 + 4 gradWord(x)
 //   gradPitch = 16 * paddedWidth; rows 0 .. height-1 are written.
-//   plane 0: B = m << 2 | dir      m = gx^2 + gy^2 < 2^21
+//   plane 0: B = q << 24 | m << 2 | dir   m = gx^2 + gy^2 < 2^21, q = min(p + light_floor,
+//            128) at the pixel's smoothed value p: its thresholds follow the light
 //   plane 1..3: Vxx, Vyy, Vxy = sum over rows y-1 .. y+1 of gx^2, gy^2, gx*gy (signed)
 //   dir: 0 horizontal (compare left/right), 1 vertical (up/down),
 //        2 diagonal with gx*gy > 0 (up-left/down-right), 3 the other diagonal.
 // gx = gy = 0 on the outermost rows and columns, as in the CPU's gradient rows. B keeps the
-// direction beside m: B > thr << 2 | 3 decides m > thr without unpacking. Products go
-// through mul24 on |gx|, |gy| (24-bit unsigned operands) with the sign put back, so every
-// value is exact. Pass 2 reads a row above and below every row and a word left and right
+// direction beside m, and q where pass 2 unpacks it for free (byte 3, regfile-A unpack
+// .8d); m's comparisons need the low 24 bits only (differences shifted left by 8, or
+// mul24, which reads 24 bits). Products go through mul24 on |gx|, |gy| (24-bit unsigned
+// operands) with the sign put back, so every value is exact. Pass 2 reads a row above and below every row and a word left and right
 // of every group: the buffer needs a margin (gradMargin()) on both sides.
 //
 // Edge output: one byte per pixel (EdgeMap::kEdge | kCorner), rows of paddedWidth bytes.
@@ -73,6 +75,7 @@ struct GradientUniforms {
 	uint32_t wmax;       ///< scaled width - 1
 	uint32_t dst_pitch;  ///< gradPitch
 	uint32_t vdw_stride; ///< VdwStride word: gradPitch / 4 - 64
+	uint32_t light_floor;///< clamp(FrontEndParams::light_floor, 0, 128)
 };
 inline constexpr unsigned kGradientUniforms = sizeof(GradientUniforms) / 4;
 /// Pass 1 unit: a strip over a band of rows; then gradientRowUniforms(rows) words, `more`.
@@ -110,8 +113,8 @@ inline uint32_t *gradientRowUniforms(uint32_t *out, uint32_t src, uint32_t strid
 /// Pass 2 uniforms: the header, once per program.
 struct EdgeUniforms {
 	uint32_t grad_pitch; ///< gradPitch
-	uint32_t edge_thr;   ///< clamp(edge_threshold_sq, -1, 2^22) << 2 | 3
-	uint32_t corner_c;   ///< 2 * corner_threshold (int32 arithmetic, as the CPU)
+	uint32_t edge_thr;   ///< E' = clamp(edge_threshold_sq, 0, 2^22) (-1 acts as 0: m > 0 anyway)
+	uint32_t corner_t;   ///< T = clamp(corner_threshold, 0, 2^23 - 1)
 	uint32_t vdw_stride; ///< VdwStride word: edge pitch - 64
 	uint32_t edge_pitch4;///< 4 * edge pitch: one block of four rows
 };
@@ -168,7 +171,8 @@ uint32_t *regionSourceRows(uint32_t *out, uint32_t src, uint32_t stride, int src
 /// Dark pass uniforms of one block; then regionTileRows()'s kRegionTileRows words, then
 /// `more`.
 struct RegionDarkUniforms {
-	uint32_t contrast;   ///< FrontEndParams::region_contrast (> 0)
+	uint32_t contrast;   ///< min(FrontEndParams::region_contrast, 65536) (> 0)
+	uint32_t floor2;     ///< 2 clamp(FrontEndParams::light_floor, 0, 128)
 	uint32_t x0;
 	uint32_t txm1;       ///< tiles across - 1: (w + 3) / 4 - 1
 	uint32_t rwm2;       ///< w - 2

@@ -19,6 +19,11 @@
 // the sums does not matter). The running sums keep two generations only (q = I + I',
 // G = hd + hd', F = hs - hs'), so the window needs no register rotation. The tensor's
 // vertical sums lag one more row: V(g-1) = S' + P(g), S = P' + P, P' = P.
+// The thresholds follow the light (front_end_cpu.cpp): the light's q = min(p_0 +
+// light_floor, 128) (not the running sums' q above) of the smoothed row rides in B's byte 3
+// (a regfile-A pack), one row behind the smoothing as B is (QN -> QP), and pass 2 scales
+// both thresholds by it. v8adds saturates at 255, above 128 whatever the floor (the host
+// caps it at 128), so v8min(., 128) gives q exactly; both in MUL slots that were free.
 // The next row's gathers are issued as soon as this row's are popped, so a whole row of
 // work hides the TMU latency: 4 in flight at most (kTmuDepth 4: row R's last column goes
 // out after its first is popped), or 5 with the 8-deep build. Each output row (4 planes)
@@ -35,10 +40,11 @@ namespace {
 // immediate takes B's), and ADD and MUL results of one instruction go to different files.
 constexpr Reg SWMAX = A(1), STEPX = A(2), WMAX = A(3), ROWADDR = A(5), DSTS = A(6),
 	      VPMW = A(7), C106 = A(8), HS = A(22), FP = A(23), COLMASK = A(25), PXX = A(26),
-	      SYY = A(27), PXY = A(28), CNT = A(29), ELEM4 = A(30), VDWTOG = A(31);
+	      SYY = A(27), PXY = A(28), CNT = A(29), ELEM4 = A(30), VDWTOG = A(31), FLOOR = A(0),
+	      QT = A(4), BPREV = A(24);
 constexpr Reg DPITCH = B(4), ROWS = B(7), HD = B(20), GP = B(21), SXX = B(22),
-	      PYY = B(23), SXY = B(24), BPREV = B(25), VDWSTRIDE = B(26), VDWS = B(27),
-	      TMPB = B(29), XS = B(30);
+	      PYY = B(23), SXY = B(24), VDWSTRIDE = B(26), VDWS = B(27),
+	      TMPB = B(29), XS = B(30), K128 = B(3), QN = B(5), QP = B(6);
 constexpr Reg COLOFF[5] = {B(8), B(9), B(10), B(11), B(12)};
 constexpr Reg COLSH[5] = {A(9), A(10), A(11), A(12), A(13)};
 constexpr Reg T[5] = {A(14), B(13), A(15), B(14), A(16)};
@@ -84,11 +90,12 @@ void rowBody(Builder &b)
 	b.op(add(r2, r2, r3));
 	b.op(shr(r0, r0, imm(4)));
 	b.op(shr(r1, r1, imm(4)));
-	b.op(shr(r2, r2, imm(4)));
-	// hs = p-1 + 2 p0 + p1 (r3), hd = p1 - p-1 (r2).
+	b.op(shr(r2, r2, imm(4)), mv8adds(QT, r1, FLOOR)); // p0 + floor, saturated
+	// hs = p-1 + 2 p0 + p1 (r3), hd = p1 - p-1 (r2); q of the row before to QP, this one's
+	// to QN.
 	b.op(add(r3, r0, r2), mul24(r1, r1, imm(2)));
-	b.op(sub(r2, r2, r0));
-	b.op(add(r3, r3, r1));
+	b.op(sub(r2, r2, r0), mmov(QP, QN));
+	b.op(add(r3, r3, r1), v8min(QN, QT, K128));
 	// Two-generation window: F = hs - hs', G = hd + hd'; gy = F' + F, gx = G' + G.
 	b.op(sub(r0, r3, HS), mmov(HS, r3));
 	b.op(add(r1, r2, HD), mmov(HD, r2));
@@ -102,9 +109,10 @@ void rowOutput(Builder &b)
 {
 	// Interior: the row's mask (uniform stream: -1 for rows 1 .. h-2, else 0) and the
 	// column's.
+	// Row G-1's B goes to the VPM first, so that B(G) can be made in BPREV itself.
 	b.op(band(r0, COLMASK, reg::unif));
-	b.op(band(r2, r2, r0));
-	b.op(band(r3, r3, r0));
+	b.op(band(r2, r2, r0), mmov(reg::vw_setup, VPMW));
+	b.op(band(r3, r3, r0), mmov(reg::vpm_write, BPREV));
 	b.op(sub(r0, imm(0), r2));
 	b.op(max(r0, r2, r0));                          // |gx|
 	b.op(sub(r1, imm(0), r3));
@@ -123,12 +131,10 @@ void rowOutput(Builder &b)
 	b.op(mov(r2, imm(0)).ifnn());
 	b.op(add(r0, T[0], T[1]));
 	b.op(shl(r0, r0, imm(2)));
-	b.op(bor(r2, r0, r2));                          // B(G) = m << 2 | dir
+	b.op(bor(BPREV, r0, r2));                       // B(G) = m << 2 | dir
 	b.op(mov(r0, T[0]), mmov(r1, T[1]));
-	b.op(mov(r3, T[2]));
-	// Row G-1 to the VPM: B(G-1), then V = S' + P, S = P' + P, P' = P per product.
-	b.op(mov(reg::vw_setup, VPMW));
-	b.op(mov(reg::vpm_write, BPREV), mmov(BPREV, r2));
+	b.op(mov(Dst(BPREV)[Pack::B8D], QP), mmov(r3, T[2])); // q(G) in byte 3
+	// The rest of row G-1 to the VPM: V = S' + P, S = P' + P, P' = P per product.
 	b.op(add(reg::vpm_write, SXX, r0));
 	b.op(add(SXX, PXX, r0), mmov(PXX, r0));
 	b.op(add(reg::vpm_write, SYY, r1));
@@ -172,6 +178,8 @@ Built build()
 	b.op(mov(WMAX, b.uniform("wmax")));
 	b.op(mov(DPITCH, b.uniform("dst_pitch")));
 	b.op(mov(VDWSTRIDE, b.uniform("vdw_stride")));
+	b.op(mov(FLOOR, b.uniform("light_floor")));
+	b.ldi(K128, 128);
 
 	Label unit = b.label();
 	{

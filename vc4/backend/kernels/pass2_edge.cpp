@@ -5,8 +5,8 @@
 // Lane i holds pixels x0 + 4i + j, j = 0..3 (four sub-pixels), so the four result bytes
 // pack into the lane's word (regfile-A byte packs) and one 16-word VPM row is a 64-pixel
 // image row. The six columns c = 0..5 at x0 + 4i + c - 1 cover the 3x3 neighbourhoods
-// of all four sub-pixels. Plane 0 (B = m << 2 | dir) of rows y-1, y, y+1 is a window in
-// registers that moves down a row at a time, so a row gathers 24 words a lane for 64
+// of all four sub-pixels. Plane 0 (B = q << 24 | m << 2 | dir) of rows y-1, y, y+1 is a
+// window in registers that moves down a row at a time, so a row gathers 24 words a lane for 64
 // pixels: plane 0 of row y+1 and the column sums Vxx, Vyy, Vxy of row y, per column.
 // Their per-lane addresses are a row base plus a lane pattern (kernels.hpp's interleaved
 // layout), and the tensor's horizontal sums are formed as the columns arrive:
@@ -15,10 +15,16 @@
 // kTmuDepth in flight): sub-pixel 0 computes while columns 3 and 4 arrive, 1 while column
 // 5 does, 2 and 3 while the next row's columns 0 .. 2 land where sub-pixels 0 .. 2 no
 // longer look (a column's window moves once its last reader is done).
-// The decisions are those of frappe-core's edgeSpan/isCorner:
-//   edge   : B > thr << 2 | 3, m > m(prev), m >= m(next)
-//            (B(prev) < B & ~3 and B(next) < (B & ~3) + 4: no unpacking of m)
-//   corner : c = (Sxx + Syy - 2T) >> 9, a = |Sxx - Syy| >> 9, b = |Sxy| >> 8,
+// The decisions are those of frappe-core's edgeSpan/isCorner, with thresholds that follow
+// the light: q = byte 3 of the centre's B (pass 1 put it there; regfile-A unpack .8d),
+//   E(q) = ((E' q >> 7) q) >> 7, T(q) = ((T q >> 7) q) >> 7  (mul24: E' q < 2^29, T q < 2^30)
+//   edge   : m > E(q), m > m(prev), m >= m(next)
+//            (B(prev) < B & ~3 and B(next) < (B & ~3) + 4 on the low 24 bits: those
+//            differences lie within +-2^23, so shifted left by 8 (mul24 by 256) the q
+//            bytes drop out and the sign is exact; m > E(q) as
+//            (E' q >> 7) q < 128 m, i.e. without the last shift, 128 m by mul24 of B & ~3,
+//            which reads its low 24 bits only)
+//   corner : c = (Sxx + Syy - 2T(q)) >> 9, a = |Sxx - Syy| >> 9, b = |Sxy| >> 8,
 //            c > 0 and c*c > a*a + b*b (mul24 of values below 2^16)
 // Pixels off the interior are masked at the end of the row (the row's mask comes from
 // the uniform stream, the columns' is computed per unit); their gathers land in the
@@ -52,7 +58,9 @@ constexpr Reg LANEOFF[6] = {B(12), B(13), B(14), B(15), B(16), B(17)};
 constexpr Reg LANEOFFN[3] = {B(18), B(19), B(20)};
 constexpr Reg OUTW = A(24), VPMROW = A(25), VDWTOG = A(26), EDST = A(27), ROWCNT = A(28),
 	      GRPCNT = A(29);
-constexpr Reg THR = B(21), CC = B(22), COLMASK = B(23), MASKACC = B(24), VDWS = B(25),
+// T (a uniform; E' is in r5), the edge test's (E' q >> 7) q, T(q) on its way, 32 and 256.
+constexpr Reg CT = B(21), XE = B(22), TA = A(30), TB = B(31), K32 = B(30), K256 = A(31);
+constexpr Reg COLMASK = B(23), MASKACC = B(24), VDWS = B(25),
 	      VDWSTRIDE = B(26), EPITCH4 = B(27), PITCH = B(28), MDST = B(29);
 
 Dst tmuS(unsigned k) { return (k & 1) ? reg::tmu1_s : reg::tmu0_s; }
@@ -116,6 +124,11 @@ std::vector<Ins> decide(int j)
 	const Reg l = BV[1][j], r = BV[1][j + 2], u = BV[0][j + 1], d = BV[2][j + 1];
 	const Reg ul = BV[0][j], dr = BV[2][j + 2], ur = BV[0][j + 2], dl = BV[2][j];
 	std::vector<Ins> v;
+	// The thresholds at the centre's light q (byte 3 of its B, unpacked where read) ride in
+	// the MUL slots of the decisions: XE = (E' q >> 7) q in the direction tests (E' in r5),
+	// T(q) = ((T q >> 7) q) >> 7 in TA beside the edge test and the corner's a and b; only
+	// the three shifts and a second subtraction of T(q) take instructions of their own.
+	const Src q = bc[Unpack::B8D];
 	// Neighbours along the direction: prev in r1, next in r2.
 	v.push_back(ins(band(r3, bc, imm(3))));
 	if (l.file_b != r.file_b) {
@@ -124,24 +137,24 @@ std::vector<Ins> decide(int j)
 		v.push_back(ins(mov(r1, l)));
 		v.push_back(ins(mov(r2, r)));
 	}
-	v.push_back(ins(sub(reg::nop, r3, imm(1)).setFlags()));
+	v.push_back(ins(sub(reg::nop, r3, imm(1)).setFlags(), mul24(r0, q, r5)));
+	v.push_back(ins(shr(r0, r0, imm(7))));
 	v.push_back(ins(mov(r1, u).ifz(), mmov(r2, d).ifz()));    // 1: up, down
-	v.push_back(ins(sub(reg::nop, r3, imm(2)).setFlags()));
+	v.push_back(ins(sub(reg::nop, r3, imm(2)).setFlags(), mul24(XE, r0, q)));
 	v.push_back(ins(mov(r1, ul).ifz(), mmov(r2, dr).ifz()));  // 2: up-left, down-right
 	v.push_back(ins(sub(reg::nop, r3, imm(3)).setFlags()));
 	v.push_back(ins(mov(r1, ur).ifz(), mmov(r2, dl).ifz()));  // 3: up-right, down-left
-	// Edge: the sign bits of prev - (B & ~3), next - (B & ~3) - 4 and thr - B.
+	// Edge: the sign bits of (prev - (B & ~3)) << 8, (next - (B & ~3) - 4) << 8 (the low
+	// 24 bits' differences: q's bytes shifted out, by mul24) and XE - 128 m.
 	v.push_back(ins(band(r0, bc, imm(-4))));
-	v.push_back(ins(sub(r1, r1, r0)));
+	v.push_back(ins(sub(r1, r1, r0), mul24(r3, r0, K32))); // 128 m
 	v.push_back(ins(add(r0, r0, imm(4))));
-	v.push_back(ins(sub(r2, r2, r0)));
+	v.push_back(ins(sub(r2, r2, r0), mul24(TA, q, CT)));
 	v.push_back(ins(band(r1, r1, r2)));
-	v.push_back(ins(sub(r2, THR, bc)));
-	v.push_back(ins(band(r1, r1, r2)));                      // edge: sign
-	// Corner: c in r0, a in r2, b in r3; the sign of (a^2 + b^2 - c^2) & -c.
-	v.push_back(ins(add(r0, SX[j], SY[j])));
-	v.push_back(ins(sub(r0, r0, CC)));
-	v.push_back(ins(asr(r0, r0, imm(9))));
+	v.push_back(ins(shr(TB, TA, imm(7))));
+	v.push_back(ins(sub(r2, XE, r3), mul24(r1, r1, K256)));
+	v.push_back(ins(band(r1, r1, r2), mul24(TA, TB, q)));    // edge: sign
+	// Corner: a in r2, b in r3, c in r0; the sign of (a^2 + b^2 - c^2) & -c.
 	v.push_back(ins(sub(r2, SX[j], SY[j])));
 	v.push_back(ins(sub(r3, imm(0), r2)));
 	v.push_back(ins(max(r2, r2, r3)));
@@ -149,7 +162,11 @@ std::vector<Ins> decide(int j)
 	v.push_back(ins(sub(r3, imm(0), SZ[j])));
 	v.push_back(ins(max(r3, r3, SZ[j])));
 	v.push_back(ins(shr(r3, r3, imm(8)), mul24(r2, r2, r2)));
-	v.push_back(ins(mul24(r3, r3, r3)));
+	v.push_back(ins(shr(TA, TA, imm(7)), mul24(r3, r3, r3))); // T(q)
+	v.push_back(ins(add(r0, SX[j], SY[j])));
+	v.push_back(ins(sub(r0, r0, TA)));
+	v.push_back(ins(sub(r0, r0, TA)));
+	v.push_back(ins(asr(r0, r0, imm(9))));
 	v.push_back(ins(add(r2, r2, r3), mul24(r3, r0, r0)));
 	v.push_back(ins(sub(r2, r2, r3)));                       // a^2 + b^2 - c^2
 	v.push_back(ins(sub(r3, imm(0), r0)));                   // -c
@@ -177,8 +194,10 @@ Built build()
 	b.op(shl(r1, r0, imm(10))); // Y = 8q at bit 7
 	b.op(add(VDWS, r2, r1));
 	b.op(mov(PITCH, b.uniform("grad_pitch")));
-	b.op(mov(THR, b.uniform("edge_thr")));
-	b.op(mov(CC, b.uniform("corner_c")));
+	b.op(mov(reg::r5rep, b.uniform("edge_thr")));
+	b.op(mov(CT, b.uniform("corner_t")));
+	b.ldi(K32, 32);
+	b.ldi(K256, 256);
 	b.op(mov(VDWSTRIDE, b.uniform("vdw_stride")));
 	b.op(mov(EPITCH4, b.uniform("edge_pitch4")));
 	// Lane patterns (kernels.hpp): column c >= 1 is the run of sub-pixel c-1, 4 lane + 64

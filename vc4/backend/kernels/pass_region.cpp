@@ -12,7 +12,8 @@
 //    tile row the four rows of r and a row of tile words lo | (255 - hi) << 8, one VDW.
 //  dark (regionDarkPass): the nine tile words around a tile (clamped to the tiles that
 //    exist) reduced by v8min, which gives the least lo and, in byte 1, 255 - the greatest
-//    hi; mid = (lo + hi + 1) >> 1 when hi - lo >= contrast, else 0; a pixel is dark when
+//    hi; mid = (lo + hi + 1) >> 1 when hi - lo >= C, else 0, where the contrast follows the
+//    light, C = (contrast * min(lo + hi + 2 floor, 256) + 255) >> 8; a pixel is dark when
 //    v8subs(mid x 4, r) is non-zero in its byte (r < mid), v8min with the lane's interior
 //    column bytes makes that kEdge, a row mask from the uniform stream clears the outer
 //    rows. Four rows a VDW, double-buffered; the OR of the block's words is its mask row.
@@ -196,9 +197,10 @@ Built build()
 namespace dark {
 
 constexpr Reg COLW = A(0), M4 = A(1), MASKACC = A(2), VPMROW = A(3), EDST = A(4), MDST = A(5),
-	      VDWTOG = A(6), UNITDIFF = A(7), TRCNT = A(8), TXM1 = A(9), RWM2 = A(10);
+	      VDWTOG = A(6), UNITDIFF = A(7), TRCNT = A(8), TXM1 = A(9), RWM2 = A(10), CONTRAST = A(11);
 constexpr Reg COLOFF[3] = {B(0), B(1), B(2)};
-constexpr Reg LANE4 = B(3), CONTRAST = B(4), VDWSTRIDE = B(5), EPITCH4 = B(6), VDWS = B(7), XS = B(8);
+constexpr Reg FLOOR2 = B(9), C256 = B(10);
+constexpr Reg LANE4 = B(3), VDWSTRIDE = B(5), EPITCH4 = B(6), VDWS = B(7), XS = B(8);
 
 // Requests 0 .. 8: the tile words of rows up, this, down (r0, r1, r2) at the clamped columns
 // left, this, right; 9 .. 12: the four rows of r (addresses from the uniform stream).
@@ -230,10 +232,16 @@ void tileRow(Builder &b)
 	b.op(band(r1, r1, r5));
 	b.op(bxor(r1, r1, r5));                       // hi
 	b.op(sub(r2, r1, r0));                        // hi - lo
-	b.op(add(r1, r1, r0));
-	b.op(add(r1, r1, imm(1)));
+	b.op(add(r1, r1, r0));                        // lo + hi
+	// The contrast at this light: (contrast * min(lo + hi + 2 floor, 256) + 255) >> 8
+	// (contrast <= 2^16: the product fits mul24).
+	b.op(add(r3, r1, FLOOR2));
+	b.op(min(r3, r3, C256));
+	b.op(add(r1, r1, imm(1)), mul24(r3, r3, CONTRAST));
 	b.op(shr(r1, r1, imm(1)));                    // mid
-	b.op(sub(reg::nop, r2, CONTRAST).setFlags());
+	b.op(add(r3, r3, r5));                        // + 255
+	b.op(shr(r3, r3, imm(8)));
+	b.op(sub(reg::nop, r2, r3).setFlags());
 	b.op(mov(r1, imm(0)).ifn());                  // too little contrast: nothing is dark
 	b.op(mov(Dst(M4)[Pack::B8888], r1));          // mid in every byte
 	b.op(mov(reg::vw_setup, VPMROW));
@@ -258,10 +266,11 @@ Built build()
 	b.ldi(reg::r5rep, 0xff);
 	b.ldi(VDWTOG, 4u << 7);     // VDW VPM base Y sits at bit 7: flip between the two halves
 	b.ldi(UNITDIFF, 3u << 23);  // VDW units 4 -> 1
+	b.ldi(C256, 256);
 	vpmRows(b, VPMROW, VDWS, 4);
 
 	Label block = b.label();
-	readUniforms(b, {{CONTRAST, "contrast"}, {XS, "x0"}, {TXM1, "txm1"}, {RWM2, "rwm2"},
+	readUniforms(b, {{CONTRAST, "contrast"}, {FLOOR2, "floor2"}, {XS, "x0"}, {TXM1, "txm1"}, {RWM2, "rwm2"},
 	                 {EDST, "out_dst", UniformKind::Address}, {VDWSTRIDE, "vdw_stride"},
 	                 {EPITCH4, "out_pitch4"}, {MDST, "mask_dst", UniformKind::Address}});
 	// Byte j of COLW: 1 when pixel x = x0 + 4 lane + j is in 1 .. w-2 (the outermost

@@ -60,8 +60,25 @@ Img scene(int width, int height, unsigned seed, int markers, int padding = 0)
 
 size_t last_edges = 0, last_corners = 0, last_dark = 0;
 
-// Region contrast 41: Config's default 0.16, so every comparison covers the region map too.
-FrontEndParams params(int64_t edge = 400, int64_t corner = 2000, int region = 41) { return {edge, corner, region}; }
+// Region contrast 41: Config's default 0.16, so every comparison covers the region map too;
+// light floor 16: Config's default 0.063 (thresholds that follow the light below mid-grey).
+FrontEndParams params(int64_t edge = 400, int64_t corner = 2000, int region = 41, int floor = 16)
+{
+	return {edge, corner, region, floor};
+}
+
+// The light floors every kind of comparison runs at: the default, none (thresholds scaled
+// down to zero in black), and 128 (the absolute thresholds of the paper).
+constexpr int kFloors[] = {16, 0, 128};
+
+// A dim copy of a scene (grey levels times num / den): most of it below mid-grey, where the
+// thresholds follow the light.
+Img dimmed(Img img, int num, int den)
+{
+	for (uint8_t &v : img.pixels)
+		v = static_cast<uint8_t>(v * num / den);
+	return img;
+}
 
 void expectSameMap(const TraceMap &got, const TraceMap &want, const std::string &what)
 {
@@ -102,14 +119,15 @@ void compare(const Img &img, float scale, const FrontEndParams &p, unsigned seed
 	last_dark = static_cast<size_t>(std::count(want.regions.pixels.begin(), want.regions.pixels.end(), TraceMap::kEdge));
 }
 
-// Pass 1's planes from frappe-core's own scaling, smoothing and Sobel rows: B = m << 2 | dir
-// and the tensor products summed over rows y-1 .. y+1 (zero beyond the frame).
+// Pass 1's planes from frappe-core's own scaling, smoothing and Sobel rows: B = q << 24 |
+// m << 2 | dir (q = min(smoothed + floor, 128)) and the tensor products summed over rows
+// y-1 .. y+1 (zero beyond the frame).
 struct Planes {
 	int w = 0, h = 0;
 	std::vector<uint32_t> b, xx, yy, xy;
 };
 
-Planes referencePlanes(const Img &img, float scale)
+Planes referencePlanes(const Img &img, float scale, int floor)
 {
 	Planes r;
 	r.w = scale < 1.0f ? scaledLength(img.width, scale) : img.width;
@@ -144,7 +162,8 @@ Planes referencePlanes(const Img &img, float scale)
 			const size_t i = static_cast<size_t>(y) * w + x;
 			const int ax = std::abs(gx[i]), ay = std::abs(gy[i]);
 			const uint32_t dir = 256 * ay <= 106 * ax ? 0 : 256 * ax <= 106 * ay ? 1 : (gx[i] > 0) == (gy[i] > 0) ? 2 : 3;
-			r.b[i] = static_cast<uint32_t>(gx[i] * gx[i] + gy[i] * gy[i]) << 2 | dir;
+			const uint32_t q = static_cast<uint32_t>(std::min(sm[i] + floor, FrontEndParams::kLightReference));
+			r.b[i] = q << 24 | static_cast<uint32_t>(gx[i] * gx[i] + gy[i] * gy[i]) << 2 | dir;
 			for (int yy = std::max(0, y - 1); yy <= std::min(h - 1, y + 1); ++yy) {
 				const size_t j = static_cast<size_t>(yy) * w + x;
 				r.xx[i] += static_cast<uint32_t>(gx[j] * gx[j]);
@@ -157,15 +176,15 @@ Planes referencePlanes(const Img &img, float scale)
 
 // Pass 1 alone: its gradient buffer against referencePlanes(); then pass 2, whose input is
 // thereby the reference, against the CPU's EdgeMap (expectSame in compare()).
-void comparePass1(const Img &img, float scale, unsigned seed, const std::string &what)
+void comparePass1(const Img &img, float scale, unsigned seed, const std::string &what, int floor = 16)
 {
 	auto fe = vc4::makeFrontEnd({.emulate = true, .seed = seed, .strict = true});
 	EdgeMap got;
-	fe->run(img.view(), scale, params(), got);
+	fe->run(img.view(), scale, params(400, 2000, 41, floor), got);
 	std::vector<uint32_t> buf;
 	int pitch = 0;
 	ASSERT_TRUE(vc4::lastGradientBuffer(*fe, buf, pitch)) << what;
-	const Planes ref = referencePlanes(img, scale);
+	const Planes ref = referencePlanes(img, scale, floor);
 	ASSERT_EQ(got.width, ref.w);
 	size_t bad = 0;
 	std::string first;
@@ -190,6 +209,9 @@ TEST(Vc4Kernels, GradientPassMatchesCoreRows)
 	comparePass1(scene(130, 70, 4, 2, 3), 1.0f, 2, "130x70 stride 133");
 	comparePass1(scene(200, 150, 5, 2), 0.5f, 3, "200x150 scale 0.5");
 	comparePass1(scene(161, 97, 6, 2), 0.7f, 4, "161x97 scale 0.7");
+	for (const int floor : kFloors)
+		comparePass1(dimmed(scene(130, 70, 8, 2), 1, 3), 1.0f, 5, "130x70 dim, floor " + std::to_string(floor), floor);
+	comparePass1(scene(67, 33, 1, 1), 1.0f, 0, "67x33 floor 200", 200);
 }
 
 // One launch of a kernel driven without the front end (seed 0: round robin); every program
@@ -209,7 +231,7 @@ void runJobs(vc4::emu::Device &dev, const std::vector<vc4::emu::Job> &jobs, unsi
 void comparePass2(const Img &img, const FrontEndParams &p, unsigned seed, const std::string &what)
 {
 	namespace k = vc4::kernels;
-	const Planes ref = referencePlanes(img, 1.0f);
+	const Planes ref = referencePlanes(img, 1.0f, std::max(p.light_floor, 0));
 	const int w = ref.w, h = ref.h;
 	const uint32_t pw = (w + 63) / 64 * 64, ph = (h + 31) / 32 * 32, pitch = 16 * pw, margin = k::gradMargin(pitch);
 	const unsigned tx = pw / 64, tiles = tx * (ph / 32), units = tx * (ph / k::kEdgeRows);
@@ -228,11 +250,10 @@ void comparePass2(const Img &img, const FrontEndParams &p, unsigned seed, const 
 				std::memcpy(grad.cpu.data() + margin + y * pitch + q * pitch / 4 + 4 * k::gradWord(x), &v[q], 4);
 		}
 	const auto code = dev.upload(k::edgePass().program.code);
-	const int64_t thr = std::clamp<int64_t>(p.edge_threshold_sq, -1, int64_t{1} << 22);
 	std::vector<vc4::emu::Job> jobs;
 	for (unsigned prog = 0; prog < programs; ++prog) {
-		const k::EdgeUniforms e{pitch, static_cast<uint32_t>(thr) << 2 | 3u,
-		                        2u * static_cast<uint32_t>(static_cast<int32_t>(p.corner_threshold)),
+		const k::EdgeUniforms e{pitch, uint32_t(std::clamp<int64_t>(p.edge_threshold_sq, 0, int64_t{1} << 22)),
+		                        uint32_t(std::clamp<int64_t>(p.corner_threshold, 0, (int64_t{1} << 23) - 1)),
 		                        vc4::isa::VdwStride{.stride = uint16_t(pw - 64)}.word(), 4 * pw};
 		const auto *words = reinterpret_cast<const uint32_t *>(&e);
 		std::vector<uint32_t> u(words, words + k::kEdgeUniforms);
@@ -272,6 +293,13 @@ TEST(Vc4Kernels, EdgePassMatchesCoreOnCoreGradients)
 	comparePass2(scene(7, 5, 3, 0), params(0, 0), 1, "7x5");
 	comparePass2(scene(200, 150, 5, 3), params(), 2, "200x150");
 	comparePass2(scene(131, 97, 6, 2), params(100, 500), 3, "131x97 low thresholds");
+	// Thresholds that follow the light, on a dim scene, at each floor.
+	const Img dim = dimmed(scene(200, 150, 9, 3), 2, 7);
+	for (const int floor : kFloors)
+		for (const auto &[edge, corner] : {std::pair<int64_t, int64_t>{4740, 12354}, {400, 2000}, {-1, 0}, {int64_t{1} << 30, 0}})
+			comparePass2(dim, params(edge, corner, 41, floor), floor % 5,
+			             "dim 200x150 floor " + std::to_string(floor) + " thresholds " + std::to_string(edge) + " " +
+			                     std::to_string(corner));
 }
 
 // The region map's means pass alone, on the emulator without the front end: its rows of r
@@ -353,13 +381,14 @@ TEST(Vc4Kernels, ListingsRoundTrip)
 	namespace k = vc4::kernels;
 	EXPECT_EQ(k::gradientPass().program.uniforms.size(), k::kGradientUniforms + k::kGradientUnitUniforms + 1);
 	EXPECT_EQ(k::edgePass().program.uniforms.size(), k::kEdgeUniforms + k::kEdgeUnitUniforms + 1);
-	EXPECT_EQ(k::gradientPass().program.uniformIndex("vdw_stride"), k::kGradientUniforms - 1);
+	EXPECT_EQ(k::gradientPass().program.uniformIndex("vdw_stride"), k::kGradientUniforms - 2);
+	EXPECT_EQ(k::gradientPass().program.uniformIndex("light_floor"), k::kGradientUniforms - 1);
 	EXPECT_EQ(k::gradientPass().program.uniformIndex("rows"), k::kGradientUniforms + k::kGradientUnitUniforms - 1);
 	EXPECT_EQ(k::edgePass().program.uniformIndex("edge_pitch4"), k::kEdgeUniforms - 1);
 	EXPECT_EQ(k::edgePass().program.uniformIndex("mask_dst"), k::kEdgeUniforms + k::kEdgeUnitUniforms - 1);
 	EXPECT_EQ(k::regionMeansPass().program.uniforms.size(), k::kRegionMeansUniforms + 1);
 	EXPECT_EQ(k::regionDarkPass().program.uniforms.size(), k::kRegionDarkUniforms + 1);
-	EXPECT_EQ(k::regionDarkPass().program.uniformIndex("mask_dst"), 7u);
+	EXPECT_EQ(k::regionDarkPass().program.uniformIndex("mask_dst"), 8u);
 	// Every program keeps to the build's TMU depth, and the safe one always.
 	for (const auto &built : {k::gradientPass(), k::edgePass(), k::regionMeansPass(), k::regionDarkPass()}) {
 		EXPECT_TRUE(vc4::qasm::lint(built.program.code, vc4::kTmuDepth).empty()) << built.program.name;
@@ -549,12 +578,42 @@ TEST(Vc4FrontEnd, SparseTileMask)
 	}
 }
 
+// Six threshold pairs at each light floor, on a scene and on a dim copy of it (where the
+// thresholds follow the light), and floors beyond 128 (absolute) and negative (the CPU's).
 TEST(Vc4FrontEnd, Thresholds)
 {
-	const Img img = scene(150, 90, 7, 2);
-	for (const auto p : {params(0, 0), params(-5, -100), params(100, 500), params(2500, 20000),
-	                     params(int64_t{1} << 40, 0), params(400, int64_t{1} << 20)})
-		compare(img, 1.0f, p, 0, "thresholds " + std::to_string(p.edge_threshold_sq) + " " + std::to_string(p.corner_threshold));
+	const Img img = scene(150, 90, 7, 2), dim = dimmed(img, 1, 4);
+	for (const int floor : {16, 0, 128, 1, 127, 255})
+		for (const Img *frame : {&img, &dim})
+			for (auto p : {params(0, 0), params(-5, -100), params(100, 500), params(2500, 20000),
+			               params(int64_t{1} << 40, 0), params(400, int64_t{1} << 20), params(4740, 12354),
+			               params(int64_t{1} << 22, (int64_t{1} << 23) - 1)}) {
+				p.light_floor = floor;
+				compare(*frame, 1.0f, p, floor % 3,
+				        std::string(frame == &dim ? "dim " : "") + "floor " + std::to_string(floor) + " thresholds " +
+				                std::to_string(p.edge_threshold_sq) + " " + std::to_string(p.corner_threshold));
+			}
+	compare(dim, 1.0f, params(400, 2000, 41, -20), 0, "negative floor");
+}
+
+// A frame whose light falls from white to black across it: edges and dark regions where
+// the thresholds are scaled down, at each floor; more edges with a lower floor.
+TEST(Vc4FrontEnd, ThresholdsFollowTheLight)
+{
+	Img img = scene(260, 140, 17, 4);
+	for (int y = 0; y < img.height; ++y)
+		for (int x = 0; x < img.width; ++x) {
+			uint8_t &v = img.pixels[static_cast<size_t>(y) * img.stride + x];
+			v = static_cast<uint8_t>(v * (img.width - x) / img.width);
+		}
+	size_t edges[3] = {};
+	for (int k = 0; k < 3; ++k) {
+		compare(img, 1.0f, params(4740, 12354, 41, kFloors[k]), static_cast<unsigned>(k),
+		        "gradient of light, floor " + std::to_string(kFloors[k]));
+		edges[k] = last_edges;
+	}
+	EXPECT_GT(edges[1], edges[0]); // floor 0 > floor 16
+	EXPECT_GT(edges[0], edges[2]); // floor 16 > absolute
 }
 
 TEST(Vc4FrontEnd, Interleavings)
@@ -588,21 +647,27 @@ TEST(Vc4Regions, SmallMapsAndContrasts)
 {
 	for (const int h : {6, 7, 11})
 		for (const int w : {6, 7, 8, 9, 13})
-			for (const int contrast : {1, 41}) {
-				const std::string what = std::to_string(w) + "x" + std::to_string(h) + " contrast " +
-				                         std::to_string(contrast);
-				compare(scene(w, h, static_cast<unsigned>(w * 31 + h), 0), 1.0f, params(0, 0, contrast), 0, what);
-			}
+			for (const int contrast : {1, 41})
+				for (const int floor : kFloors) {
+					const std::string what = std::to_string(w) + "x" + std::to_string(h) + " contrast " +
+					                         std::to_string(contrast) + " floor " + std::to_string(floor);
+					compare(scene(w, h, static_cast<unsigned>(w * 31 + h), 0), 1.0f, params(0, 0, contrast, floor), 0,
+					        what);
+				}
 	const Img img = scene(150, 90, 7, 2);
-	for (const int contrast : {0, 1, 20, 41, 128, 255, 1000}) {
-		const std::string what = "contrast " + std::to_string(contrast);
-		compare(img, 1.0f, params(400, 2000, contrast), contrast % 3, what);
-		if (contrast == 0 || contrast > 255) {
-			EXPECT_EQ(last_dark, 0u) << what;
-		} else if (contrast <= 128) {
-			EXPECT_GT(last_dark, 100u) << what;
-		}
-	}
+	const Img dim = dimmed(img, 1, 3);
+	for (const int floor : {16, 0, 128, 7, 300})
+		for (const Img *frame : {&img, &dim})
+			for (const int contrast : {0, 1, 20, 41, 128, 255, 1000, 65280, 65281, 1 << 20}) {
+				const std::string what = std::string(frame == &dim ? "dim " : "") + "contrast " +
+				                         std::to_string(contrast) + " floor " + std::to_string(floor);
+				compare(*frame, 1.0f, params(400, 2000, contrast, floor), contrast % 3, what);
+				if (contrast == 0 || contrast > 255 * 256) {
+					EXPECT_EQ(last_dark, 0u) << what;
+				} else if (contrast <= 128 && frame == &img) {
+					EXPECT_GT(last_dark, 100u) << what;
+				}
+			}
 	EdgeMap off;
 	vc4::makeFrontEnd({})->run(img.view(), 1.0f, params(400, 2000, 0), off);
 	EXPECT_EQ(off.regions.width, 0);
@@ -619,8 +684,11 @@ TEST(Vc4Regions, ScenesScalesAndSeeds)
 		const Img img = scene(c.w, c.h, c.w * 7 + c.h, 4, c.pad);
 		const std::string what = std::to_string(c.w) + "x" + std::to_string(c.h) + " scale " +
 		                         std::to_string(c.scale) + " seed " + std::to_string(c.seed);
-		compare(img, c.scale, params(), c.seed, what);
-		EXPECT_GT(last_dark, 20u) << what;
+		for (const int floor : kFloors) {
+			compare(floor ? img : dimmed(img, 1, 3), c.scale, params(400, 2000, 41, floor), c.seed,
+			        what + " floor " + std::to_string(floor));
+			EXPECT_GT(last_dark, 20u) << what;
+		}
 	}
 	// A flat frame with one marker: most of the map's 16x16 blocks empty.
 	Img flat{300, 200, 300, std::vector<uint8_t>(300 * 200, 128)};
@@ -663,7 +731,9 @@ TEST(Vc4FrontEnd, SharedImages)
 	const bool all = std::getenv("FRAPPE_VC4_ALL") && std::string(std::getenv("FRAPPE_VC4_ALL")) == "1";
 	const size_t limit = all ? files.size() : 10;
 	const size_t step = all ? 1 : std::max<size_t>(1, files.size() / limit);
-	const FrontEndParams p = params(4740, 12354, 41); // Config's defaults 0.27, 0.19 and 0.16
+	// Config's defaults 0.27, 0.19, 0.16 and 0.063; every third image at floor 0, and at
+	// 128 (the absolute thresholds), in turn.
+	const FrontEndParams defaults = params(4740, 12354, 41, 16);
 	size_t runs = 0, fallback = 0, frames = 0;
 	auto cpu = makeCpuFrontEnd(1);
 	// FRAPPE_VC4_SHARD=k/n: only images i with i % n == k (to spread a full run over cores).
@@ -680,11 +750,14 @@ TEST(Vc4FrontEnd, SharedImages)
 		const ImageView view(m.data, m.cols, m.rows, static_cast<int>(m.step));
 		const unsigned seed = static_cast<unsigned>(i % 5); // 0: round robin
 		auto fe = vc4::makeFrontEnd({.emulate = true, .seed = seed, .strict = true});
+		FrontEndParams p = defaults;
+		p.light_floor = kFloors[frames % 3];
 		for (const float scale : {1.0f, std::min(1.0f, 320.0f / static_cast<float>(m.cols))}) {
 			EdgeMap want, got;
 			cpu->run(view, scale, p, want);
 			fe->run(view, scale, p, got);
-			expectSame(got, want, files[i].string() + " scale " + std::to_string(scale) + " seed " + std::to_string(seed));
+			expectSame(got, want, files[i].string() + " scale " + std::to_string(scale) + " seed " + std::to_string(seed) +
+			                              " floor " + std::to_string(p.light_floor));
 			if (want.width > vc4::kMaxQpuWidth)
 				++fallback;
 			++runs;

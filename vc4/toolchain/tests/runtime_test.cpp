@@ -6,9 +6,11 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <fstream>
-#include <future>
+#include <optional>
+#include <thread>
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -579,14 +581,24 @@ TEST(RuntimeOs, ReadFileRefusesFifosDevicesAndLargeFiles)
 	const std::string fifo = std::string(dir) + "/model", small = std::string(dir) + "/small",
 	                  large = std::string(dir) + "/large";
 	ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
-	auto outcome = std::async(std::launch::async, [&] { return systemOs().readFile(fifo); });
-	if (outcome.wait_for(std::chrono::seconds(3)) != std::future_status::ready) {
+	// A thread polled, not std::future: libstdc++ has no timed futex wait on ARMv6.
+	std::atomic<bool> done{ false };
+	std::optional<std::string> got = std::string("not read");
+	std::thread reader([&] {
+		got = systemOs().readFile(fifo);
+		done = true;
+	});
+	const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(3);
+	while (!done && std::chrono::steady_clock::now() < end)
+		std::this_thread::sleep_for(std::chrono::milliseconds(5));
+	if (!done) {
 		ADD_FAILURE() << "readFile blocked on a FIFO";
 		const int fd = ::open(fifo.c_str(), O_WRONLY | O_NONBLOCK); // set it free
 		if (fd >= 0)
 			::close(fd);
 	}
-	EXPECT_EQ(outcome.get(), std::nullopt);
+	reader.join();
+	EXPECT_EQ(got, std::nullopt);
 	EXPECT_EQ(systemOs().readFile("/dev/zero"), std::nullopt);
 	std::ofstream(small) << "Raspberry Pi Zero W Rev 1.1";
 	EXPECT_EQ(systemOs().readFile(small), "Raspberry Pi Zero W Rev 1.1");
