@@ -171,27 +171,21 @@ Binarised binarise(const WarpedMarker &w, int bits)
 		}
 	}
 	const float thr = lo + 0.5f * (hi - lo);
-	auto cellMean = [&](int cx, int cy) {
-		float s = 0.0f;
-		for (int y = 0; y < k; ++y)
-			for (int x = 0; x < k; ++x)
-				s += w.at(cx * k + x, cy * k + y);
-		return s / static_cast<float>(k * k);
-	};
+	auto mean = [&](int cx, int cy) { return cellMean(w, k, cx, cy); };
 	Binarised out;
 	out.contrast = hi - lo;
 	out.threshold = thr;
 	for (int cy = 1; cy <= bits; ++cy) {
 		for (int cx = 1; cx <= bits; ++cx)
-			out.code = (out.code << 1) | (cellMean(cx, cy) > thr ? 1u : 0u);
+			out.code = (out.code << 1) | (mean(cx, cy) > thr ? 1u : 0u);
 	}
 	for (int c = 0; c < cells; ++c) {
-		out.border_errors += cellMean(c, 0) > thr;
-		out.border_errors += cellMean(c, cells - 1) > thr;
+		out.border_errors += mean(c, 0) > thr;
+		out.border_errors += mean(c, cells - 1) > thr;
 	}
 	for (int c = 1; c < cells - 1; ++c) {
-		out.border_errors += cellMean(0, c) > thr;
-		out.border_errors += cellMean(cells - 1, c) > thr;
+		out.border_errors += mean(0, c) > thr;
+		out.border_errors += mean(cells - 1, c) > thr;
 	}
 	return out;
 }

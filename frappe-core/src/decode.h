@@ -84,6 +84,16 @@ struct Binarised {
 	float threshold = 0.0f; ///< the grey level between black and white
 };
 
+/// The mean of cell (cx, cy)'s k x k samples.
+inline float cellMean(const WarpedMarker &w, int k, int cx, int cy)
+{
+	float s = 0.0f;
+	for (int y = 0; y < k; ++y)
+		for (int x = 0; x < k; ++x)
+			s += w.at(cx * k + x, cy * k + y);
+	return s / static_cast<float>(k * k);
+}
+
 /// Thresholds the payload at the mid-point of its darkest and brightest
 /// samples, averages the k x k samples of each cell (k = side / (bits + 2):
 /// 2 for warpMarker's grid, 1 for a grid of cell centres), and checks the

@@ -82,13 +82,7 @@ CellRead readCells(const WarpedMarker &w, int bits, const Binarised &b, float we
 	const float thr = b.threshold;
 	const float clear = kStraddle * b.contrast;
 	const float half = 0.5f * b.contrast;
-	auto mean = [&](int cx, int cy) {
-		float sum = 0.0f;
-		for (int y = 0; y < k; ++y)
-			for (int x = 0; x < k; ++x)
-				sum += w.at(cx * k + x, cy * k + y);
-		return sum / static_cast<float>(k * k);
-	};
+	auto mean = [&](int cx, int cy) { return cellMean(w, k, cx, cy); };
 	/* Glare: a black border cell at the sensor's ceiling. */
 	const float clip = tone.apply(kClipped);
 	bool glare = false;

@@ -426,6 +426,21 @@ std::vector<std::uint8_t> slowRegionMap(const Gray &g, int minContrast, int ligh
 	return out;
 }
 
+/* A map's tile mask against the pixels it should mark: a tile is set
+ * exactly when one of its 16 x 16 pixels is. */
+void compareTileMask(const TraceMap &map, const std::vector<std::uint8_t> &want, int w, int h, const char *what,
+		     const char *kind)
+{
+	for (int ty = 0; ty < map.tiles_y; ++ty)
+		for (int tx = 0; tx < map.tiles_x; ++tx) {
+			bool any = false;
+			for (int y = ty * 16; y < std::min(h, ty * 16 + 16); ++y)
+				for (int x = tx * 16; x < std::min(w, tx * 16 + 16); ++x)
+					any = any || want[static_cast<std::size_t>(y) * w + x];
+			CHECK(!map.tileEmpty(tx, ty) == any, "%s: %s tile %d,%d", what, kind, tx, ty);
+		}
+}
+
 /* The whole region map (this build's: the ARMv6 kernels) against the rule,
  * pixels and tile mask; the number of dark pixels. */
 std::size_t compareRegionMap(const Gray &g, int contrast, const char *what, int lightFloor = 16)
@@ -441,14 +456,7 @@ std::size_t compareRegionMap(const Gray &g, int contrast, const char *what, int 
 	regionMap(ImageView(g.px.data(), g.w, g.h, g.w), 1.0f, params, map, shades, scratch);
 	if (w >= 3 && h >= 3 && lightFloor < 128) {
 		CHECK(shades.pixels == wantShades, "%s: shade map pixels", what);
-		for (int ty = 0; ty < shades.tiles_y; ++ty)
-			for (int tx = 0; tx < shades.tiles_x; ++tx) {
-				bool any = false;
-				for (int y = ty * 16; y < std::min(h, ty * 16 + 16); ++y)
-					for (int x = tx * 16; x < std::min(w, tx * 16 + 16); ++x)
-						any = any || wantShades[static_cast<std::size_t>(y) * w + x];
-				CHECK(!shades.tileEmpty(tx, ty) == any, "%s: shade tile %d,%d", what, tx, ty);
-			}
+		compareTileMask(shades, wantShades, w, h, what, "shade");
 	}
 	if (w < 3 || h < 3) {
 		CHECK(map.width == 0, "%s: a map of a frame too small", what);
@@ -465,14 +473,7 @@ std::size_t compareRegionMap(const Gray &g, int contrast, const char *what, int 
 	}
 	CHECK(diff == 0, "%s: %zu region pixels differ", what, diff);
 	compareTracers(map, what);
-	for (int ty = 0; ty < map.tiles_y; ++ty)
-		for (int tx = 0; tx < map.tiles_x; ++tx) {
-			bool any = false;
-			for (int y = ty * 16; y < std::min(h, ty * 16 + 16); ++y)
-				for (int x = tx * 16; x < std::min(w, tx * 16 + 16); ++x)
-					any = any || want[static_cast<std::size_t>(y) * w + x];
-			CHECK(!map.tileEmpty(tx, ty) == any, "%s: region tile %d,%d", what, tx, ty);
-		}
+	compareTileMask(map, want, w, h, what, "region");
 	return dark;
 }
 
