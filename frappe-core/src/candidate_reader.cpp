@@ -260,8 +260,12 @@ void Detector::Impl::sampleRefined(Reading &r, const detail::Quad &q, std::size_
 void Detector::Impl::readInset(Reading &r, detail::Quad &q, const detail::DecodePolicy &pol, StageTimer &timer)
 {
 	timer.lap(Stage::Refine);
-	q.corners = r.outline;
-	const bool inset = detail::insetQuad(r.block.view, q.corners, dict->bits, warped, pol.tone);
+	if (r.inset == 0) {
+		r.insetCorners = r.outline;
+		r.inset = detail::insetCorners(r.block.view, r.insetCorners, dict->bits) ? 1 : -1;
+	}
+	q.corners = r.inset > 0 ? r.insetCorners : r.outline;
+	const bool inset = r.inset > 0 && detail::warpMarker(r.block.view, q.corners, dict->bits, warped, pol.tone);
 	r.readable = inset && bigEnough(q.corners, r.minSide);
 	if (!r.readable)
 		return;
@@ -349,7 +353,11 @@ bool Detector::Impl::readCandidate(const ImageView &image, Slot &slot, std::size
 	detail::MarkerRead read = readWith(policy);
 	const bool counted = r.counted;
 	if (!read.ok() && !logPolicy.tone.linear()) {
+		const int inset = r.inset;
+		const std::array<Point2f, 4> insetCorners = r.insetCorners;
 		r = refined;
+		r.inset = inset;
+		r.insetCorners = insetCorners;
 		q.corners = refinedCorners;
 		read = readWith(logPolicy);
 	}

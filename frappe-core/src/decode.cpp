@@ -32,8 +32,19 @@ void Tone::apply(WarpedMarker &w) const
 	if (linear())
 		return;
 	const float k = 1.0f / logFloor, norm = 255.0f / std::log1p(255.0f * k);
-	for (int i = 0; i < w.side * w.side; ++i)
-		w.samples[static_cast<std::size_t>(i)] = norm * std::log1p(std::max(w.samples[static_cast<std::size_t>(i)], 0.0f) * k);
+	for (int i = 0; i < w.side * w.side; ++i) {
+		float &v = w.samples[static_cast<std::size_t>(i)];
+		const int g = static_cast<int>(v);
+		v = table && g >= 0 && g <= 255 && static_cast<float>(g) == v ? table[g]
+									       : norm * std::log1p(std::max(v, 0.0f) * k);
+	}
+}
+
+void Tone::fillTable(float *out256) const
+{
+	const float k = 1.0f / logFloor, norm = 255.0f / std::log1p(255.0f * k);
+	for (int g = 0; g < 256; ++g)
+		out256[g] = norm * std::log1p(static_cast<float>(g) * k);
 }
 
 bool warpMarker(const ImageView &image, const std::array<Point2f, 4> &corners, int bits,
@@ -138,8 +149,7 @@ bool warpCellCentres(const ImageView &image, const std::array<Point2f, 4> &corne
 	return true;
 }
 
-bool insetQuad(const ImageView &image, std::array<Point2f, 4> &corners, int bits,
-	       WarpedMarker &out, Tone tone)
+bool insetCorners(const ImageView &image, std::array<Point2f, 4> &corners, int bits)
 {
 	const auto H = Homography::fromUnitSquare(corners);
 	if (!H)
@@ -153,7 +163,15 @@ bool insetQuad(const ImageView &image, std::array<Point2f, 4> &corners, int bits
 	}
 	if (!refineCorners(image, inner, std::max(1.5f, 1.2f * cell)))
 		return false;
-	if (!warpMarker(image, inner, bits, out, tone))
+	corners = inner;
+	return true;
+}
+
+bool insetQuad(const ImageView &image, std::array<Point2f, 4> &corners, int bits,
+	       WarpedMarker &out, Tone tone)
+{
+	std::array<Point2f, 4> inner = corners;
+	if (!insetCorners(image, inner, bits) || !warpMarker(image, inner, bits, out, tone))
 		return false;
 	corners = inner;
 	return true;

@@ -30,7 +30,12 @@ struct Tone {
 	/// which keeps the darkest levels' noise from being magnified without
 	/// bound: v -> 255 ln(1 + v / floor) / ln(1 + 255 / floor), 0 .. 255.
 	float logFloor = 0.0f;
+	/// Optional: apply()'s value of each grey level 0 .. 255 (fillTable()),
+	/// for samples that are whole grey levels (the fixed-point warp's):
+	/// the same floats, without a log each.
+	const float *table = nullptr;
 	bool linear() const { return logFloor <= 0.0f; }
+	void fillTable(float *out256) const;
 	float apply(float v) const;
 	/// apply()'s inverse: the grey level of a value on this scale.
 	float invert(float v) const;
@@ -57,8 +62,12 @@ bool warpMarker(const ImageView &image, const std::array<Point2f, 4> &corners, i
 		WarpedMarker &out, Tone tone = {});
 
 /// Treats `corners` as the outline of a one-cell quiet zone: moves them one
-/// cell inwards, re-measures the sides there and warps the result. False
-/// when the inner outline cannot be measured.
+/// cell inwards and re-measures the sides there. False when the inner
+/// outline cannot be measured. Grey levels only: a second read on another
+/// Tone reuses it.
+bool insetCorners(const ImageView &image, std::array<Point2f, 4> &corners, int bits);
+
+/// insetCorners(), then warpMarker() at the result.
 bool insetQuad(const ImageView &image, std::array<Point2f, 4> &corners, int bits,
 	       WarpedMarker &out, Tone tone = {});
 

@@ -237,8 +237,11 @@ Detector::Detector(const Config &config) : impl_(std::make_unique<Impl>())
 	 * many, and they made wrong ids. */
 	impl_->logPolicy = impl_->policy;
 	impl_->logPolicy.maxTotal = impl_->policy.maxHamming;
-	if (impl_->params.light_floor < FrontEndParams::kLightReference)
+	if (impl_->params.light_floor < FrontEndParams::kLightReference) {
 		impl_->logPolicy.tone.logFloor = static_cast<float>(std::max(1, impl_->params.light_floor));
+		impl_->logPolicy.tone.fillTable(impl_->logTable.data());
+		impl_->logPolicy.tone.table = impl_->logTable.data();
+	}
 	impl_->frontEnd = makeCpuFrontEnd(config.threads);
 }
 

@@ -6,6 +6,7 @@
 // truth is exact; each is also run with Config::light_floor at 0.5, the
 // paper's absolute thresholds, to show what the light-following ones add.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <functional>
@@ -250,4 +251,28 @@ TEST(Lighting, LogScaleTurnsLightIntoAShift)
 	EXPECT_GT(shaded, 0.7f * lit); /* grey levels: 0.3 of it */
 	EXPECT_TRUE(detail::Tone{}.linear());
 	EXPECT_FLOAT_EQ(detail::Tone{}.apply(77.0f), 77.0f);
+}
+
+/* The table of whole grey levels the detector gives its second read gives
+ * the very floats the logs do, and samples between grey levels still take
+ * the log: the table changes the cost, never a read. */
+TEST(Lighting, LogTableGivesTheLogsFloats)
+{
+	detail::Tone logs{ 16.0f };
+	std::array<float, 256> table{};
+	logs.fillTable(table.data());
+	detail::Tone tabled = logs;
+	tabled.table = table.data();
+	detail::WarpedMarker a, b;
+	a.side = b.side = CandidateSamples::kMaxSide;
+	for (int i = 0; i < a.side * a.side; ++i) {
+		/* whole levels, halves, and the ends beyond the range */
+		const float v = i % 3 == 0 ? static_cast<float>(i % 256) : i % 3 == 1 ? 0.5f * static_cast<float>(i % 511)
+										      : static_cast<float>(i % 300) - 20.0f;
+		a.samples[static_cast<std::size_t>(i)] = b.samples[static_cast<std::size_t>(i)] = v;
+	}
+	logs.apply(a);
+	tabled.apply(b);
+	for (int i = 0; i < a.side * a.side; ++i)
+		ASSERT_EQ(a.samples[static_cast<std::size_t>(i)], b.samples[static_cast<std::size_t>(i)]) << i;
 }
