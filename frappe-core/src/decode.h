@@ -24,17 +24,28 @@ using WarpedMarker = CandidateSamples;
 /// where the light is dim or changes across the marker (a blind's stripes,
 /// a cast shadow's edge), a log scale: light that multiplies every grey
 /// level (a shadow, a dim room) only shifts it there, so one threshold
-/// between black and white holds across a shadow's edge.
+/// between black and white holds across a shadow's edge. Where the whites
+/// clip, an exponential scale: the true white lies somewhere above 255, so
+/// the midpoint between black and the clipped white is too dark a
+/// threshold (a blurred black cell among white ones reads white); on this
+/// scale the threshold rises towards the ceiling.
+/// A grey level at or above which a sample is taken as clipped.
+constexpr float kClippedGrey = 250.0f;
+
 struct Tone {
-	/// 0: grey levels. Otherwise the grey level added before the log,
-	/// which keeps the darkest levels' noise from being magnified without
-	/// bound: v -> 255 ln(1 + v / floor) / ln(1 + 255 / floor), 0 .. 255.
+	/// 0: not the log scale. Otherwise the grey level added before the
+	/// log, which keeps the darkest levels' noise from being magnified
+	/// without bound: v -> 255 ln(1 + v / floor) / ln(1 + 255 / floor).
 	float logFloor = 0.0f;
-	/// Optional: apply()'s value of each grey level 0 .. 255 (fillTable()),
-	/// for samples that are whole grey levels (the fixed-point warp's):
-	/// the same floats, without a log each.
+	/// 0: not the exponential scale. Otherwise its grey levels per e-fold:
+	/// v -> 255 (e^(v / s) - 1) / (e^(255 / s) - 1); the midpoint of a
+	/// black at 60 and the ceiling is about 255 - 0.7 s in grey levels.
+	float expScale = 0.0f;
+	/// Optional: apply()'s value of each grey level 0 .. 255 (fillTable()):
+	/// apply(WarpedMarker) then takes whole grey levels (the fixed-point
+	/// warp's samples) from it and interpolates between them.
 	const float *table = nullptr;
-	bool linear() const { return logFloor <= 0.0f; }
+	bool linear() const { return logFloor <= 0.0f && expScale <= 0.0f; }
 	void fillTable(float *out256) const;
 	float apply(float v) const;
 	/// apply()'s inverse: the grey level of a value on this scale.

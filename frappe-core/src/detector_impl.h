@@ -51,6 +51,10 @@ struct FRAPPE_HIDDEN Detector::Impl {
 	 * grey levels (no second read) when light_floor keeps thresholds absolute. */
 	detail::DecodePolicy logPolicy;
 	std::array<float, 256> logTable; /* logPolicy.tone's value of each grey level */
+	/* policy on the exponential scale, the last read of a candidate whose
+	 * whites clip (none when light_floor keeps thresholds absolute). */
+	detail::DecodePolicy clipPolicy;
+	std::array<float, 256> clipTable;
 	FrontEndParams params;
 	std::unique_ptr<FrontEnd> frontEnd;
 	std::unique_ptr<CandidateWarper> warper; /* nullptr: warp on the CPU, one by one */
