@@ -323,11 +323,31 @@ Decoded decode(const Dictionary &dict, std::uint64_t code, int maxHamming)
 	return nearestCode(dict, code, maxHamming);
 }
 
+bool plainCode(std::uint64_t code, int n)
+{
+	/* Cell (r, c) of the code with its border: 0 (black) outside the code. */
+	auto cell = [&](int r, int c) {
+		if (r < 0 || c < 0 || r >= n || c >= n)
+			return 0;
+		return static_cast<int>((code >> (n * n - 1 - (r * n + c))) & 1u);
+	};
+	int changes = 0;
+	for (int r = -1; r < n; ++r)
+		for (int c = -1; c < n; ++c) {
+			changes += r >= 0 && cell(r, c) != cell(r, c + 1); /* rows: code cells and the border's */
+			changes += c >= 0 && cell(r, c) != cell(r + 1, c); /* columns */
+		}
+	return 5 * changes <= 3 * n * (n + 1);
+}
+
 CodeBook::CodeBook(const Dictionary &dict) : dict_(&dict)
 {
 	sorted_.reserve(dict.codes.size());
-	for (int id = 0; id < dict.size(); ++id)
+	plain_.reserve(dict.codes.size());
+	for (int id = 0; id < dict.size(); ++id) {
 		sorted_.emplace_back(dict.codes[id], id);
+		plain_.push_back(plainCode(dict.codes[id], dict.bits) ? 1 : 0);
+	}
 	std::sort(sorted_.begin(), sorted_.end());
 }
 
