@@ -29,24 +29,25 @@ void copyRect(const TraceMap &sub, int sx, int sy, TraceMap &out, int x0, int y0
 			    static_cast<std::size_t>(x1 - x0));
 }
 
-/* Marks the tiles of `out` that [x0, x1) x [y0, y1) puts an edge pixel in,
- * the rectangle copied from `sub`, whose tile grid is the frame's shifted
- * by (sx, sy), multiples of the tile. A tile wholly inside takes the sub
- * map's; one the rectangle cuts (two may share it) is read, a word at a
- * time. */
-void markRectTiles(const TraceMap &sub, int sx, int sy, TraceMap &out, int x0, int y0, int x1, int y1)
+/* Marks the tiles of `out` that [x0, x1) x [y0, y1) puts a pixel in, the
+ * rectangle copied from `sub` (or nullptr), whose tile grid is the frame's
+ * shifted by (sx, sy), multiples of the tile. A tile wholly inside takes
+ * the sub map's; one the rectangle cuts (two may share it) is read, a word
+ * at a time. */
+void markRectTiles(const TraceMap *sub, int sx, int sy, TraceMap &out, int x0, int y0, int x1, int y1)
 {
 	constexpr int T = TraceMap::kTile;
 	for (int ty = y0 / T; ty * T < y1; ++ty) {
 		const int ya = std::max(y0, ty * T), yb = std::min(y1, ty * T + T);
 		const bool rowsWhole = ya == ty * T && (yb == ty * T + T || yb == out.height);
 		std::uint8_t *tiles = out.tiles.data() + static_cast<std::size_t>(ty) * out.tiles_x;
-		const std::uint8_t *subTiles = sub.tiles.data() + static_cast<std::size_t>(ty - sy / T) * sub.tiles_x;
+		const std::uint8_t *subTiles =
+			sub ? sub->tiles.data() + static_cast<std::size_t>(ty - sy / T) * sub->tiles_x : nullptr;
 		for (int tx = x0 / T; tx * T < x1; ++tx) {
 			if (tiles[tx])
 				continue;
 			const int a = std::max(x0, tx * T), b = std::min(x1, tx * T + T);
-			if (rowsWhole && a == tx * T && (b == tx * T + T || b == out.width)) {
+			if (sub && rowsWhole && a == tx * T && (b == tx * T + T || b == out.width)) {
 				tiles[tx] = subTiles[tx - sx / T];
 				continue;
 			}
@@ -174,7 +175,7 @@ void RegionFrontEnd::run(const ImageView &image, std::span<const PixelRect> rect
 		cpu_->run(sub, 1.0f, edgesOnly, sub_);
 		bytesRead_ += s.area();
 		copyRect(sub_, s.x0, s.y0, out, r.x0, r.y0, r.x1, r.y1);
-		markRectTiles(sub_, s.x0, s.y0, out, r.x0, r.y0, r.x1, r.y1);
+		markRectTiles(&sub_, s.x0, s.y0, out, r.x0, r.y0, r.x1, r.y1);
 		written_.push_back(r);
 	}
 	/* The region and shade maps of the whole frame, exactly a whole run's:
@@ -185,6 +186,37 @@ void RegionFrontEnd::run(const ImageView &image, std::span<const PixelRect> rect
 	regionMap(image, 1.0f, params, out.regions, out.shades, scratch_);
 	if (out.regions.width > 0)
 		bytesRead_ += static_cast<std::size_t>(w) * h;
+	keepOnlyRects(out.shades);
+}
+
+/* The shade map outside the rectangles is cleared: the lighting path for
+ * the markers the rectangles hold (the tracked ones, the band's), while
+ * the region map searches the rest of the frame. Traced whole, its
+ * clutter cost as much as the region map's. */
+void RegionFrontEnd::keepOnlyRects(TraceMap &m)
+{
+	if (m.width == 0)
+		return;
+	row_.resize(static_cast<std::size_t>(m.width));
+	for (int y = 0; y < m.height; ++y) {
+		std::uint8_t *p = m.pixels.data() + static_cast<std::size_t>(y) * m.width;
+		std::fill(row_.begin(), row_.end(), 0);
+		bool any = false;
+		for (const PixelRect &r : written_) {
+			if (2 * y < r.y0 || 2 * y >= r.y1)
+				continue;
+			const int x0 = r.x0 / 2, x1 = std::min(m.width, r.x1 / 2);
+			std::copy(p + x0, p + x1, row_.begin() + x0);
+			any = true;
+		}
+		if (any)
+			std::copy(row_.begin(), row_.end(), p);
+		else
+			std::fill_n(p, m.width, 0);
+	}
+	std::fill(m.tiles.begin(), m.tiles.end(), 0);
+	for (const PixelRect &r : written_)
+		markRectTiles(nullptr, 0, 0, m, r.x0 / 2, r.y0 / 2, std::min(m.width, r.x1 / 2), std::min(m.height, r.y1 / 2));
 }
 
 Tracker::Tracker(int coverFrames) : coverFrames_(std::max(1, coverFrames))

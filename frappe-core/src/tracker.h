@@ -65,9 +65,12 @@ public:
 	std::size_t bytesRead() const { return bytesRead_; }
 
 private:
+	void keepOnlyRects(TraceMap &m);
+
 	std::unique_ptr<FrontEnd> cpu_; /* one thread: its output does not depend on it */
 	EdgeMap sub_;
 	RegionScratch scratch_;
+	std::vector<std::uint8_t> row_;
 	std::vector<PixelRect> written_; /* the rectangles of the last run, to clear */
 	bool dirtyAll_ = true;
 	const EdgeMap *last_ = nullptr; /* the map written_ is of (a Pipeline's slots take turns) */
