@@ -5,7 +5,7 @@
 //
 //   frappe-track-bench --list SEQ.txt [--dictionary D] [--cover K]
 //                      [--resize F | --canvas F] [--out-normal N.jsonl]
-//                      [--out-track T.jsonl]
+//                      [--out-track T.jsonl] [--only normal|track]
 //
 // Prints each mode's median and p90 milliseconds per frame, their ratio,
 // the frames Track read whole, and the bytes each read per frame against
@@ -14,7 +14,9 @@
 // each frame in the middle of a frame F times larger, the rest the frame's
 // own pixels mirrored (the same markers, in pixels, in a larger scene). The
 // JSON lines are the contract's, for shared/tools/eval.py (with --resize
-// or --canvas the truth's corners no longer apply). Not a test: speed is
+// or --canvas the truth's corners no longer apply). --only runs one mode,
+// for instruction counts (valgrind --tool=callgrind
+// --toggle-collect='frappe::Detector::detect(*'). Not a test: speed is
 // never asserted.
 #include <algorithm>
 #include <chrono>
@@ -70,7 +72,7 @@ void writeLine(std::ofstream &out, const std::string &image, const frappe::Resul
 
 int main(int argc, char **argv)
 {
-	std::string list, dictionary = "aruco_mip_36h12", outNormal, outTrack;
+	std::string list, dictionary = "aruco_mip_36h12", outNormal, outTrack, only;
 	int cover = frappe::Config{}.track_cover_frames;
 	double resize = 1.0, canvas = 1.0;
 	for (int i = 1; i < argc; ++i) {
@@ -94,11 +96,16 @@ int main(int argc, char **argv)
 			outNormal = value();
 		else if (a == "--out-track")
 			outTrack = value();
+		else if (a == "--only")
+			only = value();
 		else
 			usage("unknown option " + a);
 	}
 	if (list.empty())
 		usage("--list is required");
+	if (!only.empty() && only != "normal" && only != "track")
+		usage("--only takes normal or track");
+	const bool runNormal = only != "track", runTrack = only != "normal";
 	if (!(resize >= 1.0 && canvas >= 1.0) || (resize > 1.0 && canvas > 1.0))
 		usage("one of --resize and --canvas, at least 1");
 
@@ -139,8 +146,10 @@ int main(int argc, char **argv)
 		return frappe::ImageView(g.data, g.cols, g.rows, static_cast<int>(g.step[0]));
 	};
 	/* Warm both on the first frame, then forget it. */
-	normal.detect(view(frames[0]));
-	track.detect(view(frames[0]));
+	if (runNormal)
+		normal.detect(view(frames[0]));
+	if (runTrack)
+		track.detect(view(frames[0]));
 	track.reset();
 
 	std::ofstream nOut, tOut;
@@ -153,9 +162,10 @@ int main(int argc, char **argv)
 	for (std::size_t f = 0; f < frames.size(); ++f) {
 		const frappe::ImageView v = view(frames[f]);
 		auto t0 = Clock::now();
-		const frappe::Result &n = normal.detect(v);
+		static const frappe::Result none;
+		const frappe::Result &n = runNormal ? normal.detect(v) : none;
 		auto t1 = Clock::now();
-		const frappe::Result &t = track.detect(v);
+		const frappe::Result &t = runTrack ? track.detect(v) : none;
 		auto t2 = Clock::now();
 		const double nm = std::chrono::duration<double, std::milli>(t1 - t0).count();
 		const double tm = std::chrono::duration<double, std::milli>(t2 - t1).count();
