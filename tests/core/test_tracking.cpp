@@ -334,6 +334,41 @@ TEST(Tracking, FrontEndsWithoutRegionsSearchEveryFrameWhole)
 	}
 }
 
+/* The paper's pipelined mode: the next frame's front end (its plan from
+ * the tracks) runs while this frame finishes (updating them), on two
+ * threads; the tracks are under a lock. Every frame keeps its markers. */
+TEST(Tracking, StagedPipelineTracksEveryFrame)
+{
+	Config cfg;
+	cfg.mode = Mode::Track;
+	for (int latency : { 1, 2 }) {
+		Pipeline pipeline(cfg, Pipeline::Mode::Stages, latency);
+		std::vector<Image> frames;
+		for (int f = 0; f < 12; ++f)
+			frames.push_back(movingFrame(f, sceneAt(f, false, 0)));
+		int out = 0, regions = 0;
+		auto take = [&](const Result *r) {
+			if (!r)
+				return;
+			const std::vector<Placed> truth = sceneAt(out, false, 0);
+			EXPECT_EQ(r->markers.size(), truth.size()) << "latency " << latency << " frame " << out;
+			for (const Placed &t : truth) {
+				const Marker *m = findMarker(r->markers, t.id);
+				ASSERT_NE(m, nullptr) << "latency " << latency << " frame " << out << " id " << t.id;
+				EXPECT_LT(meanCornerError(m->corners, t.corners), 0.35f);
+			}
+			regions += r->whole_frame ? 0 : 1;
+			++out;
+		};
+		for (const Image &img : frames)
+			take(pipeline.push(img.view()));
+		while (const Result *r = pipeline.flush())
+			take(r);
+		EXPECT_EQ(out, 12);
+		EXPECT_GE(regions, 6) << "latency " << latency;
+	}
+}
+
 TEST(Tracking, CoverFramesOutOfRangeIsRefused)
 {
 	Config cfg;

@@ -20,15 +20,19 @@ enum class Mode {
 	AScale,
 	/// Video: the markers of the last frames predict where each will be (a
 	/// constant-velocity model of its corners) and the full detector runs
-	/// in a region around each prediction, at full resolution; the rest of
-	/// the frame is searched for new markers a band at a time, so that all
-	/// of it is searched at least every `track_cover_frames` frames, and
-	/// all of it at once after a scene change or when a tracked marker is
-	/// not found where predicted (then the same frame is searched again,
-	/// whole). Marker::tracked says which markers were tracked. The cost of
-	/// a frame follows its markers' area more than the frame's. Needs a
-	/// front end that can run on regions (the CPU's); others run every
-	/// frame whole.
+	/// in a region around each prediction, at full resolution. The rest of
+	/// the frame is searched for new markers by the full detector a band
+	/// of rows at a time, all of it at least every `track_cover_frames`
+	/// frames, and by the whole frame's region map (half resolution) on
+	/// every frame; all of it at once after a scene change or when a
+	/// tracked marker is not found where predicted (then the same frame is
+	/// searched again, whole). Marker::tracked says which markers were
+	/// tracked; corners are always measured on the frame. 0.55-0.7 of
+	/// NORMAL's instructions on the synthetic sequences, the same markers
+	/// found (docs/tracking.md). Needs a front end that can run on regions
+	/// (the CPU's); others run every frame whole. One detector per video,
+	/// its frames in order (a Pipeline's Mode::Frames on several threads
+	/// gives each detector a part of them; Mode::Stages keeps one).
 	Track,
 };
 
