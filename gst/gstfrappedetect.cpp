@@ -39,7 +39,8 @@
  *   x0, y0, ..., x3, y3), `hamming` (uint), `margin` (double: how clearly
  *   the code was read, in [0, 1], the weakest code cell's distance from
  *   the black-white threshold as a fraction of half the contrast; near 0
- *   some cell was nearly a coin toss) and, when the pose is known,
+ *   some cell was nearly a coin toss), `tracked` (boolean: mode track found
+ *   it where the last frames predicted it) and, when the pose is known,
  *   `rvec` and `tvec` (GstValueArray of 3 doubles: Rodrigues rotation and
  *   translation in metres), `reprojection-error` (double, RMS pixels) and
  *   `alternative-reprojection-error` (double: the error of the other planar
@@ -288,7 +289,8 @@ static bool ensure_pipeline(GstFrappeDetect *self)
 	GST_DEBUG_OBJECT(self,
 			 "pipeline for %s, mode %s, max-hamming %d, front end %s, overlap %s, %d thread(s), "
 			 "%u QPU context(s) opened",
-			 priv->dictionary.c_str(), s.mode == GST_FRAPPE_MODE_ASCALE ? "ascale" : "normal",
+			 priv->dictionary.c_str(),
+			 s.mode == GST_FRAPPE_MODE_ASCALE ? "ascale" : s.mode == GST_FRAPPE_MODE_TRACK ? "track" : "normal",
 			 priv->pipeline->detector().maxHamming(), priv->pipeline->detector().frontEnd().name(),
 			 overlap_name(overlap), priv->pipeline->threads(), priv->qpuContexts);
 	return true;

@@ -17,6 +17,8 @@ GType gst_frappe_mode_get_type(void)
 		{ GST_FRAPPE_MODE_NORMAL, "Every frame at full resolution", "normal" },
 		{ GST_FRAPPE_MODE_ASCALE,
 		  "Scale frames down from the size of the markers of the previous frame", "ascale" },
+		{ GST_FRAPPE_MODE_TRACK,
+		  "Search around the markers of the last frames and a band of the rest of the frame", "track" },
 		{ 0, nullptr, nullptr },
 	};
 	if (g_once_init_enter(&type)) {
@@ -99,12 +101,20 @@ gint gst_frappe_dictionary_index(const char *name)
 
 GstFrappeMode gst_frappe_mode_from_library(frappe::Mode mode)
 {
-	return mode == frappe::Mode::AScale ? GST_FRAPPE_MODE_ASCALE : GST_FRAPPE_MODE_NORMAL;
+	switch (mode) {
+	case frappe::Mode::AScale: return GST_FRAPPE_MODE_ASCALE;
+	case frappe::Mode::Track: return GST_FRAPPE_MODE_TRACK;
+	default: return GST_FRAPPE_MODE_NORMAL;
+	}
 }
 
 frappe::Mode gst_frappe_mode_to_library(GstFrappeMode mode)
 {
-	return mode == GST_FRAPPE_MODE_ASCALE ? frappe::Mode::AScale : frappe::Mode::Normal;
+	switch (mode) {
+	case GST_FRAPPE_MODE_ASCALE: return frappe::Mode::AScale;
+	case GST_FRAPPE_MODE_TRACK: return frappe::Mode::Track;
+	default: return frappe::Mode::Normal;
+	}
 }
 
 const char *gst_frappe_backend_nick(GstFrappeBackend backend)

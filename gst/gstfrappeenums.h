@@ -13,6 +13,7 @@ G_BEGIN_DECLS
 typedef enum {
 	GST_FRAPPE_MODE_NORMAL,
 	GST_FRAPPE_MODE_ASCALE,
+	GST_FRAPPE_MODE_TRACK,
 } GstFrappeMode;
 
 typedef enum {

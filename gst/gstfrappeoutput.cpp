@@ -47,7 +47,7 @@ GstStructure *markerStructure(const Marker &m, const std::optional<frappe::Marke
 	}
 	addDoubleArray(ms, "corners", corners, 8);
 	gst_structure_set(ms, "hamming", G_TYPE_UINT, static_cast<guint>(m.hamming), "margin", G_TYPE_DOUBLE,
-			  static_cast<gdouble>(m.margin), nullptr);
+			  static_cast<gdouble>(m.margin), "tracked", G_TYPE_BOOLEAN, m.tracked ? TRUE : FALSE, nullptr);
 	if (pose) {
 		addDoubleArray(ms, "rvec", pose->pose.rvec.data(), 3);
 		addDoubleArray(ms, "tvec", pose->pose.tvec.data(), 3);

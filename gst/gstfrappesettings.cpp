@@ -33,6 +33,7 @@ constexpr gfloat kRegionContrastMin = 0.0f, kRegionContrastMax = 1.0f;
 constexpr gfloat kLightFloorMin = 0.0f, kLightFloorMax = 1.0f;
 constexpr gfloat kScaledSizeMin = 8.0f, kScaledSizeMax = 1000.0f;
 constexpr gint kMaxScaledFramesMax = 1000;
+constexpr gint kTrackCoverFramesMax = 1000;
 /* The element's own: the pose's marker side in metres. */
 constexpr gdouble kMarkerSizeMax = 1000.0;
 
@@ -149,7 +150,9 @@ frappe::Config Settings::config(bool staged) const
 	config.max_hamming = std::min(maxHamming, dict.bits * dict.bits / 2);
 	config.scaled_size = scaledSize;
 	config.max_scaled_frames = maxScaledFrames;
-	config.threads = pipelined && !staged ? 2 : 1; /* whole frames on two threads */
+	config.track_cover_frames = trackCoverFrames;
+	/* Whole frames on two threads; track follows the video on one. */
+	config.threads = pipelined && !staged && config.mode != frappe::Mode::Track ? 2 : 1;
 	return config;
 }
 
@@ -234,6 +237,12 @@ void installProperties(GObjectClass *gobject_class)
 		g_param_spec_int("max-scaled-frames", "Max scaled frames",
 				 "ascale: at most this many scaled frames in a row before one at full resolution",
 				 0, kMaxScaledFramesMax, defaults.maxScaledFrames, live));
+	g_object_class_install_property(
+		gobject_class, PROP_TRACK_COVER_FRAMES,
+		g_param_spec_int("track-cover-frames", "Track cover frames",
+				 "track: every part of the frame is searched for new markers at least every this "
+				 "many frames",
+				 1, kTrackCoverFramesMax, defaults.trackCoverFrames, live));
 	g_object_class_install_property(
 		gobject_class, PROP_ANNOTATE,
 		g_param_spec_boolean("annotate", "Annotate",
@@ -356,6 +365,9 @@ bool setValue(Settings &p, guint propId, const GValue *value, std::string &warni
 		break;
 	case PROP_MAX_SCALED_FRAMES:
 		p.maxScaledFrames = g_value_get_int(value);
+		break;
+	case PROP_TRACK_COVER_FRAMES:
+		p.trackCoverFrames = g_value_get_int(value);
 		break;
 	case PROP_ANNOTATE:
 		p.annotate = g_value_get_boolean(value);
@@ -605,6 +617,9 @@ bool getProperty(const Settings &p, guint propId, GValue *value)
 		break;
 	case PROP_MAX_SCALED_FRAMES:
 		g_value_set_int(value, p.maxScaledFrames);
+		break;
+	case PROP_TRACK_COVER_FRAMES:
+		g_value_set_int(value, p.trackCoverFrames);
 		break;
 	case PROP_ANNOTATE:
 		g_value_set_boolean(value, p.annotate);

@@ -33,6 +33,7 @@ enum Property {
 	PROP_MAX_HAMMING,
 	PROP_SCALED_SIZE,
 	PROP_MAX_SCALED_FRAMES,
+	PROP_TRACK_COVER_FRAMES,
 	PROP_ANNOTATE,
 	PROP_POST_MESSAGES,
 	PROP_PIPELINED,
@@ -62,6 +63,7 @@ struct Settings {
 	gint maxHamming = kLibraryDefaults.max_hamming;
 	gfloat scaledSize = kLibraryDefaults.scaled_size;
 	gint maxScaledFrames = kLibraryDefaults.max_scaled_frames;
+	gint trackCoverFrames = kLibraryDefaults.track_cover_frames;
 	gboolean annotate = FALSE;
 	gboolean postMessages = TRUE;
 	gboolean pipelined = FALSE;

@@ -22,6 +22,10 @@
 #include <string>
 #include <vector>
 
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
+
 #include <opencv2/imgcodecs.hpp>
 
 #include "annotate.h"
@@ -47,7 +51,12 @@ const char kUsage[] =
 	"  -d, --dictionary NAME|FILE  marker family (default aruco_mip_36h12), see\n"
 	"                          --dictionaries; else a file of your own (the text format of\n"
 	"                          frappe-core/dictionaries, or OpenCV's aruco YAML/XML)\n"
-	"      --mode MODE         normal (default) or ascale (adaptive scaling over a sequence)\n"
+	"      --mode MODE         normal (default), ascale (adaptive scaling over a sequence)\n"
+	"                          or track (the list is a video: markers searched where the\n"
+	"                          last frames put them, the rest of the frame a band at a\n"
+	"                          time; each marker says whether it was \"tracked\")\n"
+	"      --track-cover-frames K  track: every part of the frame is searched for new\n"
+	"                          markers at least every K frames (default 4)\n"
 	"      --threads T         images detected at once, each on a thread of its own:\n"
 	"                          1 (default), 0 = one per core; time_ms is then each\n"
 	"                          image's own detection time, and the images per second\n"
@@ -69,7 +78,9 @@ const char kUsage[] =
 	"      --json              print one JSON line per image instead of text\n"
 	"      --stats             per-stage timings: a line of text, or with --json a \"stats\"\n"
 	"                          object in each image's line; the first image's also gives\n"
-	"                          the untimed warm-up detection run before it (warm_up_ms)\n"
+	"                          the untimed warm-up detection run before it (warm_up_ms);\n"
+	"                          bytes_read: what the front end read of the frame,\n"
+	"                          whole_frame: whether all of it was searched (track)\n"
 	"      --list FILE         images to process, one path per line (a regular file of\n"
 	"                          at most 64 MiB and 1000000 images)\n"
 	"      --out FILE          JSON lines output, one per listed image, in order; a\n"
@@ -241,8 +252,12 @@ Options parse(int argc, char **argv)
 				o.config.mode = frappe::Mode::Normal;
 			else if (m == "ascale")
 				o.config.mode = frappe::Mode::AScale;
+			else if (m == "track")
+				o.config.mode = frappe::Mode::Track;
 			else
-				usageError("--mode takes normal or ascale, got '" + m + "'");
+				usageError("--mode takes normal, ascale or track, got '" + m + "'");
+		} else if (a == "--track-cover-frames") {
+			o.config.track_cover_frames = parseNumber<int>(a, value());
 		} else if (a == "--threads") {
 			o.config.threads = parseNumber<int>(a, value());
 		} else if (a == "--edge-threshold") {
@@ -297,6 +312,7 @@ using frappe::cli::jsonEscape;
 struct LineExtras {
 	const std::vector<std::optional<frappe::Pose>> *poses = nullptr; /* one per marker */
 	std::string stats; /* `"stats": {...}`, or empty */
+	bool tracking = false; /* Mode::Track: each marker says whether it was tracked */
 };
 
 std::string jsonLine(const std::string &image, const std::vector<Marker> &markers, double ms,
@@ -319,6 +335,8 @@ std::string jsonLine(const std::string &image, const std::vector<Marker> &marker
 		}
 		std::snprintf(buf, sizeof(buf), "%.3f", m.margin);
 		o << "], \"hamming\": " << m.hamming << ", \"margin\": " << buf;
+		if (extras.tracking)
+			o << ", \"tracked\": " << (m.tracked ? "true" : "false");
 		if (extras.poses && (*extras.poses)[i])
 			o << frappe::cli::poseJson(*(*extras.poses)[i]);
 		o << "}";
@@ -333,7 +351,7 @@ std::string jsonLine(const std::string &image, const std::vector<Marker> &marker
 
 /* The per-stage times as a JSON member; the warm-up's wall time when one
  * ran before this image (below 0: none). */
-std::string statsJson(const frappe::StageTimes &times, double warmUpMs)
+std::string statsJson(const frappe::StageTimes &times, double warmUpMs, std::size_t bytesRead, bool wholeFrame)
 {
 	std::ostringstream o;
 	char buf[32];
@@ -344,6 +362,8 @@ std::string statsJson(const frappe::StageTimes &times, double warmUpMs)
 	}
 	std::snprintf(buf, sizeof(buf), "%.4f", times.total_ms);
 	o << ", \"total_ms\": " << buf;
+	/* What the front end read of the frame: all of it, or Track's regions. */
+	o << ", \"bytes_read\": " << bytesRead << ", \"whole_frame\": " << (wholeFrame ? "true" : "false");
 	if (warmUpMs >= 0.0) {
 		std::snprintf(buf, sizeof(buf), "%.4f", warmUpMs);
 		o << ", \"warm_up_ms\": " << buf;
@@ -358,6 +378,8 @@ struct Frame {
 	std::string error;
 	std::vector<Marker> markers;
 	frappe::StageTimes times;
+	std::size_t bytes_read = 0; /* the last repetition's Result::bytes_read */
+	bool whole_frame = true;
 	std::vector<double> times_ms; /* one per repeat */
 	int in_flight = 0;            /* pushes whose result has not come back */
 	bool all_pushed = false;
@@ -572,6 +594,8 @@ private:
 		f.times_ms.push_back(serial_ ? wallMs : res.times.total_ms);
 		f.markers = res.markers; /* the last repetition's */
 		f.times = res.times;
+		f.bytes_read = res.bytes_read;
+		f.whole_frame = res.whole_frame;
 		++detected_;
 	}
 
@@ -622,6 +646,7 @@ private:
 			++failed_;
 		const double ms = f.error.empty() && !f.times_ms.empty() ? median(f.times_ms) : 0.0;
 		LineExtras extras;
+		extras.tracking = opt_.config.mode == frappe::Mode::Track;
 		if (!f.poses.empty())
 			extras.poses = &f.poses;
 		if (out_) {
@@ -634,7 +659,7 @@ private:
 		if (opt_.json) {
 			/* The stats inside the line: every line stays one JSON object. */
 			if (opt_.stats && f.error.empty())
-				extras.stats = statsJson(f.times, f.warm_up_ms);
+				extras.stats = statsJson(f.times, f.warm_up_ms, f.bytes_read, f.whole_frame);
 			std::cout << jsonLine(f.path, f.markers, ms, f.error, extras) << "\n";
 		} else if (f.error.empty() && opt_.out.empty()) {
 			std::printf("%s: %zu marker%s (%s) in %.2f ms\n", f.path.c_str(), f.markers.size(),
@@ -706,7 +731,23 @@ private:
 
 int main(int argc, char **argv)
 {
+#if defined(__GLIBC__)
+	/* Each image's file and decoded frame are freed before the next of the
+	 * same size is allocated. Under glibc's defaults a frame of 300 KB is
+	 * mmap'ed and unmapped each time, and the top of the heap given back
+	 * and taken again: page faults on every image, 3-4x the time of the
+	 * detection itself on a list of small images. Kept, the same pages
+	 * serve every image. (The values of the GLIBC_TUNABLES the peers are
+	 * timed with: trim at 256 MiB, mmap from 32 MiB.) */
+	mallopt(M_MMAP_THRESHOLD, 32 << 20);
+	mallopt(M_TRIM_THRESHOLD, 256 << 20);
+#endif
 	Options opt = parse(argc, argv);
+	if (opt.config.mode == frappe::Mode::Track && opt.config.threads != 1) {
+		/* Frames on several detectors would each see a part of the video. */
+		std::cerr << "frappe-detect: --mode track follows one video on one detector; using --threads 1\n";
+		opt.config.threads = 1;
+	}
 
 	/* Opened before the run: a path that cannot be written fails now, not
 	 * after an hour of detection. */
@@ -726,8 +767,9 @@ int main(int argc, char **argv)
 		std::cerr << "frappe-detect: " << e.what() << "\n";
 		return 2;
 	}
-	if (opt.config.mode == frappe::Mode::AScale && opt.repeat > 1) {
-		std::cerr << "frappe-detect: --mode ascale treats the list as a video; using --repeat 1\n";
+	if (opt.config.mode != frappe::Mode::Normal && opt.repeat > 1) {
+		std::cerr << "frappe-detect: --mode " << (opt.config.mode == frappe::Mode::AScale ? "ascale" : "track")
+			  << " treats the list as a video; using --repeat 1\n";
 		opt.repeat = 1;
 	}
 

@@ -61,6 +61,10 @@ void validate(const Config &c, const Dictionary &d)
 		fail("scaled_size must be in [8, 1000] pixels, got " + std::to_string(c.scaled_size));
 	if (c.max_scaled_frames < 0 || c.max_scaled_frames > 1000)
 		fail("max_scaled_frames must be in [0, 1000], got " + std::to_string(c.max_scaled_frames));
+	if (c.mode != Mode::Normal && c.mode != Mode::AScale && c.mode != Mode::Track)
+		fail("mode must be Normal, AScale or Track");
+	if (c.track_cover_frames < 1 || c.track_cover_frames > 1000)
+		fail("track_cover_frames must be in [1, 1000], got " + std::to_string(c.track_cover_frames));
 	if (!(c.corner_cluster_radius >= 1.0f && c.corner_cluster_radius <= 32.0f))
 		fail("corner_cluster_radius must be in [1, 32], got " + std::to_string(c.corner_cluster_radius));
 	if (!(c.min_marker_side >= 4.0f))
@@ -253,6 +257,8 @@ Detector::Detector(const Config &config) : impl_(std::make_unique<Impl>())
 		impl_->clipPolicy.tone.table = impl_->clipTable.data();
 	}
 	impl_->frontEnd = makeCpuFrontEnd(config.threads);
+	if (config.mode == Mode::Track)
+		impl_->tracker = std::make_unique<detail::Tracker>(config.track_cover_frames);
 }
 
 Detector::~Detector() = default;
@@ -261,8 +267,23 @@ Detector &Detector::operator=(Detector &&) noexcept = default;
 
 const Result &Detector::detect(const ImageView &image)
 {
+	Impl &d = *impl_;
+	d.mayRetry = d.tracker != nullptr;
 	detail::DetectorStages::frontEnd(*this, image, 0);
-	return detail::DetectorStages::backEnd(*this, image, 0);
+	const Result &first = detail::DetectorStages::backEnd(*this, image, 0);
+	d.mayRetry = false;
+	if (!d.tracker || first.whole_frame || !d.tracker->retrying())
+		return first;
+	/* Track: a marker of the last frame was not where predicted. The
+	 * same frame again, whole (the tracker planned it so), so that it
+	 * does not drop out; the frame's time is both searches'. */
+	const StageTimes partial = first.times;
+	detail::DetectorStages::frontEnd(*this, image, 0);
+	Result &again = const_cast<Result &>(detail::DetectorStages::backEnd(*this, image, 0));
+	for (int i = 0; i < kStageCount; ++i)
+		again.times.ms[i] += partial.ms[i];
+	again.times.total_ms += partial.total_ms;
+	return again;
 }
 
 namespace detail {
@@ -284,6 +305,20 @@ void DetectorStages::frontEnd(Detector &detector, const ImageView &image, int sl
 		scale = 1.0f;
 	s.image = image;
 	timer.lap(Stage::FrontEnd);
+	/* Track: the CPU front end over the regions the tracks predict and a
+	 * band of the rest, or the whole frame. */
+	const bool regions = d.tracker && d.tracker->plan(image, std::string_view(d.frontEnd->name()) == "cpu");
+	s.result.whole_frame = !regions;
+	s.result.bytes_read = static_cast<std::size_t>(image.width) * image.height;
+	if (regions) {
+		d.tracker->runRegions(image, d.params, s.edges);
+		s.result.bytes_read = d.tracker->bytesRead();
+		s.result.scale = 1.0f;
+		s.result.copy_bytes = 0;
+		return;
+	}
+	if (d.tracker)
+		d.tracker->ranWhole();
 	d.frontEnd->run(image, scale, d.params, s.edges);
 	if (!d.frontEnd->makesRegionMap()) {
 		/* A front end without a region map (one of the caller's): the
@@ -323,6 +358,8 @@ const Result &DetectorStages::finish(Detector &detector, const ImageView &image,
 		std::lock_guard<std::mutex> lock(d.adaptiveLock);
 		d.adaptive.update(s.result.markers);
 	}
+	if (d.tracker)
+		d.tracker->update(s.result.markers, image.width, image.height, !s.result.whole_frame, d.mayRetry);
 	double total = 0;
 	for (double ms : s.result.times.ms)
 		total += ms;
@@ -350,8 +387,12 @@ const CandidateWarper *Detector::warper() const { return impl_->warper.get(); }
 const EdgeMap &Detector::edgeMap() const { return impl_->slots[0].edges; }
 void Detector::reset()
 {
-	std::lock_guard<std::mutex> lock(impl_->adaptiveLock);
-	impl_->adaptive.reset();
+	{
+		std::lock_guard<std::mutex> lock(impl_->adaptiveLock);
+		impl_->adaptive.reset();
+	}
+	if (impl_->tracker)
+		impl_->tracker->reset();
 }
 const Config &Detector::config() const { return impl_->config; }
 const Dictionary &Detector::dictionary() const { return *impl_->dict; }

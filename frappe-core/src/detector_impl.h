@@ -19,6 +19,7 @@
 #include "front_end_rows.h"
 #include "region_map.h"
 #include "stage_timer.h"
+#include "tracker.h"
 #include "verify.h"
 
 namespace frappe {
@@ -62,6 +63,10 @@ struct FRAPPE_HIDDEN Detector::Impl {
 	 * they run on different threads. */
 	std::mutex adaptiveLock;
 	detail::AdaptiveScale adaptive;
+	/* Mode::Track's tracks and regions (nullptr in the other modes); under
+	 * its own lock. mayRetry: detect() may search a frame again whole. */
+	std::unique_ptr<detail::Tracker> tracker;
+	bool mayRetry = false;
 
 	/* One frame in flight: its edges, its candidates, its result. */
 	struct Slot {

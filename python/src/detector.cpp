@@ -24,12 +24,14 @@ Mode modeArg(std::string name)
 		return Mode::Normal;
 	if (name == "ascale")
 		return Mode::AScale;
-	throw py::value_error("mode must be 'normal' or 'ascale', not '" + name + "'");
+	if (name == "track")
+		return Mode::Track;
+	throw py::value_error("mode must be 'normal', 'ascale' or 'track', not '" + name + "'");
 }
 
 const char *modeName(Mode mode)
 {
-	return mode == Mode::AScale ? "ascale" : "normal";
+	return mode == Mode::AScale ? "ascale" : mode == Mode::Track ? "track" : "normal";
 }
 
 /// `obj` as a 2-D uint8 array (a (h, w, 1) one too), or TypeError /
@@ -97,6 +99,8 @@ private:
 		int candidates = 0;
 		int candidates_dropped = 0;
 		bool copied = false;
+		std::size_t bytes_read = 0;
+		bool whole_frame = true;
 	} last_;
 };
 
@@ -136,13 +140,14 @@ py::list PyDetector::detect(py::handle obj)
 			view = ImageView(buffer_.data(), view.width, view.height, view.width);
 		}
 		result = &detector_.detect(view);
-		last_ = { result->times, result->scale, result->candidates, result->candidates_dropped, !direct };
+		last_ = { result->times,	   result->scale,      result->candidates, result->candidates_dropped,
+			  !direct, result->bytes_read, result->whole_frame };
 	}
 
 	py::list markers(result->markers.size());
 	for (std::size_t i = 0; i < result->markers.size(); ++i) {
 		const frappe::Marker &m = result->markers[i];
-		Marker out{ m.id, newFloatArray(4, 2), m.hamming, m.margin };
+		Marker out{ m.id, newFloatArray(4, 2), m.hamming, m.margin, m.tracked };
 		float *c = out.corners.mutable_data();
 		for (int k = 0; k < 4; ++k) {
 			c[2 * k] = m.corners[k].x;
@@ -171,6 +176,8 @@ py::dict PyDetector::stats()
 	out["candidates"] = last.candidates;
 	out["candidates_dropped"] = last.candidates_dropped;
 	out["input_copied"] = last.copied;
+	out["bytes_read"] = last.bytes_read;
+	out["whole_frame"] = last.whole_frame;
 	return out;
 }
 
@@ -192,6 +199,7 @@ py::dict PyDetector::configDict() const
 	d["weak_margin"] = config_.weak_margin;
 	d["scaled_size"] = config_.scaled_size;
 	d["max_scaled_frames"] = config_.max_scaled_frames;
+	d["track_cover_frames"] = config_.track_cover_frames;
 	d["region_contrast"] = config_.region_contrast;
 	d["light_floor"] = config_.light_floor;
 	d["corner_cluster_radius"] = config_.corner_cluster_radius;
@@ -204,7 +212,7 @@ py::dict PyDetector::configDict() const
 
 PyDetector *makeDetector(py::handle dictionary, const std::string &mode, float edge_threshold,
 			 float corner_threshold, int max_hamming, float weak_margin, float scaled_size,
-			 int max_scaled_frames, float region_contrast, float light_floor, float corner_cluster_radius,
+			 int max_scaled_frames, int track_cover_frames, float region_contrast, float light_floor, float corner_cluster_radius,
 			 float min_marker_side, long long max_pixels, int max_candidates, int threads)
 {
 	DictionaryRef dict = dictionaryArg(dictionary);
@@ -220,6 +228,7 @@ PyDetector *makeDetector(py::handle dictionary, const std::string &mode, float e
 	c.weak_margin = weak_margin;
 	c.scaled_size = scaled_size;
 	c.max_scaled_frames = max_scaled_frames;
+	c.track_cover_frames = track_cover_frames;
 	c.region_contrast = region_contrast;
 	c.light_floor = light_floor;
 	c.corner_cluster_radius = corner_cluster_radius;
@@ -251,12 +260,14 @@ range raises ValueError saying which.
 
 One detector detects one frame at a time: calls from several threads take
 turns (the GIL is released while detecting). Use one detector per thread to
-detect in parallel; with mode='ascale' one detector per video stream.)doc")
+detect in parallel; with mode='ascale' or 'track' one detector per video
+stream, its frames in order.)doc")
 		.def(py::init(&makeDetector), py::arg("dictionary") = d.dictionary, py::kw_only(),
 		     py::arg("mode") = "normal", py::arg("edge_threshold") = d.edge_threshold,
 		     py::arg("corner_threshold") = d.corner_threshold, py::arg("max_hamming") = d.max_hamming,
 		     py::arg("weak_margin") = d.weak_margin, py::arg("scaled_size") = d.scaled_size,
 		     py::arg("max_scaled_frames") = d.max_scaled_frames,
+		     py::arg("track_cover_frames") = d.track_cover_frames,
 		     py::arg("region_contrast") = d.region_contrast, py::arg("light_floor") = d.light_floor,
 		     py::arg("corner_cluster_radius") = d.corner_cluster_radius,
 		     py::arg("min_marker_side") = d.min_marker_side, py::arg("max_pixels") = d.max_pixels,
@@ -269,12 +280,16 @@ into a buffer the detector keeps. A colour image raises ValueError (convert
 it to grey first: cv2.cvtColor(image, cv2.COLOR_BGR2GRAY), or read it with
 cv2.IMREAD_GRAYSCALE as frappe-detect does), another dtype TypeError, an image
 over max_pixels ValueError.)doc")
-		.def("reset", &PyDetector::reset, "Forgets what mode='ascale' learned from earlier frames.")
+		.def("reset", &PyDetector::reset,
+		     "Forgets what mode='ascale' or 'track' learned from earlier frames.")
 		.def_property_readonly("stats", &PyDetector::stats, R"doc(
 The last detect() call: {'times_ms': {stage: ms, ..., 'total': ms},
 'scale': the resolution traced at, 'candidates': outlines decoded,
 'candidates_dropped': outlines beyond max_candidates left unread,
-'input_copied': whether the image was copied (its rows not contiguous)}.)doc")
+'input_copied': whether the image was copied (its rows not contiguous),
+'bytes_read': bytes of the frame the front end read (width x height, less
+in mode='track' on a frame read in regions), 'whole_frame': whether all of
+the frame was searched}.)doc")
 		.def_property_readonly("config", &PyDetector::configDict,
 				       "The keyword arguments it was made with: Detector(**d.config) makes another.")
 		.def_property_readonly("dictionary", &PyDetector::dictionary, "Its frappe.Dictionary.")

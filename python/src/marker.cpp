@@ -69,13 +69,16 @@ corners  (4, 2) float32 array, pixels: the outer corners of the black border,
          (0, 0) is the centre of the top-left pixel
 hamming  bits corrected to reach the code
 margin   how clearly the code was read, 0..1: filter on it to trade misses for
-         certainty)doc")
+         certainty
+tracked  mode='track': found where the last frames predicted it (its corners
+         measured on this frame all the same); False when found afresh)doc")
 		.def(py::init(&makeMarker), py::arg("id"), py::arg("corners"), py::arg("hamming") = 0,
 		     py::arg("margin") = 0.0f)
 		.def_readonly("id", &Marker::id)
 		.def_readonly("corners", &Marker::corners)
 		.def_readonly("hamming", &Marker::hamming)
 		.def_readonly("margin", &Marker::margin)
+		.def_readonly("tracked", &Marker::tracked)
 		.def_property_readonly(
 			"center",
 			[](const Marker &mk) {

@@ -206,6 +206,39 @@ def pose(exe, sample, expected, tmp):
               '%s: exit 2, "%s"' % (' '.join(args), what))
 
 
+def track_mode(exe, sample, expected, tmp):
+    """--mode track over a list in frame order: each marker says whether it
+    was tracked, --stats says what the front end read; --threads and
+    --repeat fall back to one."""
+    listed = os.path.join(tmp, 'video.txt')
+    with open(listed, 'w') as f:
+        f.write((sample + '\n') * 4)
+    out = os.path.join(tmp, 'video.jsonl')
+    r = run(exe, '--mode', 'track', '--list', listed, '--out', out, '--json', '--stats', '--threads', '2',
+            '--repeat', '3')
+    check(r.returncode == 0, '--mode track: exit 0 (%s)' % text(r.stderr))
+    check('using --threads 1' in text(r.stderr) and 'using --repeat 1' in text(r.stderr),
+          '--mode track: one thread, one repetition, said on stderr')
+    lines = json_lines(r)
+    ids = sorted(m['id'] for m in expected['markers'])
+    check(len(lines) == 4 and all(sorted(m['id'] for m in l['markers']) == ids for l in lines),
+          '--mode track: every frame finds the sample\'s markers')
+    check(not any(m['tracked'] for m in lines[0]['markers'])
+          and all(m['tracked'] for l in lines[1:] for m in l['markers']),
+          '--mode track: found afresh on the first frame, tracked after')
+    w_h = lines[0]['stats']['bytes_read']
+    check(lines[0]['stats']['whole_frame'] and not lines[1]['stats']['whole_frame'],
+          '--mode track: the first frame whole, the next in regions')
+    check(all('"tracked"' in l for l in open(out)), '--out lines say "tracked" too')
+    normal = json_lines(run(exe, '--json', '--stats', sample))[0]
+    check('tracked' not in normal['markers'][0] and normal['stats']['bytes_read'] == w_h,
+          '--mode normal: no "tracked"; bytes_read is the frame\'s')
+    r = run(exe, '--mode', 'fast', sample)
+    check(r.returncode == 2 and 'normal, ascale or track' in text(r.stderr), '--mode fast: exit 2, the modes named')
+    r = run(exe, '--mode', 'track', '--track-cover-frames', '0', sample)
+    check(r.returncode != 0 and 'track_cover_frames' in text(r.stderr), '--track-cover-frames 0 is refused')
+
+
 def main():
     exe, render = sys.argv[1], sys.argv[2]
     sample = os.path.join(SAMPLES, 'markers-36h12.png')
@@ -217,6 +250,7 @@ def main():
         standard_input(exe, sample)
         dictionary_files(exe, render, sample, expected, tmp)
         pose(exe, sample, expected, tmp)
+        track_mode(exe, sample, expected, tmp)
     return 0
 
 

@@ -76,13 +76,15 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t *data, std::size_t size
 	if (found && frappe::findDictionary(found->name) != found)
 		std::abort(); /* a dictionary's own name finds it */
 
-	c.mode = (in.get<std::uint8_t>() & 1) != 0 ? frappe::Mode::AScale : frappe::Mode::Normal;
+	static constexpr frappe::Mode kModes[] = { frappe::Mode::Normal, frappe::Mode::AScale, frappe::Mode::Track };
+	c.mode = kModes[in.get<std::uint8_t>() % 3];
 	c.edge_threshold = number(in, 0.27f);
 	c.corner_threshold = number(in, 0.19f);
 	c.max_hamming = in.get<std::int8_t>() % 24;
 	c.weak_margin = number(in, 0.3f);
 	c.scaled_size = number(in, 28.0f);
 	c.max_scaled_frames = in.get<std::int16_t>();
+	c.track_cover_frames = in.get<std::int16_t>();
 	c.region_contrast = number(in, 0.16f);
 	c.light_floor = number(in, 0.063f);
 	c.corner_cluster_radius = number(in, 4.0f);

@@ -62,6 +62,19 @@ void checkFloat(const Element &el, const char *name, float frappe::Config::*fiel
 	}
 }
 
+/* An int property: default, both ends accepted, beyond either refused. */
+void checkInt(const Element &el, const char *name, int frappe::Config::*field)
+{
+	SCOPED_TRACE(name);
+	auto *p = G_PARAM_SPEC_INT(el.spec(name));
+	ASSERT_NE(p, nullptr);
+	EXPECT_EQ(p->default_value, frappe::Config{}.*field);
+	EXPECT_TRUE(accepted([&](frappe::Config &c) { c.*field = p->minimum; }));
+	EXPECT_TRUE(accepted([&](frappe::Config &c) { c.*field = p->maximum; }));
+	EXPECT_FALSE(accepted([&](frappe::Config &c) { c.*field = p->minimum - 1; }));
+	EXPECT_FALSE(accepted([&](frappe::Config &c) { c.*field = p->maximum + 1; }));
+}
+
 } // namespace
 
 TEST(Settings, DetectorPropertiesFollowTheLibrary)
@@ -75,12 +88,8 @@ TEST(Settings, DetectorPropertiesFollowTheLibrary)
 	checkFloat(el, "light-floor", &frappe::Config::light_floor, true);
 	checkFloat(el, "scaled-size", &frappe::Config::scaled_size, true);
 
-	auto *frames = G_PARAM_SPEC_INT(el.spec("max-scaled-frames"));
-	EXPECT_EQ(frames->default_value, frappe::Config{}.max_scaled_frames);
-	EXPECT_TRUE(accepted([&](frappe::Config &c) { c.max_scaled_frames = frames->minimum; }));
-	EXPECT_TRUE(accepted([&](frappe::Config &c) { c.max_scaled_frames = frames->maximum; }));
-	EXPECT_FALSE(accepted([&](frappe::Config &c) { c.max_scaled_frames = frames->minimum - 1; }));
-	EXPECT_FALSE(accepted([&](frappe::Config &c) { c.max_scaled_frames = frames->maximum + 1; }));
+	checkInt(el, "max-scaled-frames", &frappe::Config::max_scaled_frames);
+	checkInt(el, "track-cover-frames", &frappe::Config::track_cover_frames);
 
 	/* max-hamming: the element clamps to the dictionary; its maximum is
 	 * the largest some dictionary accepts. */
