@@ -215,7 +215,11 @@ Options parse(int argc, char **argv)
 			std::exit(0);
 		} else if (a == "--dictionaries") {
 			for (const auto &d : frappe::dictionaries())
-				std::cout << d.name << "  (" << d.bits << "x" << d.bits << ", " << d.size()
+				std::cout << d.name << "  ("
+					  << (d.layout ? std::to_string(d.codeBits()) + " bits in a layout of " +
+								 std::to_string(d.layout->size) + "x" + std::to_string(d.layout->size) + " cells"
+						       : std::to_string(d.bits) + "x" + std::to_string(d.bits))
+					  << ", " << d.size()
 					  << " ids, min distance " << d.min_hamming << ", corrects "
 					  << d.defaultMaxHamming() << ", " << d.weakMaxHamming() << " with weak cells)\n";
 			std::exit(0);

@@ -110,7 +110,7 @@ int main(int argc, char **argv)
 		if (id < 0 || id >= dict->size())
 			fail("id must be in 0.." + std::to_string(dict->size() - 1));
 		/* the side in pixels stays within what an image file holds */
-		if (static_cast<long long>(cell) * (dict->bits + 2 + 2 * quiet) > 32768)
+		if (static_cast<long long>(cell) * ((dict->layout ? dict->layout->size : dict->bits + 2) + 2 * quiet) > 32768)
 			fail("--cell " + std::to_string(cell) + " with --quiet " + std::to_string(quiet) +
 			     " makes a marker wider than 32768 pixels");
 		int side = 0;
@@ -141,7 +141,9 @@ int main(int argc, char **argv)
 		const int mid = static_cast<int>(U(rng) * dict->size());
 		const double cx = 110 + (k % cols) * 210 + 20 * (U(rng) - 0.5);
 		const double cy = 480.0 / (rows + 1) * (k / cols + 1) + 20 * (U(rng) - 0.5);
-		const double side = 50 + 70 * U(rng);
+		/* A layout's square is part of its marker: the whole marker as large as today's. */
+		const double fit = dict->layout ? static_cast<double>(dict->bits + 2) / dict->layout->size : 1.0;
+		const double side = (50 + 70 * U(rng)) * fit;
 		const auto q = frappe::perspectiveSquare(static_cast<float>(cx), static_cast<float>(cy), static_cast<float>(side),
 							 static_cast<float>(360 * U(rng)), static_cast<float>(50 * U(rng)));
 		frappe::RenderOptions opt;
