@@ -89,8 +89,16 @@ LayoutCells readLayoutCells(const WarpedMarker &g, const MarkerLayout &l, float 
 			if (x < 0 || y < 0 || x >= l.size || y >= l.size)
 				continue;
 			const int bit = l.at(x, y);
-			if (bit < 0)
+			if (bit == MarkerLayout::kWhite) {
+				out.ringErrors += v < thr;
+				++out.ringCells;
 				continue;
+			}
+			if (bit < 0) {
+				++out.plainCells;
+				out.plainLight += v > thr;
+				continue;
+			}
 			value[static_cast<std::size_t>(bit)] = v > thr;
 			margin[static_cast<std::size_t>(bit)] = std::min(std::abs(v - thr) / half, 1.0f);
 		}
@@ -111,6 +119,14 @@ MarkerRead decodeLayout(const LayoutCells &cells, const CodeBook &codes, const D
 	/* A square of real contrast, its two rings whole but for a cell in 16
 	 * (blur at the corners, a corner covered). */
 	if (cells.contrast < 10.0f || 16 * cells.ringErrors > cells.ringCells) {
+		read.rejection = Rejection::BorderNotBlack;
+		return read;
+	}
+	/* A circle family's corners carry nothing, but they are one colour
+	 * (drawn black, or the paper around a printed circle); another
+	 * layout's bits there are a mixture. (A tagStandard41h12 marker read
+	 * as a tagCircle21h7 code, exactly, on 1 in 360 rendered markers.) */
+	if (8 * std::min(cells.plainLight, cells.plainCells - cells.plainLight) > cells.plainCells) {
 		read.rejection = Rejection::BorderNotBlack;
 		return read;
 	}

@@ -33,12 +33,18 @@ struct LayoutCells {
 	std::uint64_t weak = 0;  ///< bits read weakly, in the code's order
 	int ringErrors = 0;      ///< cells of the two rings on the wrong side
 	int ringCells = 0;
+	/// The other cells that are no bits (always black, or of no matter:
+	/// a circle family's corners), and those of them that read light.
+	int plainCells = 0;
+	int plainLight = 0;
 	float contrast = 0.0f;   ///< the white ring's mean less the black ring's
 	float margin = 0.0f;     ///< the weakest bit's distance from its threshold over half the contrast
 };
 LayoutCells readLayoutCells(const WarpedMarker &grid, const MarkerLayout &layout, float weakMargin);
 
-/// Decodes and checks a read: enough contrast, rings nearly whole, at most
+/// Decodes and checks a read: enough contrast, rings nearly whole, the
+/// plain cells beyond them one colour but for one in eight (black as
+/// libapriltag draws them, or a circle family's paper), at most
 /// policy.maxHamming clear bits corrected (policy.maxTotal with weak ones),
 /// an id clearly nearer than any other.
 MarkerRead decodeLayout(const LayoutCells &cells, const CodeBook &codes, const DecodePolicy &policy);

@@ -236,8 +236,9 @@ TEST_P(LayoutScenes, FoundWithExactIdsAndCorners)
 		}
 	}
 	EXPECT_EQ(found, total);
-	if (found)
+	if (found) {
 		EXPECT_LT(errSum / found, 0.25) << dict.name;
+	}
 }
 
 INSTANTIATE_TEST_SUITE_P(AprilTag3, LayoutScenes, ::testing::ValuesIn(kLayoutFamilies),
