@@ -5,7 +5,8 @@ by AprilTag 3.3 (`apriltag-peer`, decimate 1) and scored by
 shared/tools/eval.py; then every layout family's detector over the other
 families' scenes and ../shared's synth subsets, where any marker is a wrong id.
 
-usage: scripts/layout_quality.py BUILD_DIR OUT_DIR [--images 60]
+usage: scripts/layout_quality.py BUILD_DIR OUT_DIR [--images 60] [--synth]
+(the synth subsets: also tests/data's data-wrong-ids)
 """
 import json
 import os
@@ -23,15 +24,15 @@ def run(cmd):
     subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)
 
 
-def scenes(build, out, family, images):
-    folder = os.path.join(out, family)
+def scenes(build, out, family, images, hard=False):
+    folder = os.path.join(out, family + ('-hard' if hard else ''))
     os.makedirs(folder, exist_ok=True)
     truth = []
     for k in range(images):
         png = os.path.join(folder, f'{k:05d}.png')
         if not os.path.exists(png):
             run([os.path.join(build, 'tools', 'frappe-render'), '--scene', '--dictionary', family,
-                 '--seed', str(3200 + k), '--count', '6', png])
+                 '--seed', str(3200 + k), '--count', '6', png] + (['--hard'] if hard else []))
         with open(png[:-4] + '.json') as f:
             truth.append(f.read().strip())
     with open(os.path.join(folder, 'truth.jsonl'), 'w') as f:
@@ -63,16 +64,17 @@ def main():
     detect = os.path.join(build, 'tools', 'frappe-detect')
     peer = os.path.join(build, 'tests', 'bench', 'apriltag-peer')
     folders = {f: scenes(build, out, f, images) for f in FAMILIES}
+    hard = {f: scenes(build, out, f, images, True) for f in FAMILIES}
     print('| family | markers | frappe sensitivity | FP | corner mean / median px | ms median '
           '| AprilTag 3.3 d1 sensitivity | FP | corner mean / median px | ms median |')
     print('|---|---|---|---|---|---|---|---|---|---|')
-    for f in FAMILIES:
-        folder = folders[f]
+    for f, folder in [(f, folders[f]) for f in FAMILIES] + [(f + ' hard', hard[f]) for f in FAMILIES]:
+        f = f.split()[0]
         dets = os.path.join(folder, 'frappe.jsonl')
         run([detect, '--dictionary', f, '--list', os.path.join(folder, 'list.txt'), '--out', dets,
              '--repeat', '1', '--threads', '1'])
         a = score(folder, dets)
-        row = [f, a['truth_markers']]
+        row = [os.path.basename(folder), a['truth_markers']]
 
         def cells(s):
             return [f"{s['sensitivity']:.3f}", s['fp'],
@@ -90,7 +92,7 @@ def main():
     # Wrong ids: each family over the others' scenes and the shared subsets.
     others = {f'{g} (rendered)': os.path.join(folders[g], 'list.txt') for g in FAMILIES}
     synth = os.path.join(SHARED, 'data', 'synth')
-    if os.path.isdir(synth):
+    if os.path.isdir(synth) and '--synth' in sys.argv:
         for sub in sorted(os.listdir(synth)):
             t = os.path.join(synth, sub, 'truth.jsonl')
             if not os.path.exists(t):
