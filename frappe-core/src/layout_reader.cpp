@@ -58,10 +58,33 @@ Plane fitRing(const WarpedMarker &g, const MarkerLayout &l, int ring)
 	return p;
 }
 
+/* Each cell's sample against its four neighbours: c + k (4 c - their sum).
+ * Blur of a cell's width (small or blurred markers) spreads each cell over
+ * its neighbours; this takes most of it back, as warpCellCentres() does
+ * for today's markers. The grid's outer ring stays as sampled. */
+constexpr float kSharpening = 0.25f;
+
+void sharpen(const WarpedMarker &in, WarpedMarker &out)
+{
+	const int n = in.side;
+	out.side = n;
+	for (int y = 0; y < n; ++y) {
+		for (int x = 0; x < n; ++x) {
+			const float c = in.at(x, y);
+			float v = c;
+			if (x > 0 && y > 0 && x < n - 1 && y < n - 1)
+				v = c + kSharpening * (4.0f * c - in.at(x - 1, y) - in.at(x + 1, y) - in.at(x, y - 1) - in.at(x, y + 1));
+			out.samples[static_cast<std::size_t>(y * n + x)] = v;
+		}
+	}
+}
+
 } // namespace
 
-LayoutCells readLayoutCells(const WarpedMarker &g, const MarkerLayout &l, float weakMargin)
+LayoutCells readLayoutCells(const WarpedMarker &sampled, const MarkerLayout &l, float weakMargin)
 {
+	WarpedMarker g;
+	sharpen(sampled, g);
 	/* The ring just outside the square and the one just inside it; the
 	 * outer one may be the quiet zone, a ring of the grid beyond the layout. */
 	const int outer = l.square_start - 1, inner = l.square_start;
