@@ -250,8 +250,12 @@ void Detector::Impl::sampleRefined(Reading &r, const detail::Quad &q, std::size_
 void Detector::Impl::readInset(Reading &r, detail::Quad &q, const detail::DecodePolicy &pol, StageTimer &timer)
 {
 	timer.lap(Stage::Refine);
-	q.corners = r.outline;
-	const bool inset = detail::insetQuad(r.block.view, q.corners, dict->bits, warped, pol.tone);
+	if (r.inset == 0) {
+		r.insetCorners = r.outline;
+		r.inset = detail::insetCorners(r.block.view, r.insetCorners, dict->bits) ? 1 : -1;
+	}
+	q.corners = r.inset > 0 ? r.insetCorners : r.outline;
+	const bool inset = r.inset > 0 && detail::warpMarker(r.block.view, q.corners, dict->bits, warped, pol.tone);
 	r.readable = inset && bigEnough(q.corners, r.minSide);
 	if (!r.readable)
 		return;
@@ -306,6 +310,22 @@ detail::MarkerRead Detector::Impl::decodeCandidate(const Reading &r, detail::Qua
 	return read;
 }
 
+/* Whether a candidate's whites reach the sensor's ceiling (an eighth of
+ * its samples: an overexposed marker's white cells, not a glint or the
+ * brightest paper of an evenly lit frame, whose reads would only cost
+ * time), so that the midpoint between black and white is too dark a
+ * threshold (Tone's exponential scale). */
+constexpr int kClippedShare = 8;
+namespace {
+bool clipsWhite(const detail::WarpedMarker &w)
+{
+	int n = 0;
+	for (int i = 0; i < w.side * w.side; ++i)
+		n += w.samples[static_cast<std::size_t>(i)] >= detail::kClippedGrey;
+	return n * kClippedShare >= w.side * w.side;
+}
+} // namespace
+
 /* Reads candidate k: refine, warp, binarise; the inset read when that finds
  * no dark frame; then decoding and its fallbacks. A marker read is left in
  * `m`, its corners in frame pixels from the code's first. */
@@ -328,7 +348,9 @@ bool Detector::Impl::readCandidate(const ImageView &image, Slot &slot, std::size
 					refineQuad(r.block.view, slot, q, std::max(search / ff, kSearch), r.f);
 	/* Read on grey levels; where that fails, once more on the log scale
 	 * (Tone), from the same refined corners: a marker under a shadow's
-	 * stripes or in a dim room. */
+	 * stripes or in a dim room; and where the first read's whites clipped,
+	 * on the exponential scale: an overexposed marker, whose blurred black
+	 * cells the midpoint below the ceiling reads white. */
 	const Reading refined = r;
 	const std::array<Point2f, 4> refinedCorners = q.corners;
 	auto readWith = [&](const detail::DecodePolicy &pol) {
@@ -340,11 +362,21 @@ bool Detector::Impl::readCandidate(const ImageView &image, Slot &slot, std::size
 	};
 	detail::MarkerRead read = readWith(policy);
 	const bool counted = r.counted;
-	if (!read.ok() && !logPolicy.tone.linear()) {
+	/* Whites at the sensor's ceiling in what the first read sampled. */
+	const bool clipped = !read.ok() && r.samples && clipsWhite(*r.samples);
+	auto readAgain = [&](const detail::DecodePolicy &pol) {
+		const int inset = r.inset;
+		const std::array<Point2f, 4> insetCorners = r.insetCorners;
 		r = refined;
+		r.inset = inset;
+		r.insetCorners = insetCorners;
 		q.corners = refinedCorners;
-		read = readWith(logPolicy);
-	}
+		read = readWith(pol);
+	};
+	if (!read.ok() && !logPolicy.tone.linear())
+		readAgain(logPolicy);
+	if (!read.ok() && clipped && !clipPolicy.tone.linear())
+		readAgain(clipPolicy);
 	slot.result.candidates += counted || r.counted;
 	if (!read.ok())
 		return false;

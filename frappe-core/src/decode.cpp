@@ -17,6 +17,8 @@ float Tone::apply(float v) const
 {
 	if (linear())
 		return v;
+	if (expScale > 0.0f)
+		return 255.0f * std::expm1(std::clamp(v, 0.0f, 255.0f) / expScale) / std::expm1(255.0f / expScale);
 	return 255.0f * std::log1p(std::max(v, 0.0f) / logFloor) / std::log1p(255.0f / logFloor);
 }
 
@@ -24,16 +26,45 @@ float Tone::invert(float v) const
 {
 	if (linear())
 		return v;
+	if (expScale > 0.0f)
+		return expScale * std::log1p(std::max(v, 0.0f) / 255.0f * std::expm1(255.0f / expScale));
 	return logFloor * std::expm1(v / 255.0f * std::log1p(255.0f / logFloor));
 }
+
+/* The log scale's samples as they have always been computed (a factor,
+ * not a division: a read's floats do not move). */
+namespace {
+float logSample(float v, float k, float norm)
+{
+	return norm * std::log1p(std::max(v, 0.0f) * k);
+}
+} // namespace
 
 void Tone::apply(WarpedMarker &w) const
 {
 	if (linear())
 		return;
 	const float k = 1.0f / logFloor, norm = 255.0f / std::log1p(255.0f * k);
-	for (int i = 0; i < w.side * w.side; ++i)
-		w.samples[static_cast<std::size_t>(i)] = norm * std::log1p(std::max(w.samples[static_cast<std::size_t>(i)], 0.0f) * k);
+	for (int i = 0; i < w.side * w.side; ++i) {
+		float &v = w.samples[static_cast<std::size_t>(i)];
+		if (table) {
+			/* Between whole levels, along the chord: within 0.05 of a
+			 * grey level of the curve, at a fraction of a log's cost
+			 * (soft-float on ARMv6). */
+			const float c = std::clamp(v, 0.0f, 255.0f);
+			const int g = std::min(static_cast<int>(c), 254);
+			v = table[g] + (c - static_cast<float>(g)) * (table[g + 1] - table[g]);
+		} else {
+			v = expScale > 0.0f ? apply(v) : logSample(v, k, norm);
+		}
+	}
+}
+
+void Tone::fillTable(float *out256) const
+{
+	const float k = 1.0f / logFloor, norm = 255.0f / std::log1p(255.0f * k);
+	for (int g = 0; g < 256; ++g)
+		out256[g] = expScale > 0.0f ? apply(static_cast<float>(g)) : logSample(static_cast<float>(g), k, norm);
 }
 
 bool warpMarker(const ImageView &image, const std::array<Point2f, 4> &corners, int bits,
@@ -138,8 +169,7 @@ bool warpCellCentres(const ImageView &image, const std::array<Point2f, 4> &corne
 	return true;
 }
 
-bool insetQuad(const ImageView &image, std::array<Point2f, 4> &corners, int bits,
-	       WarpedMarker &out, Tone tone)
+bool insetCorners(const ImageView &image, std::array<Point2f, 4> &corners, int bits)
 {
 	const auto H = Homography::fromUnitSquare(corners);
 	if (!H)
@@ -153,7 +183,15 @@ bool insetQuad(const ImageView &image, std::array<Point2f, 4> &corners, int bits
 	}
 	if (!refineCorners(image, inner, std::max(1.5f, 1.2f * cell)))
 		return false;
-	if (!warpMarker(image, inner, bits, out, tone))
+	corners = inner;
+	return true;
+}
+
+bool insetQuad(const ImageView &image, std::array<Point2f, 4> &corners, int bits,
+	       WarpedMarker &out, Tone tone)
+{
+	std::array<Point2f, 4> inner = corners;
+	if (!insetCorners(image, inner, bits) || !warpMarker(image, inner, bits, out, tone))
 		return false;
 	corners = inner;
 	return true;

@@ -60,6 +60,11 @@ struct FRAPPE_HIDDEN Detector::Impl {
 	/* policy on the log scale (Tone), the second read of a candidate;
 	 * grey levels (no second read) when light_floor keeps thresholds absolute. */
 	detail::DecodePolicy logPolicy;
+	std::array<float, 256> logTable; /* logPolicy.tone's value of each grey level */
+	/* policy on the exponential scale, the last read of a candidate whose
+	 * whites clip (none when light_floor keeps thresholds absolute). */
+	detail::DecodePolicy clipPolicy;
+	std::array<float, 256> clipTable;
 	FrontEndParams params;
 	std::unique_ptr<FrontEnd> frontEnd;
 	std::unique_ptr<CandidateWarper> warper; /* nullptr: warp on the CPU, one by one */
@@ -131,6 +136,10 @@ struct FRAPPE_HIDDEN Detector::Impl {
 		detail::Binarised b;
 		const detail::WarpedMarker *samples = nullptr;
 		bool counted = false;   /* sampled for a read: one of Result::candidates */
+		/* The inset outline (insetCorners()), measured once for every read:
+		 * 0 not yet, 1 measured, -1 not measurable. */
+		int inset = 0;
+		std::array<Point2f, 4> insetCorners;
 	};
 
 	void checkImage(const ImageView &image) const;

@@ -36,7 +36,7 @@ constexpr float kPaperWhite = 0.5f;
 
 /* A cell whose mean is at least this grey level clips: what lies under it
  * may be black ink under glare. */
-constexpr float kClipped = 250.0f;
+constexpr float kClipped = kClippedGrey;
 
 /* A candidate's payload must span at least this many grey levels (the
  * detector's rule for every read). */
