@@ -43,7 +43,7 @@ gint maxMaxHamming()
 {
 	gint most = 0;
 	for (const auto &d : frappe::dictionaries())
-		most = std::max(most, d.bits * d.bits / 2);
+		most = std::max(most, d.codeBits() / 2);
 	return most;
 }
 
@@ -147,7 +147,7 @@ frappe::Config Settings::config(bool staged) const
 	config.corner_threshold = cornerThreshold;
 	config.region_contrast = regionContrast;
 	config.light_floor = lightFloor;
-	config.max_hamming = std::min(maxHamming, dict.bits * dict.bits / 2);
+	config.max_hamming = std::min(maxHamming, dict.codeBits() / 2);
 	config.scaled_size = scaledSize;
 	config.max_scaled_frames = maxScaledFrames;
 	config.track_cover_frames = trackCoverFrames;

@@ -98,6 +98,9 @@ const char kUsage[] =
 	"      --marker-size M     the markers' side in metres (the black border's outside)\n"
 	"      --marker-sizes SPEC  sides of some ids, \"0:0.05,7:0.1\"; the others\n"
 	"                          --marker-size's, or no pose\n"
+	"      --bundle FILE       one pose from every marker of a rigid set: apriltag_ros's\n"
+	"                          tags.yaml (tag_bundles) or a grid board (board: grid, rows,\n"
+	"                          cols, size, gap, first_id); its sizes need no --marker-size\n"
 	"\n"
 	"Images are read one at a time and refused, with an error line, when larger\n"
 	"than 2^26 pixels (read from the header, before decoding) or cut short.\n"
@@ -109,9 +112,10 @@ struct Options {
 	std::string list, out, annotate, backend = "auto";
 	int repeat = 1;
 	bool json = false, stats = false;
-	/* Pose: a camera and the sizes, or neither. */
+	/* Pose: a camera and the sizes (or a bundle), or neither. */
 	std::optional<frappe::Camera> camera;
 	frappe::MarkerSizes sizes;
+	std::optional<frappe::Bundle> bundle;
 };
 
 [[noreturn]] void usageError(const std::string &msg)
@@ -178,8 +182,15 @@ void useDictionary(Options &o, const std::string &name)
 
 /* The pose options, checked together once all are read. */
 void usePose(Options &o, const std::string &calibration, const std::string &camera, double size,
-	     const std::string &sizes)
+	     const std::string &sizes, const std::string &bundle)
 {
+	if (!bundle.empty()) {
+		try {
+			o.bundle = frappe::loadBundle(bundle);
+		} catch (const std::exception &e) {
+			usageError(std::string("--bundle: ") + e.what());
+		}
+	}
 	if (!calibration.empty() && !camera.empty())
 		usageError("--calibration and --camera: give one camera");
 	if (!calibration.empty()) {
@@ -200,8 +211,10 @@ void usePose(Options &o, const std::string &calibration, const std::string &came
 	} catch (const std::exception &e) {
 		usageError(std::string("--marker-sizes: ") + e.what());
 	}
-	if (o.camera && !o.sizes.any())
-		usageError("a camera without marker sizes: add --marker-size M (metres) or --marker-sizes");
+	if (o.camera && !o.sizes.any() && !o.bundle)
+		usageError("a camera without marker sizes: add --marker-size M (metres), --marker-sizes or --bundle");
+	if (!o.camera && o.bundle)
+		usageError("a bundle without a camera: add --calibration FILE or --camera fx,fy,cx,cy");
 	if (!o.camera && o.sizes.any())
 		usageError("marker sizes without a camera: add --calibration FILE or --camera fx,fy,cx,cy");
 }
@@ -209,7 +222,7 @@ void usePose(Options &o, const std::string &calibration, const std::string &came
 Options parse(int argc, char **argv)
 {
 	Options o;
-	std::string calibration, camera, sizes;
+	std::string calibration, camera, sizes, bundle;
 	double size = 0.0;
 	for (int i = 1; i < argc; ++i) {
 		const std::string a = argv[i];
@@ -226,7 +239,11 @@ Options parse(int argc, char **argv)
 			std::exit(0);
 		} else if (a == "--dictionaries") {
 			for (const auto &d : frappe::dictionaries())
-				std::cout << d.name << "  (" << d.bits << "x" << d.bits << ", " << d.size()
+				std::cout << d.name << "  ("
+					  << (d.layout ? std::to_string(d.codeBits()) + " bits in a layout of " +
+								 std::to_string(d.layout->size) + "x" + std::to_string(d.layout->size) + " cells"
+						       : std::to_string(d.bits) + "x" + std::to_string(d.bits))
+					  << ", " << d.size()
 					  << " ids, min distance " << d.min_hamming << ", corrects "
 					  << d.defaultMaxHamming() << ", " << d.weakMaxHamming() << " with weak cells)\n";
 			std::exit(0);
@@ -246,6 +263,10 @@ Options parse(int argc, char **argv)
 				usageError("--marker-size must be a side in metres above 0, got " + std::string(argv[i]));
 		} else if (a == "--marker-sizes") {
 			sizes = value();
+		} else if (a == "--bundle") {
+			bundle = value();
+			if (bundle.empty())
+				usageError("--bundle needs a file");
 		} else if (a == "--mode") {
 			const std::string m = value();
 			if (m == "normal")
@@ -296,7 +317,7 @@ Options parse(int argc, char **argv)
 			o.images.push_back(a);
 		}
 	}
-	usePose(o, calibration, camera, size, sizes);
+	usePose(o, calibration, camera, size, sizes, bundle);
 	if (!o.list.empty())
 		readList(o.list, o.images);
 	if (o.images.empty())
@@ -311,9 +332,27 @@ using frappe::cli::jsonEscape;
 /* What a line may carry beyond the contract's fields. */
 struct LineExtras {
 	const std::vector<std::optional<frappe::Pose>> *poses = nullptr; /* one per marker */
+	const frappe::Bundle *bundle = nullptr; /* with its pose, when one was found */
+	const std::optional<frappe::BundlePose> *bundlePose = nullptr;
 	std::string stats; /* `"stats": {...}`, or empty */
 	bool tracking = false; /* Mode::Track: each marker says whether it was tracked */
 };
+
+/* The bundle's pose: `{"name": .., "rvec": .., "tvec": .., "pose_error": ..,
+ * "used": [ids], "rejected": [ids]}`, or null when none. */
+std::string bundleJson(const frappe::Bundle &b, const std::optional<frappe::BundlePose> &p)
+{
+	if (!p)
+		return "null";
+	auto ids = [](const std::vector<int> &v) {
+		std::string s = "[";
+		for (std::size_t i = 0; i < v.size(); ++i)
+			s += (i ? ", " : "") + std::to_string(v[i]);
+		return s + "]";
+	};
+	return "{\"name\": \"" + jsonEscape(b.name) + "\"" + frappe::cli::poseJson(p->pose) + ", \"used\": " + ids(p->used) +
+	       ", \"rejected\": " + ids(p->rejected) + "}";
+}
 
 std::string jsonLine(const std::string &image, const std::vector<Marker> &markers, double ms,
 		     const std::string &error, const LineExtras &extras = {})
@@ -343,6 +382,8 @@ std::string jsonLine(const std::string &image, const std::vector<Marker> &marker
 	}
 	std::snprintf(buf, sizeof(buf), "%.4f", ms);
 	o << "], \"time_ms\": " << buf;
+	if (extras.bundle)
+		o << ", \"bundle\": " << bundleJson(*extras.bundle, *extras.bundlePose);
 	if (!extras.stats.empty())
 		o << ", " << extras.stats;
 	o << "}";
@@ -385,6 +426,7 @@ struct Frame {
 	bool all_pushed = false;
 	double warm_up_ms = -1.0;     /* the untimed warm-up run on it, when one was */
 	std::vector<std::optional<frappe::Pose>> poses; /* one per marker, with a camera */
+	std::optional<frappe::BundlePose> bundlePose; /* with --bundle */
 };
 
 /* Reads, checks and decodes one image into f.gray, or sets f.error. The
@@ -635,7 +677,10 @@ private:
 			std::cerr << "frappe-detect: " << f.error << "\n";
 			return;
 		}
-		f.poses = frappe::cli::markerPoses(f.markers, opt_.sizes, *camera);
+		if (opt_.sizes.any())
+			f.poses = frappe::cli::markerPoses(f.markers, opt_.sizes, *camera);
+		if (opt_.bundle)
+			f.bundlePose = frappe::estimateBundlePose(*opt_.bundle, f.markers, *camera);
 	}
 
 	void write(Frame &f)
@@ -649,6 +694,10 @@ private:
 		extras.tracking = opt_.config.mode == frappe::Mode::Track;
 		if (!f.poses.empty())
 			extras.poses = &f.poses;
+		if (opt_.bundle && f.error.empty()) {
+			extras.bundle = &*opt_.bundle;
+			extras.bundlePose = &f.bundlePose;
+		}
 		if (out_) {
 			/* The contract's line, with the poses when asked for. */
 			const std::string line = jsonLine(f.path, f.markers, ms, f.error, extras) + "\n";
@@ -674,6 +723,12 @@ private:
 				if (!f.poses.empty() && f.poses[i])
 					std::printf("           %s\n", frappe::cli::poseText(*f.poses[i]).c_str());
 			}
+			if (f.bundlePose)
+				std::printf("  bundle %s: %zu markers used, %zu rejected  %s\n", opt_.bundle->name.c_str(),
+					    f.bundlePose->used.size(), f.bundlePose->rejected.size(),
+					    frappe::cli::poseText(f.bundlePose->pose).c_str());
+			else if (opt_.bundle)
+				std::printf("  bundle %s: no pose\n", opt_.bundle->name.c_str());
 			if (opt_.stats) {
 				std::printf("  stages:");
 				for (int s = 0; s < frappe::kStageCount; ++s)

@@ -19,7 +19,7 @@ namespace {
 using detail::bigEnough;
 using detail::cellSide;
 using detail::kMaxReadBlock;
-using detail::kReadCell;
+using detail::readBlock;
 using detail::quadArea;
 using detail::sidesAtLeast;
 using detail::StageTimer;
@@ -31,16 +31,6 @@ using detail::toFullResolution;
 bool smallCells(const std::array<Point2f, 4> &q, int bits)
 {
 	return !sidesAtLeast(q, 4.0f * static_cast<float>(bits + 2));
-}
-
-/* The block (1: the frame itself) a candidate with cells of `cell` pixels
- * is read at. */
-int readBlock(float cell)
-{
-	int f = 1;
-	while (2 * f <= kMaxReadBlock && cell >= static_cast<float>(2 * f) * kReadCell)
-		f *= 2;
-	return f;
 }
 
 /* The corner refinement window for cells large enough (refineQuad). */
@@ -342,6 +332,8 @@ bool clipsWhite(const detail::WarpedMarker &w)
 bool Detector::Impl::readCandidate(const ImageView &image, Slot &slot, std::size_t k, float search,
 				   StageTimer &timer, Marker &m)
 {
+	if (dict->layout)
+		return readLayoutCandidate(image, slot, k, search, timer, m);
 	detail::Quad &q = slot.quads[k];
 	const std::array<Point2f, 4> tracedOutline = warper ? batch.outlines[k] : q.corners;
 	if (skipCandidate(q, tracedOutline, slot.result.markers))
@@ -388,8 +380,16 @@ bool Detector::Impl::readCandidate(const ImageView &image, Slot &slot, std::size
 	slot.result.candidates += counted || r.counted;
 	if (!read.ok())
 		return false;
-	if (r.f > 1) {
-		const Point2f origin{ static_cast<float>(r.block.ox), static_cast<float>(r.block.oy) };
+	toMarker(q, r.f, r.block, read, m);
+	return true;
+}
+
+void Detector::Impl::toMarker(detail::Quad &q, int f, const BlockView &block, const detail::MarkerRead &read,
+			      Marker &m)
+{
+	if (f > 1) {
+		const float ff = static_cast<float>(f);
+		const Point2f origin{ static_cast<float>(block.ox), static_cast<float>(block.oy) };
 		for (Point2f &p : q.corners) {
 			p = toFullResolution(p, 1.0f / ff);
 			p = { p.x + origin.x, p.y + origin.y };
@@ -401,7 +401,6 @@ bool Detector::Impl::readCandidate(const ImageView &image, Slot &slot, std::size
 	m.margin = read.margin;
 	for (int i = 0; i < 4; ++i)
 		m.corners[i] = q.corners[(i + d.rotation) & 3];
-	return true;
 }
 
 /* The candidates in order, smallest first: each read, each marker kept
@@ -427,7 +426,9 @@ void Detector::Impl::finish(const ImageView &image, Slot &slot)
 	 * 32 px; a large candidate's box spans many, and then the grid visits
 	 * every entry instead. */
 	markerCentres.reset(2 * slot.quads.size(), 32.0f);
-	if (warper)
+	if (warper && dict->layout)
+		refineAndWarpLayouts(image, slot, search);
+	else if (warper)
 		refineAndWarpAll(image, slot, search);
 	for (std::size_t k = 0; k < slot.quads.size(); ++k) {
 		StageTimer timer(res.times, Stage::Refine);

@@ -251,10 +251,10 @@ inline int bitCount(std::uint64_t v)
 /* rotations[r]: the code as read with quad corner r as the top-left. Reading
  * from corner 1 sees the grid turned a quarter anticlockwise, i.e. three
  * quarter turns clockwise; from corner 3, one. */
-std::array<std::uint64_t, 4> rotationsOf(std::uint64_t code, int bits)
+std::array<std::uint64_t, 4> rotationsOf(std::uint64_t code, const Dictionary &dict)
 {
-	const std::uint64_t one = rotateCode(code, bits), two = rotateCode(one, bits);
-	return { code, rotateCode(two, bits), two, one };
+	const std::uint64_t one = dict.rotate(code), two = dict.rotate(one);
+	return { code, dict.rotate(two), two, one };
 }
 
 } // namespace
@@ -273,10 +273,10 @@ __attribute__((target_clones("popcnt", "default")))
 #endif
 Decoded nearestCode(const Dictionary &dict, std::uint64_t code, int maxHamming)
 {
-	const std::array<std::uint64_t, 4> rotations = rotationsOf(code, dict.bits);
+	const std::array<std::uint64_t, 4> rotations = rotationsOf(code, dict);
 	/* The nearest id and the nearest other id: an id's distance is its
 	 * nearest rotation's. Ids further than the runner-up cannot matter. */
-	const int words = dict.bits * dict.bits;
+	const int words = dict.codeBits();
 	Decoded best;
 	best.hamming = words + 1;
 	best.runnerUp = words + 1;
@@ -357,7 +357,7 @@ Decoded CodeBook::decode(std::uint64_t code, int maxHamming) const
 		return {};
 	/* decode() takes the lowest id at distance 0 and the lowest rotation
 	 * for it, and calls two ids at distance 0 ambiguous. */
-	const std::array<std::uint64_t, 4> rotations = rotationsOf(code, dict_->bits);
+	const std::array<std::uint64_t, 4> rotations = rotationsOf(code, *dict_);
 	Decoded exact;
 	for (int r = 0; r < 4; ++r) {
 		auto it = std::lower_bound(sorted_.begin(), sorted_.end(), std::make_pair(rotations[r], -1));

@@ -39,21 +39,23 @@ void validate(const Config &c, const Dictionary &d)
 	if (c.custom_dictionary) {
 		/* One made by hand rather than by loadDictionary(): what the
 		 * decoder and the sample grid rely on. */
-		if (d.bits < 3 || d.bits > 8)
+		if (!d.layout && (d.bits < 3 || d.bits > 8))
 			fail("custom_dictionary: bits must be 3..8, got " + std::to_string(d.bits));
+		if (d.layout && (d.layout->size + 2 > 16 || d.bits != d.layout->square_cells - 2))
+			fail("custom_dictionary: a layout of at most 14 cells a side, with bits its square's cells less 2");
 		if (d.codes.empty())
 			fail("custom_dictionary: no codes");
 		/* Every output carries the name: JSON, GStreamer, Python. */
 		if (detail::invalidUtf8At(d.name) != std::string_view::npos)
 			fail("custom_dictionary: the name is not UTF-8 text");
-		const int cells = d.bits * d.bits;
+		const int cells = d.codeBits();
 		for (std::uint64_t code : d.codes) {
 			if (cells < 64 && code >> cells)
 				fail("custom_dictionary: a code with bits beyond the " + std::to_string(cells) + " cells");
 		}
 	}
-	if (c.max_hamming < -1 || c.max_hamming > d.bits * d.bits / 2)
-		fail("max_hamming must be -1 (dictionary default) or 0.." + std::to_string(d.bits * d.bits / 2) +
+	if (c.max_hamming < -1 || c.max_hamming > d.codeBits() / 2)
+		fail("max_hamming must be -1 (dictionary default) or 0.." + std::to_string(d.codeBits() / 2) +
 		     " for " + std::string(d.name) + ", got " + std::to_string(c.max_hamming));
 	if (!(c.weak_margin >= 0.0f && c.weak_margin <= 1.0f))
 		fail("weak_margin must be in [0, 1], got " + std::to_string(c.weak_margin));
@@ -98,6 +100,9 @@ public:
 	 * samples (finish() uses both before refining). */
 	bool isMarker(detail::Quad &quad) override
 	{
+		/* A layout's square is read by finish() alone (layout_candidate.cpp). */
+		if (dict_.layout)
+			return false;
 		std::array<Point2f, 4> corners;
 		for (int i = 0; i < 4; ++i)
 			corners[i] = toFullResolution(quad.corners[i], scale_);

@@ -37,6 +37,16 @@ namespace detail {
 constexpr float kReadCell = 6.0f;
 constexpr int kMaxReadBlock = 8;
 
+/* The block (1: the frame itself) a candidate with cells of `cell` pixels
+ * is read at. */
+inline int readBlock(float cell)
+{
+	int f = 1;
+	while (2 * f <= kMaxReadBlock && cell >= static_cast<float>(2 * f) * kReadCell)
+		f *= 2;
+	return f;
+}
+
 } // namespace detail
 
 struct FRAPPE_HIDDEN Detector::Impl {
@@ -152,6 +162,14 @@ struct FRAPPE_HIDDEN Detector::Impl {
 			   detail::StageTimer &timer);
 	void readInset(Reading &r, detail::Quad &q, const detail::DecodePolicy &pol, detail::StageTimer &timer);
 	detail::MarkerRead decodeCandidate(const Reading &r, detail::Quad &q, const detail::DecodePolicy &pol);
+	/* A read's marker: q's corners back in frame pixels from the block
+	 * of f pixels they were read on, the code's first corner first. */
+	static void toMarker(detail::Quad &q, int f, const BlockView &block, const detail::MarkerRead &read, Marker &m);
+	/* The same for a dictionary with a layout (layout_candidate.cpp). */
+	bool refineLayoutQuad(const ImageView &image, detail::Quad &q, float search) const;
+	void refineAndWarpLayouts(const ImageView &image, Slot &slot, float search);
+	bool readLayoutCandidate(const ImageView &image, Slot &slot, std::size_t k, float search,
+				 detail::StageTimer &timer, Marker &m);
 	/* Border cells that make a white frame: three quarters of the
 	 * 4(n+1). */
 	int whiteFrame() const { return 3 * dict->bits + 3; }

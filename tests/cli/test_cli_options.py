@@ -239,6 +239,42 @@ def track_mode(exe, sample, expected, tmp):
     check(r.returncode != 0 and 'track_cover_frames' in text(r.stderr), '--track-cover-frames 0 is refused')
 
 
+def layouts_and_bundles(exe, render, tmp):
+    """Issue 32: a layout family rendered and read with its corners; a board
+    printed by frappe-render --board and its bundle file read back by
+    --bundle: one pose from all its markers, face on at the camera's
+    distance."""
+    tag = os.path.join(tmp, 'tag41.png')
+    check(run(render, '--dictionary', 'tagStandard41h12', '--id', '7', '--cell', '10', tag).returncode == 0,
+          'frappe-render draws a tagStandard41h12 marker')
+    r = run(exe, '--json', '--dictionary', 'tagStandard41h12', tag)
+    m = json_lines(r)[0]['markers']
+    # 11 x 11 cells of 10 px with the quiet cell; the found square is cells 3..8.
+    check(len(m) == 1 and m[0]['id'] == 7 and
+          max(abs(a - b) for p, q in zip(m[0]['corners'], [[29.5, 29.5], [79.5, 29.5], [79.5, 79.5], [29.5, 79.5]])
+              for a, b in zip(p, q)) < 0.1,
+          'tagStandard41h12 id 7 read with the found square\'s corners: %s' % m)
+    board = os.path.join(tmp, 'board.png')
+    check(run(render, '--board', '3x4', '--cell', '8', '--first-id', '5', '--marker-size', '0.08', board).returncode == 0,
+          'frappe-render --board writes a board and its bundle file')
+    bundle = os.path.join(tmp, 'board.yaml')
+    # Squares of 64 px for 8 cm: a focal length of 800 px puts the board 1 m away, face on.
+    r = run(exe, '--json', '--camera', '800,800,167.5,127.5', '--bundle', bundle, board)
+    line = json_lines(r)[0]
+    b = line.get('bundle')
+    check(r.returncode == 0 and len(line['markers']) == 12 and b and b['used'] == list(range(5, 17))
+          and b['rejected'] == [], '--bundle: one pose from the 12 markers: %s' % b)
+    check(abs(b['tvec'][2] - 1.0) < 0.01 and b['pose_error'] < 0.5,
+          '--bundle: the board 1 m away (%.4f m), reprojected within %.3f px' % (b['tvec'][2], b['pose_error']))
+    r = run(exe, '--bundle', bundle, board)
+    check(r.returncode == 2 and 'a bundle without a camera' in text(r.stderr), '--bundle without a camera: exit 2')
+    bad = os.path.join(tmp, 'bad.yaml')
+    with open(bad, 'w') as f:
+        f.write('board: hexagon\n')
+    r = run(exe, '--camera', '800,800,167.5,127.5', '--bundle', bad, board)
+    check(r.returncode == 2 and "board: 'hexagon' is not a known board" in text(r.stderr), '--bundle FILE of no bundle: exit 2')
+
+
 def main():
     exe, render = sys.argv[1], sys.argv[2]
     sample = os.path.join(SAMPLES, 'markers-36h12.png')
@@ -251,6 +287,7 @@ def main():
         dictionary_files(exe, render, sample, expected, tmp)
         pose(exe, sample, expected, tmp)
         track_mode(exe, sample, expected, tmp)
+        layouts_and_bundles(exe, render, tmp)
     return 0
 
 

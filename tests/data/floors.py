@@ -103,6 +103,9 @@ WRONG_IDS_PER_300 = {
     '7x7_50': (1, 1), '7x7_100': (1, 1), '7x7_250': (1, 1), '7x7_1000': (1, 1),
     'apriltag_16h5': (1, 1), 'apriltag_25h9': (1, 1), 'apriltag_36h10': (1, 1),
     'apriltag_36h11': (1, 1), 'aruco_mip_36h12': (1, 1), 'aruco_original': (1, 1),
+    # AprilTag 3's layout families (issue 32): none over any subset, measured.
+    'apriltag_standard41h12': (0, 0), 'apriltag_standard52h13': (0, 0), 'apriltag_circle21h7': (0, 0),
+    'apriltag_circle49h12': (0, 0), 'apriltag_custom48h12': (0, 0),
 }
 
 # Any resolution: each subset upsampled 2x and 3x, bilinear and nearest,

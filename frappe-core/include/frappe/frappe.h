@@ -2,6 +2,7 @@
 // frappe/frappe.h: the whole public API of frappe-core.
 #pragma once
 
+#include "frappe/bundle.h"
 #include "frappe/camera.h"
 #include "frappe/candidate_warp.h"
 #include "frappe/config.h"
@@ -10,6 +11,7 @@
 #include "frappe/edge_map.h"
 #include "frappe/homography.h"
 #include "frappe/image.h"
+#include "frappe/layout.h"
 #include "frappe/marker.h"
 #include "frappe/pipeline.h"
 #include "frappe/pose.h"
