@@ -7,7 +7,7 @@
 //
 // Renders N frames of text (seeded, so every run sees the same frames):
 // lines of random words and letter shapes in OpenCV's Hershey fonts, at
-// sizes from 12 to 110 px a letter, strokes of 1 to 9 px, upright, italic,
+// sizes from 12 to 110 px a letter, strokes of 1 to 21 px (a third bold), upright, italic,
 // turned, seen at a tilt, blurred a little, on paper lit unevenly, with
 // sensor noise. No frame holds a marker: every detection is a false one.
 // Runs each dictionary (default: every built-in one) through frappe at its
@@ -83,7 +83,8 @@ cv::Mat textFrame(unsigned seed, int k)
 		if (uni(0, 1) < 0.2)
 			font |= cv::FONT_ITALIC;
 		const double scale = uni(0.4, 3.6);
-		const int thick = std::max(1, static_cast<int>(scale * uni(0.8, 3.0)));
+		/* A third of the lines bold: strokes up to six times the letter's scale. */
+		const int thick = std::max(1, static_cast<int>(scale * uni(0.8, uni(0, 1) < 0.33 ? 6.0 : 3.0)));
 		std::string text;
 		for (int n = static_cast<int>(uni(1, 6)); n > 0; --n)
 			text += word(rng) + " ";
