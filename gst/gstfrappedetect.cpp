@@ -45,8 +45,13 @@
  *   `alternative-reprojection-error` (double: the error of the other planar
  *   solution; close to `reprojection-error` when the pose is ambiguous).
  *
- * #GstFrappeDetect:dictionary takes the library's names (`apriltag_36h11`)
- * or the same with dashes (`apriltag-36h11`); #GstFrappeDetect:dictionary-file
+ * The detector's properties are the library's settings table
+ * (frappe/settings.h, docs/settings.md): one per frappe::Config field, named
+ * in kebab-case, with its default and range. #GstFrappeDetect:dictionary
+ * takes every spelling the library does: its names (`apriltag_36h11`), the
+ * same with dashes (`apriltag-36h11`), OpenCV's (`DICT_APRILTAG_36h11`) and
+ * AprilTag's (`tag36h11`), and reads back as the library's; an unknown name
+ * is a warning listing the known ones. #GstFrappeDetect:dictionary-file
  * a dictionary of one's own (frappe::loadDictionary), used instead; metas
  * and messages carry the dictionary's name.
  *
@@ -288,7 +293,7 @@ static bool ensure_pipeline(GstFrappeDetect *self)
 	GST_DEBUG_OBJECT(self,
 			 "pipeline for %s, mode %s, max-hamming %d, front end %s, overlap %s, %d thread(s), "
 			 "%u QPU context(s) opened",
-			 priv->dictionary.c_str(), s.mode == GST_FRAPPE_MODE_ASCALE ? "ascale" : "normal",
+			 priv->dictionary.c_str(), std::string(frappe::modeName(s.library.mode)).c_str(),
 			 priv->pipeline->detector().maxHamming(), priv->pipeline->detector().frontEnd().name(),
 			 overlap_name(overlap), priv->pipeline->threads(), priv->qpuContexts);
 	return true;
@@ -765,7 +770,5 @@ static void gst_frappe_detect_class_init(GstFrappeDetectClass *klass)
 	trans_class->stop = GST_DEBUG_FUNCPTR(gst_frappe_detect_stop);
 	filter_class->set_info = GST_DEBUG_FUNCPTR(gst_frappe_detect_set_info);
 
-	gst_type_mark_as_plugin_api(GST_TYPE_FRAPPE_MODE, static_cast<GstPluginAPIFlags>(0));
 	gst_type_mark_as_plugin_api(GST_TYPE_FRAPPE_BACKEND, static_cast<GstPluginAPIFlags>(0));
-	gst_type_mark_as_plugin_api(GST_TYPE_FRAPPE_DICTIONARY, static_cast<GstPluginAPIFlags>(0));
 }

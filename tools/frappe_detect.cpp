@@ -37,34 +37,22 @@ using frappe::Config;
 using frappe::Detector;
 using frappe::Marker;
 
-const char kUsage[] =
+const char kUsageHead[] =
 	"usage: frappe-detect [options] IMAGE...   (- reads one image from standard input)\n"
 	"       frappe-detect [options] --list LIST.txt --out DETS.jsonl [--repeat N]\n"
 	"\n"
 	"Finds square fiducial markers (ArUco, AprilTag) in 8-bit images.\n"
 	"\n"
+	"detector settings (frappe::Config; docs/settings.md says more of each):\n";
+
+const char kUsageTail[] =
+	"  -d NAME|FILE            --dictionary; a file is a dictionary of your own (the text\n"
+	"                          format of frappe-core/dictionaries, or OpenCV's aruco YAML/XML)\n"
+	"                          --threads: images detected at once; time_ms is then each\n"
+	"                          image's own detection time, and the images per second of the\n"
+	"                          whole list go to standard error\n"
+	"\n"
 	"options:\n"
-	"  -d, --dictionary NAME|FILE  marker family (default aruco_mip_36h12), see\n"
-	"                          --dictionaries; else a file of your own (the text format of\n"
-	"                          frappe-core/dictionaries, or OpenCV's aruco YAML/XML)\n"
-	"      --mode MODE         normal (default) or ascale (adaptive scaling over a sequence)\n"
-	"      --threads T         images detected at once, each on a thread of its own:\n"
-	"                          1 (default), 0 = one per core; time_ms is then each\n"
-	"                          image's own detection time, and the images per second\n"
-	"                          of the whole list go to standard error\n"
-	"      --edge-threshold E  Sobel magnitude for an edge, intensities in [0,1] (default 0.27)\n"
-	"      --corner-threshold C  Shi-Tomasi threshold for a corner (default 0.19)\n"
-	"      --region-contrast R  contrast for the dark-region candidates that find blurred\n"
-	"                          markers, intensities in [0,1]; 0 = off (default 0.16)\n"
-	"      --light-floor L     below mid-grey the thresholds follow the local brightness\n"
-	"                          plus L (intensities in [0,1]): markers in dim light and\n"
-	"                          shadows; 0.5 or more = absolute thresholds (default 0.063)\n"
-	"      --max-hamming H     bits read clearly that may be corrected (default: the\n"
-	"                          dictionary's careful default, see --dictionaries)\n"
-	"      --weak-margin W     a cell nearer the threshold than W (of half the contrast)\n"
-	"                          is a weak read, correctable beyond H (default 0.3; 0: off)\n"
-	"      --backend B         front end: auto, cpu, vc4 (the Pi's QPUs), vc4-emu (the QPU\n"
-	"                          kernels on an emulator: slow, bit-exact) (default auto)\n"
 	"  -a, --annotate PATH     write the image with the markers drawn (a folder for several images)\n"
 	"      --json              print one JSON line per image instead of text\n"
 	"      --stats             per-stage timings: a line of text, or with --json a \"stats\"\n"
@@ -89,8 +77,57 @@ const char kUsage[] =
 	"                          --marker-size's, or no pose\n"
 	"\n"
 	"Images are read one at a time and refused, with an error line, when larger\n"
-	"than 2^26 pixels (read from the header, before decoding) or cut short.\n"
+	"than --max-pixels (read from the header, before decoding) or cut short.\n"
 	"Exit status: 0, 1 when an image failed, 2 for bad options or files of options.\n";
+
+/* `text` wrapped to 80 columns, each line indented by `indent`. */
+std::string wrapped(const std::string &text, std::size_t indent)
+{
+	std::string out, line;
+	std::istringstream words(text);
+	std::string word;
+	while (words >> word) {
+		if (!line.empty() && indent + line.size() + 1 + word.size() > 80) {
+			out += std::string(indent, ' ') + line + "\n";
+			line.clear();
+		}
+		line += (line.empty() ? "" : " ") + word;
+	}
+	if (!line.empty())
+		out += std::string(indent, ' ') + line + "\n";
+	return out;
+}
+
+/* An option's line: its name at column 6, its text from column 26 (on
+ * the next line when the name is longer). */
+std::string optionHelp(const std::string &name, const std::string &text)
+{
+	const std::size_t column = 26;
+	const std::string head = "      " + name;
+	const std::string body = wrapped(text, column);
+	if (head.size() + 1 >= column)
+		return head + "\n" + body;
+	return head + std::string(column - head.size(), ' ') + body.substr(column);
+}
+
+/* The help: the detector's settings from the library's table, then the
+ * CLI's own options. */
+std::string usage()
+{
+	std::string out = kUsageHead;
+	const Config defaults;
+	for (const frappe::Setting &s : frappe::settings()) {
+		if (s.surfaces & frappe::kOnCli)
+			out += optionHelp("--" + s.kebabName() + " " + std::string(s.metavar),
+					  std::string(s.doc) + " (" + (s.isChoice() ? "" : "range ") + s.rangeText() +
+						  "; default " + s.text(defaults) + ")");
+	}
+	std::string backends;
+	for (const frappe::BackendName &b : frappe::backendNames())
+		backends += std::string(backends.empty() ? "" : "; ") + std::string(b.name) + ": " + std::string(b.doc);
+	out += optionHelp("--backend B", "where the front end runs: " + backends + " (default auto)");
+	return out + kUsageTail;
+}
 
 struct Options {
 	Config config;
@@ -195,6 +232,15 @@ void usePose(Options &o, const std::string &calibration, const std::string &came
 		usageError("marker sizes without a camera: add --calibration FILE or --camera fx,fy,cx,cy");
 }
 
+/* A detector setting the CLI offers, by its kebab-case name. */
+const frappe::Setting *cliSetting(const std::string &name)
+{
+	if (name.find('_') != std::string::npos)
+		return nullptr;
+	const frappe::Setting *s = frappe::findSetting(name);
+	return s && (s->surfaces & frappe::kOnCli) ? s : nullptr;
+}
+
 Options parse(int argc, char **argv)
 {
 	Options o;
@@ -208,7 +254,7 @@ Options parse(int argc, char **argv)
 			return argv[++i];
 		};
 		if (a == "-h" || a == "--help") {
-			std::cout << kUsage;
+			std::cout << usage();
 			std::exit(0);
 		} else if (a == "--version") {
 			std::cout << "frappe-detect " << frappe::version() << "\n";
@@ -235,32 +281,20 @@ Options parse(int argc, char **argv)
 				usageError("--marker-size must be a side in metres above 0, got " + std::string(argv[i]));
 		} else if (a == "--marker-sizes") {
 			sizes = value();
-		} else if (a == "--mode") {
-			const std::string m = value();
-			if (m == "normal")
-				o.config.mode = frappe::Mode::Normal;
-			else if (m == "ascale")
-				o.config.mode = frappe::Mode::AScale;
-			else
-				usageError("--mode takes normal or ascale, got '" + m + "'");
-		} else if (a == "--threads") {
-			o.config.threads = parseNumber<int>(a, value());
-		} else if (a == "--edge-threshold") {
-			o.config.edge_threshold = parseNumber<float>(a, value());
-		} else if (a == "--corner-threshold") {
-			o.config.corner_threshold = parseNumber<float>(a, value());
-		} else if (a == "--region-contrast") {
-			o.config.region_contrast = parseNumber<float>(a, value());
-		} else if (a == "--light-floor") {
-			o.config.light_floor = parseNumber<float>(a, value());
-		} else if (a == "--max-hamming") {
-			o.config.max_hamming = parseNumber<int>(a, value());
-		} else if (a == "--weak-margin") {
-			o.config.weak_margin = parseNumber<float>(a, value());
 		} else if (a == "--backend") {
 			o.backend = value();
-			if (o.backend != "auto" && o.backend != "cpu" && o.backend != "vc4" && o.backend != "vc4-emu")
-				usageError("--backend takes auto, cpu, vc4 or vc4-emu, got '" + o.backend + "'");
+			const auto names = frappe::backendNames();
+			if (std::none_of(names.begin(), names.end(),
+					 [&](const auto &b) { return b.name == o.backend; }))
+				usageError("--backend takes " + frappe::backendNameList() + ", got '" + o.backend +
+					   "'");
+		} else if (const frappe::Setting *s = a.starts_with("--") ? cliSetting(a.substr(2)) : nullptr) {
+			const std::string text = value();
+			try {
+				s->parse(o.config, text);
+			} catch (const std::exception &e) {
+				usageError(a + " " + e.what());
+			}
 		} else if (a == "-a" || a == "--annotate") {
 			o.annotate = value();
 		} else if (a == "--json") {

@@ -68,6 +68,9 @@ TEST(Dictionary, RotateCodeTurnsTheGridClockwise)
 			for (int r = 0; r < 4; ++r)
 				c = rotateCode(c, d.bits);
 			ASSERT_EQ(c, d.codes[id]) << d.name << " id " << id;
+	/* The element's dashed spelling, on every surface now. */
+	EXPECT_EQ(findDictionary("apriltag-36h11"), findDictionary("apriltag_36h11"));
+	EXPECT_EQ(findDictionary("6x6-250"), findDictionary("6x6_250"));
 		}
 	}
 }

@@ -130,7 +130,7 @@ def main():
             "check_inspect", os.path.join(args.source_root, "tests", "gst", "check_inspect.py"))
         check_inspect = importlib.util.module_from_spec(spec)
         spec.loader.exec_module(check_inspect)
-        missing = [p for p in check_inspect.PROPERTIES if f"\n  {p} " not in element]
+        missing = [p for p in check_inspect.PROPERTIES if f"\n  {p} " not in element and f"\n  {p}:" not in element]
         if missing:
             raise Failure("gst-inspect-1.0 frappedetect lacks properties " + ", ".join(missing))
         print(f"gst-inspect-1.0 frappedetect: {len(check_inspect.PROPERTIES)} properties, from {filename[0]}")

@@ -184,3 +184,16 @@ def test_marker_object():
     import pickle
     m2 = pickle.loads(pickle.dumps(m))
     assert (m2.id, m2.corners.tolist(), m2.hamming, m2.margin) == (m.id, m.corners.tolist(), m.hamming, m.margin)
+
+def test_settings_are_the_keywords():
+    # Every setting frappe.settings() lists is a keyword with its default,
+    # and config gives each back.
+    names = [s["name"] for s in frappe.settings()]
+    assert names[:2] == ["dictionary", "mode"] and "weak_margin" in names
+    cfg = frappe.Detector().config
+    for s in frappe.settings():
+        assert cfg[s["name"]] == s["default"], s["name"]
+    kwargs = {s["name"]: s["default"] for s in frappe.settings() if s["name"] != "dictionary"}
+    assert frappe.Detector(**kwargs).config == cfg
+    with pytest.raises(TypeError, match="unexpected keyword argument 'edge-threshold'"):
+        frappe.Detector(**{"edge-threshold": 0.3})

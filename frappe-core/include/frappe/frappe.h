@@ -15,3 +15,4 @@
 #include "frappe/pose.h"
 #include "frappe/render.h"
 #include "frappe/version.h"
+#include "frappe/settings.h"
