@@ -61,17 +61,17 @@ const Camera *CameraFitter::fit(int width, int height, std::string &note, std::s
 	return &scaled_;
 }
 
-std::vector<std::optional<Pose>> markerPoses(const std::vector<Marker> &markers, const MarkerSizes &sizes,
-					     const Camera &camera)
+std::vector<std::optional<MarkerPose>> markerPoses(const std::vector<Marker> &markers, const MarkerSizes &sizes,
+						   const Camera &camera)
 {
-	std::vector<std::optional<Pose>> poses;
+	std::vector<std::optional<MarkerPose>> poses;
 	poses.reserve(markers.size());
 	for (const Marker &m : markers) {
 		const double side = sizes(m.id);
 		std::optional<MarkerPose> p;
 		if (side > 0.0)
 			p = estimatePose(m.corners, side, camera);
-		poses.push_back(p ? std::optional<Pose>(p->pose) : std::nullopt);
+		poses.push_back(p);
 	}
 	return poses;
 }
@@ -86,14 +86,6 @@ std::string triple(const std::array<double, 3> &v, const char *format)
 }
 
 } // namespace
-
-std::string poseJson(const Pose &pose)
-{
-	char error[32];
-	std::snprintf(error, sizeof error, "%.4f", pose.error);
-	return ", \"rvec\": " + triple(pose.rvec, "[%.6f, %.6f, %.6f]") + ", \"tvec\": " +
-	       triple(pose.tvec, "[%.6f, %.6f, %.6f]") + ", \"pose_error\": " + error;
-}
 
 std::string poseText(const Pose &pose)
 {

@@ -39,12 +39,8 @@ private:
 
 /// Each marker's pose (nullopt for a marker without a size or whose
 /// corners give none).
-std::vector<std::optional<Pose>> markerPoses(const std::vector<Marker> &markers, const MarkerSizes &sizes,
-					     const Camera &camera);
-
-/// `, "rvec": [..], "tvec": [..], "pose_error": e` to add to a marker's
-/// JSON object.
-std::string poseJson(const Pose &pose);
+std::vector<std::optional<MarkerPose>> markerPoses(const std::vector<Marker> &markers, const MarkerSizes &sizes,
+						   const Camera &camera);
 
 /// A readable line: the distance, the position and the rotation.
 std::string poseText(const Pose &pose);

@@ -329,40 +329,32 @@ using frappe::cli::jsonEscape;
 
 /* What a line may carry beyond the contract's fields. */
 struct LineExtras {
-	const std::vector<std::optional<frappe::Pose>> *poses = nullptr; /* one per marker */
+	const std::vector<std::optional<frappe::MarkerPose>> *poses = nullptr; /* one per marker */
 	std::string stats; /* `"stats": {...}`, or empty */
 };
 
-std::string jsonLine(const std::string &image, const std::vector<Marker> &markers, double ms,
-		     const std::string &error, const LineExtras &extras = {})
+/* A line of the benchmarks' format: the image, its markers as the
+ * library's one writer makes them (frappe/marker_record.h), the time. */
+std::string jsonLine(const std::string &image, const std::vector<Marker> &markers, std::string_view dictionary,
+		     double ms, const std::string &error, const LineExtras &extras = {})
 {
-	std::ostringstream o;
-	o << "{\"image\": \"" << jsonEscape(image) << "\"";
-	if (!error.empty()) {
-		o << ", \"markers\": [], \"error\": \"" << jsonEscape(error) << "\"}";
-		return o.str();
-	}
-	o << ", \"markers\": [";
-	char buf[64];
+	std::string o = "{\"image\": \"" + jsonEscape(image) + "\"";
+	if (!error.empty())
+		return o + ", \"markers\": [], \"error\": \"" + jsonEscape(error) + "\"}";
+	o += ", \"markers\": [";
 	for (std::size_t i = 0; i < markers.size(); ++i) {
-		const Marker &m = markers[i];
-		o << (i ? ", " : "") << "{\"id\": " << m.id << ", \"corners\": [";
-		for (int k = 0; k < 4; ++k) {
-			std::snprintf(buf, sizeof(buf), "%s[%.3f, %.3f]", k ? ", " : "", m.corners[k].x, m.corners[k].y);
-			o << buf;
-		}
-		std::snprintf(buf, sizeof(buf), "%.3f", m.margin);
-		o << "], \"hamming\": " << m.hamming << ", \"margin\": " << buf;
-		if (extras.poses && (*extras.poses)[i])
-			o << frappe::cli::poseJson(*(*extras.poses)[i]);
-		o << "}";
+		const frappe::MarkerPose *pose = extras.poses && (*extras.poses)[i] ? &*(*extras.poses)[i] : nullptr;
+		if (i)
+			o += ", ";
+		frappe::appendMarkerJson(o, { &markers[i], dictionary, pose }, frappe::JsonNumbers::Rounded);
 	}
+	char buf[64];
 	std::snprintf(buf, sizeof(buf), "%.4f", ms);
-	o << "], \"time_ms\": " << buf;
+	o += "], \"time_ms\": ";
+	o += buf;
 	if (!extras.stats.empty())
-		o << ", " << extras.stats;
-	o << "}";
-	return o.str();
+		o += ", " + extras.stats;
+	return o + "}";
 }
 
 /* The per-stage times as a JSON member; the warm-up's wall time when one
@@ -396,7 +388,7 @@ struct Frame {
 	int in_flight = 0;            /* pushes whose result has not come back */
 	bool all_pushed = false;
 	double warm_up_ms = -1.0;     /* the untimed warm-up run on it, when one was */
-	std::vector<std::optional<frappe::Pose>> poses; /* one per marker, with a camera */
+	std::vector<std::optional<frappe::MarkerPose>> poses; /* one per marker, with a camera */
 };
 
 /* Reads, checks and decodes one image into f.gray, or sets f.error. The
@@ -660,7 +652,7 @@ private:
 			extras.poses = &f.poses;
 		if (out_) {
 			/* The contract's line, with the poses when asked for. */
-			const std::string line = jsonLine(f.path, f.markers, ms, f.error, extras) + "\n";
+			const std::string line = jsonLine(f.path, f.markers, dictionary(), ms, f.error, extras) + "\n";
 			/* a line at a time: a run cut short keeps what it found */
 			if (std::fputs(line.c_str(), out_) < 0 || std::fflush(out_) != 0)
 				writeFailed_ = true;
@@ -669,7 +661,7 @@ private:
 			/* The stats inside the line: every line stays one JSON object. */
 			if (opt_.stats && f.error.empty())
 				extras.stats = statsJson(f.times, f.warm_up_ms);
-			std::cout << jsonLine(f.path, f.markers, ms, f.error, extras) << "\n";
+			std::cout << jsonLine(f.path, f.markers, dictionary(), ms, f.error, extras) << "\n";
 		} else if (f.error.empty() && opt_.out.empty()) {
 			std::printf("%s: %zu marker%s (%s) in %.2f ms\n", f.path.c_str(), f.markers.size(),
 				    f.markers.size() == 1 ? "" : "s",
@@ -681,7 +673,7 @@ private:
 					std::printf(" (%.2f, %.2f)", p.x, p.y);
 				std::printf("\n");
 				if (!f.poses.empty() && f.poses[i])
-					std::printf("           %s\n", frappe::cli::poseText(*f.poses[i]).c_str());
+					std::printf("           %s\n", frappe::cli::poseText(f.poses[i]->pose).c_str());
 			}
 			if (opt_.stats) {
 				std::printf("  stages:");
@@ -698,6 +690,8 @@ private:
 		if (!opt_.annotate.empty() && f.error.empty())
 			annotate(f);
 	}
+
+	std::string_view dictionary() { return pipeline_.detector().dictionary().name; }
 
 	void annotate(const Frame &f)
 	{

@@ -16,6 +16,8 @@ GreyImage = npt.NDArray[np.uint8]
 Corners = Union["Marker", npt.ArrayLike]
 CameraMatrix = Union["Camera", npt.ArrayLike]
 
+MARKER_FIELDS: tuple[str, ...]
+
 def simd_target() -> str: ...
 
 class Dictionary:
@@ -36,12 +38,14 @@ class Dictionary:
     def __len__(self) -> int: ...
 
 def dictionaries() -> List[str]: ...
+def settings() -> List[Dict[str, Any]]: ...
 def get_dictionary(name: str) -> Dictionary: ...
 def load_dictionary(path: Union[str, bytes, PathLike[str], PathLike[bytes]]) -> Dictionary: ...
-def settings() -> List[Dict[str, Any]]: ...
 
 class Marker:
-    def __init__(self, id: int, corners: Corners, hamming: int = 0, margin: float = 0.0) -> None: ...
+    def __init__(
+        self, id: int, corners: Corners, hamming: int = 0, margin: float = 0.0, dictionary: str = ""
+    ) -> None: ...
     @property
     def id(self) -> int: ...
     @property
@@ -52,6 +56,8 @@ class Marker:
     @property
     def margin(self) -> float: ...
     @property
+    def dictionary(self) -> str: ...
+    @property
     def center(self) -> npt.NDArray[np.float64]: ...
 
 class Detector:
@@ -59,13 +65,13 @@ class Detector:
         self,
         dictionary: Union[str, Dictionary] = "aruco_mip_36h12",
         *,
+        # BEGIN generated: pyi (frappe/settings.h; ninja -C build update-generated)
         mode: str = "normal",
         edge_threshold: float = 0.27,
         corner_threshold: float = 0.19,
         max_hamming: int = -1,
         weak_margin: float = 0.3,
         scaled_size: float = 28.0,
-        # BEGIN generated: pyi (frappe/settings.h; ninja -C build update-generated)
         max_scaled_frames: int = 5,
         region_contrast: float = 0.16,
         light_floor: float = 0.063,
@@ -74,13 +80,13 @@ class Detector:
         max_pixels: int = 67108864,
         max_candidates: int = 4096,
         threads: int = 1,
+        # END generated
     ) -> None: ...
     def detect(self, image: GreyImage) -> List[Marker]: ...
     def reset(self) -> None: ...
     @property
     def stats(self) -> Dict[str, Any]: ...
     @property
-        # END generated
     def config(self) -> Dict[str, Any]: ...
     @property
     def dictionary(self) -> Dictionary: ...

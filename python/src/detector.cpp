@@ -128,7 +128,7 @@ py::list PyDetector::detect(py::handle obj)
 	py::list markers(result->markers.size());
 	for (std::size_t i = 0; i < result->markers.size(); ++i) {
 		const frappe::Marker &m = result->markers[i];
-		Marker out{ m.id, newFloatArray(4, 2), m.hamming, m.margin };
+		Marker out{ m.id, newFloatArray(4, 2), m.hamming, m.margin, std::string(dict_.dict->name) };
 		float *c = out.corners.mutable_data();
 		for (int k = 0; k < 4; ++k) {
 			c[2 * k] = m.corners[k].x;

@@ -3,6 +3,8 @@
 // the corners that estimate_pose() and draw_marker() take.
 #include "module.h"
 
+#include <frappe/marker_record.h>
+
 #include <cstdio>
 #include <string>
 
@@ -30,10 +32,10 @@ std::array<Point2f, 4> cornersArg(py::handle obj)
 
 namespace {
 
-Marker makeMarker(int id, py::handle corners, int hamming, float margin)
+Marker makeMarker(int id, py::handle corners, int hamming, float margin, std::string dictionary)
 {
 	const std::array<Point2f, 4> c = cornersArg(corners);
-	Marker m{ id, newFloatArray(4, 2), hamming, margin };
+	Marker m{ id, newFloatArray(4, 2), hamming, margin, std::move(dictionary) };
 	float *out = m.corners.mutable_data();
 	for (int i = 0; i < 4; ++i) {
 		out[2 * i] = c[i].x;
@@ -44,7 +46,8 @@ Marker makeMarker(int id, py::handle corners, int hamming, float margin)
 
 std::string repr(const Marker &m)
 {
-	std::string s = "frappe.Marker(id=" + std::to_string(m.id) + ", corners=[";
+	std::string s = "frappe.Marker(id=" + std::to_string(m.id) +
+			(m.dictionary.empty() ? "" : ", dictionary='" + m.dictionary + "'") + ", corners=[";
 	const float *c = m.corners.data();
 	char buf[64];
 	for (int i = 0; i < 4; ++i) {
@@ -62,20 +65,25 @@ void bindMarker(py::module_ &m)
 	py::class_<Marker>(m, "Marker", R"doc(
 One detected marker.
 
-id       its id in the detector's dictionary
-corners  (4, 2) float32 array, pixels: the outer corners of the black border,
-         top-left, top-right, bottom-right, bottom-left of the marker in its
-         upright orientation (clockwise on screen), as cv2.aruco orders them;
-         (0, 0) is the centre of the top-left pixel
-hamming  bits corrected to reach the code
-margin   how clearly the code was read, 0..1: filter on it to trade misses for
-         certainty)doc")
+id          its id in the detector's dictionary
+dictionary  the dictionary's name (the library's spelling)
+corners     (4, 2) float32 array, pixels: the outer corners of the black
+            border, top-left, top-right, bottom-right, bottom-left of the marker
+            in its upright orientation (clockwise on screen), as cv2.aruco
+            orders them; (0, 0) is the centre of the top-left pixel
+hamming     bits corrected to reach the code
+margin      how clearly the code was read, 0..1: filter on it to trade misses
+            for certainty
+
+The fields are frappe::forEachMarkerField()'s (frappe.MARKER_FIELDS, the pose's
+aside: frappe.estimate_pose), as frappe-detect's and frappejson's JSON.)doc")
 		.def(py::init(&makeMarker), py::arg("id"), py::arg("corners"), py::arg("hamming") = 0,
-		     py::arg("margin") = 0.0f)
+		     py::arg("margin") = 0.0f, py::arg("dictionary") = "")
 		.def_readonly("id", &Marker::id)
 		.def_readonly("corners", &Marker::corners)
 		.def_readonly("hamming", &Marker::hamming)
 		.def_readonly("margin", &Marker::margin)
+		.def_readonly("dictionary", &Marker::dictionary)
 		.def_property_readonly(
 			"center",
 			[](const Marker &mk) {
@@ -89,12 +97,21 @@ margin   how clearly the code was read, 0..1: filter on it to trade misses for
 			"The mean of the corners, (2,) float64.")
 		.def("__repr__", &repr)
 		.def(py::pickle(
-			[](const Marker &mk) { return py::make_tuple(mk.id, mk.corners, mk.hamming, mk.margin); },
+			[](const Marker &mk) {
+				return py::make_tuple(mk.id, mk.corners, mk.hamming, mk.margin, mk.dictionary);
+			},
 			[](const py::tuple &t) {
-				if (t.size() != 4)
-					throw py::value_error("a pickled frappe.Marker has 4 fields");
-				return makeMarker(t[0].cast<int>(), t[1], t[2].cast<int>(), t[3].cast<float>());
+				/* 4: pickled before the dictionary was a field */
+				if (t.size() != 4 && t.size() != 5)
+					throw py::value_error("a pickled frappe.Marker has 5 fields");
+				return makeMarker(t[0].cast<int>(), t[1], t[2].cast<int>(), t[3].cast<float>(),
+						  t.size() == 5 ? t[4].cast<std::string>() : std::string());
 			}));
+	/* The library's one list of a marker's output fields (pose ones last). */
+	py::tuple fields(markerFieldNames().size());
+	for (std::size_t i = 0; i < markerFieldNames().size(); ++i)
+		fields[i] = py::str(std::string(markerFieldNames()[i]));
+	m.attr("MARKER_FIELDS") = fields;
 }
 
 } // namespace frappe::python

@@ -38,6 +38,7 @@ struct Marker {
 	py::array_t<float> corners; ///< (4, 2) float32: top-left, top-right, bottom-right, bottom-left
 	int hamming = 0;
 	float margin = 0.0f;
+	std::string dictionary; ///< the detector's dictionary's name
 };
 
 /// Four corners from a Marker, or an array-like of 8 numbers shaped (4, 2)

@@ -185,6 +185,19 @@ def test_marker_object():
     m2 = pickle.loads(pickle.dumps(m))
     assert (m2.id, m2.corners.tolist(), m2.hamming, m2.margin) == (m.id, m.corners.tolist(), m.hamming, m.margin)
 
+
+def test_marker_has_the_librarys_fields(scene):
+    # One list of a marker's fields (frappe/marker_record.h): Python's
+    # Marker has each that is not the pose's (frappe.estimate_pose's).
+    image, _ = scene
+    m = frappe.Detector("aruco-mip-36h12").detect(image)[0]
+    pose_fields = ("rvec", "tvec", "reprojection_error", "alternative_reprojection_error")
+    assert frappe.MARKER_FIELDS[:5] == ("id", "dictionary", "corners", "hamming", "margin")
+    for name in frappe.MARKER_FIELDS:
+        assert name in pose_fields or hasattr(m, name), name
+    assert m.dictionary == "aruco_mip_36h12"
+
+
 def test_settings_are_the_keywords():
     # Every setting frappe.settings() lists is a keyword with its default,
     # and config gives each back.

@@ -14,5 +14,6 @@
 #include "frappe/pipeline.h"
 #include "frappe/pose.h"
 #include "frappe/render.h"
+#include "frappe/marker_record.h"
 #include "frappe/version.h"
 #include "frappe/settings.h"
