@@ -235,8 +235,8 @@ static const char *overlap_name(Overlap o)
 /* A pipeline of the active settings with its front end, or nullptr after
  * an element error. Not pipelined: frames one at a time on one thread.
  * Pipelined, one frame held either way: whole frames on two detectors and
- * threads (frappe::Pipeline::Mode::Frames, latency 1), or one detector's
- * stages (Mode::Stages, latency 1: the next frame's front end beside this
+ * threads (frappe::Pipeline::Overlap::Frames, latency 1), or one detector's
+ * stages (Overlap::Stages, latency 1: the next frame's front end beside this
  * frame's trace). */
 static std::unique_ptr<frappe::Pipeline> make_pipeline(GstFrappeDetect *self, Overlap overlap,
 						       GstFrappeBackend backend)
@@ -245,9 +245,10 @@ static std::unique_ptr<frappe::Pipeline> make_pipeline(GstFrappeDetect *self, Ov
 	const bool staged = overlap == Overlap::Stages;
 	std::unique_ptr<frappe::Pipeline> pipeline;
 	try {
-		pipeline = std::make_unique<frappe::Pipeline>(
-			priv->active.config(staged), staged ? frappe::Pipeline::Mode::Stages : frappe::Pipeline::Mode::Frames,
-			overlap == Overlap::None ? 0 : 1);
+		pipeline = std::make_unique<frappe::Pipeline>(priv->active.config(staged),
+							      staged ? frappe::Pipeline::Overlap::Stages
+								     : frappe::Pipeline::Overlap::Frames,
+							      overlap == Overlap::None ? 0 : 1);
 	} catch (const std::exception &e) {
 		GST_ELEMENT_ERROR(self, LIBRARY, SETTINGS, ("Invalid detector settings"), ("%s", e.what()));
 		return nullptr;

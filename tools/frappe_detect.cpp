@@ -470,7 +470,7 @@ double median(std::vector<double> v)
  * detectors; throws std::runtime_error saying what went wrong. */
 std::unique_ptr<frappe::Pipeline> makePipeline(const Options &opt)
 {
-	auto pipeline = std::make_unique<frappe::Pipeline>(opt.config, frappe::Pipeline::Mode::Frames);
+	auto pipeline = std::make_unique<frappe::Pipeline>(opt.config, frappe::Pipeline::Overlap::Frames);
 	std::string fallback;
 	try {
 		fallback = frappe::selectBackend(*pipeline, opt.backend);

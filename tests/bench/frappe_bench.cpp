@@ -165,8 +165,8 @@ void reportThroughput(const frappe::Config &base, const std::vector<cv::Mat> &im
 	one.threads = 1;
 	two.threads = 2;
 	frappe::Detector d1(one), d2(two);
-	frappe::Pipeline pipe(one, frappe::Pipeline::Mode::Stages), frames(two, frappe::Pipeline::Mode::Frames),
-		held(two, frappe::Pipeline::Mode::Frames, 1);
+	frappe::Pipeline pipe(one, frappe::Pipeline::Overlap::Stages), frames(two, frappe::Pipeline::Overlap::Frames),
+		held(two, frappe::Pipeline::Overlap::Frames, 1);
 	std::size_t sink = 0;
 	auto single = [&](const cv::Mat &g) { sink += d1.detect(viewOf(g)).markers.size(); };
 	auto bands = [&](const cv::Mat &g) { sink += d2.detect(viewOf(g)).markers.size(); };

@@ -126,10 +126,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t *data, std::size_t size
 			det.detect(view);
 		} catch (const std::invalid_argument &) {
 		}
-		/* Mode::Stages at latency 2 or 1 (the element's staged overlap). */
+		/* Overlap::Stages at latency 2 or 1 (the element's staged overlap). */
 		const bool staged = (pipelineMode & 1) != 0;
-		frappe::Pipeline pipeline(c, staged ? frappe::Pipeline::Mode::Stages : frappe::Pipeline::Mode::Frames,
-					  staged ? 2 - ((pipelineMode >> 1) & 1) : frappe::Pipeline::kDefaultLatency);
+		frappe::Pipeline pipeline(
+			c, staged ? frappe::Pipeline::Overlap::Stages : frappe::Pipeline::Overlap::Frames,
+			staged ? 2 - ((pipelineMode >> 1) & 1) : frappe::Pipeline::kDefaultLatency);
 		try {
 			pipeline.push(view);
 		} catch (const std::invalid_argument &) {

@@ -124,7 +124,7 @@ struct Config {
 	int max_candidates = 4096;
 
 	/// Threads; 1 = strictly single-threaded, 0 = one per hardware core. A
-	/// Pipeline (Mode::Frames) runs this many whole frames at once, one per
+	/// Pipeline (Overlap::Frames) runs this many whole frames at once, one per
 	/// thread: what pays on a stream (1.8x with two threads, for a frame of
 	/// latency per thread and a detector's memory per thread). A
 	/// lone Detector, which has one frame at a time, splits its front end
