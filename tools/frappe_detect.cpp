@@ -2,7 +2,7 @@
 // frappe-detect: the command-line detector.
 //
 //   frappe-detect photo.jpg [--annotate out.png]      people
-//   frappe-detect --list L --out D.jsonl --repeat N   benchmarks (DETECTOR-CONTRACT.md)
+//   frappe-detect --list L --out D.jsonl --repeat N   benchmarks (JSON lines: README.md)
 //   frappe-detect --calibration C --marker-size M -   robots: pose, an image on stdin
 #include <algorithm>
 #include <cerrno>

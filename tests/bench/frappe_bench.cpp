@@ -10,8 +10,9 @@
 // ratio, and each stage's share of frappe's time. OpenCV gets the same
 // dictionary as a custom Dictionary, at most 5 corrected bits (capped by
 // the dictionary's safe maximum), and no corner refinement, as in
-// shared/design/DETECTOR-CONTRACT.md. For AprilTag families, AprilTag 3.3
-// (Debian's libapriltag) runs too, single-threaded, at decimate 1 and 2.
+// ../shared/design/DETECTOR-CONTRACT.md (the team's folder beside the
+// checkout). For AprilTag families, AprilTag 3.3 (Debian's libapriltag)
+// runs too, single-threaded, at decimate 1 and 2.
 //
 // Then, unless --no-extras: throughput with two threads (front-end bands,
 // the staged pipeline, whole frames on two detectors at latency 2 and at the
