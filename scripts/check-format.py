@@ -4,13 +4,14 @@
 
     scripts/check-format.py [BASE]      (the test clang-format; CI runs it)
 
-Only the lines changed since BASE are checked (git clang-format): the tree
-is not reformatted wholesale, and every change leaves what it touched in
-style. BASE defaults to $FRAPPE_FORMAT_BASE, else the merge base with
+Only the lines changed since BASE are checked (clang-format --lines, moved
+files followed): the tree is not reformatted wholesale, and every change
+leaves what it touched in style. BASE defaults to $FRAPPE_FORMAT_BASE, else the merge base with
 origin/main, else with main. Exit 77 (skipped) without git, a checkout or
 clang-format. `git clang-format --style=file BASE` applies the fixes.
 """
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -24,8 +25,8 @@ def git(*args):
 
 
 def main():
-    if not shutil.which('git') or not shutil.which('git-clang-format') or not shutil.which('clang-format'):
-        print('git, git-clang-format or clang-format not found')
+    if not shutil.which('git') or not shutil.which('clang-format'):
+        print('git or clang-format not found')
         return SKIP
     if git('rev-parse', '--git-dir').returncode != 0:
         print('not a git checkout')
@@ -40,17 +41,34 @@ def main():
     if not base:
         print('no base to compare with (origin/main, main)')
         return SKIP
-    r = git('clang-format', '--diff', '--style=file', base, '--', '*.cpp', '*.h', '*.hpp', '*.c')
-    out = r.stdout.strip()
-    if r.returncode not in (0, 1) or out.startswith('error'):
-        print(r.stdout + r.stderr)
+    # The lines changed, renames followed (a moved file is not a changed
+    # one; git clang-format would take it as new).
+    r = git('diff', '-M', '-U0', '--no-color', '--diff-filter=AMR', base, '--', '*.cpp', '*.h', '*.hpp', '*.c')
+    if r.returncode != 0:
+        print(r.stderr)
         return 1
-    if not out or out.startswith('no modified files') or 'did not modify any files' in out:
-        print(f'the lines changed since {base[:12]} are in style')
+    lines = {}
+    path = None
+    for line in r.stdout.splitlines():
+        if line.startswith('+++ '):
+            path = line[6:] if line.startswith('+++ b/') else None
+        elif line.startswith('@@') and path:
+            m = re.match(r'@@ -\S+ \+(\d+)(?:,(\d+))? @@', line)
+            start, count = int(m.group(1)), int(m.group(2) or 1)
+            if count:
+                lines.setdefault(path, []).append(f'--lines={start}:{start + count - 1}')
+    bad = []
+    for path, ranges in sorted(lines.items()):
+        p = subprocess.run(['clang-format', '--style=file', '--dry-run', '--Werror'] + ranges + [path],
+                           cwd=ROOT, capture_output=True, text=True)
+        if p.returncode != 0:
+            bad.append(path)
+            print(p.stderr.strip())
+    if not bad:
+        print(f'the lines changed since {base[:12]} are in style ({len(lines)} files)')
         return 0
-    print(out)
-    print(f'\nlines changed since {base[:12]} are not in the house style (.clang-format); '
-          f'git clang-format --style=file {base[:12]} fixes them')
+    print(f'\nlines changed since {base[:12]} are not in the house style (.clang-format) in: ' + ', '.join(bad) +
+          f'\n(git clang-format --style=file {base[:12]} fixes them where no file was moved)')
     return 1
 
 
