@@ -2,7 +2,8 @@
 # SPDX-License-Identifier: MIT
 """The C++ lines a change touches, in the house style (.clang-format).
 
-    scripts/check-format.py [BASE]      (the test clang-format; CI runs it)
+    scripts/check-format.py [BASE]         (the test clang-format; CI runs it)
+    scripts/check-format.py --fix [BASE]   (formats those lines in place)
 
 Only the lines changed since BASE are checked (clang-format --lines, moved
 files followed): the tree is not reformatted wholesale, and every change
@@ -31,7 +32,10 @@ def main():
     if git('rev-parse', '--git-dir').returncode != 0:
         print('not a git checkout')
         return SKIP
-    base = sys.argv[1] if len(sys.argv) > 1 else os.environ.get('FRAPPE_FORMAT_BASE', '')
+    args = sys.argv[1:]
+    fix = '--fix' in args
+    args = [a for a in args if a != '--fix']
+    base = args[0] if args else os.environ.get('FRAPPE_FORMAT_BASE', '')
     if not base:
         for ref in ('origin/main', 'main'):
             r = git('merge-base', 'HEAD', ref)
@@ -59,7 +63,8 @@ def main():
                 lines.setdefault(path, []).append(f'--lines={start}:{start + count - 1}')
     bad = []
     for path, ranges in sorted(lines.items()):
-        p = subprocess.run(['clang-format', '--style=file', '--dry-run', '--Werror'] + ranges + [path],
+        check = ['-i'] if fix else ['--dry-run', '--Werror']
+        p = subprocess.run(['clang-format', '--style=file'] + check + ranges + [path],
                            cwd=ROOT, capture_output=True, text=True)
         if p.returncode != 0:
             bad.append(path)
@@ -68,7 +73,7 @@ def main():
         print(f'the lines changed since {base[:12]} are in style ({len(lines)} files)')
         return 0
     print(f'\nlines changed since {base[:12]} are not in the house style (.clang-format) in: ' + ', '.join(bad) +
-          f'\n(git clang-format --style=file {base[:12]} fixes them where no file was moved)')
+          f'\n(scripts/check-format.py --fix {base[:12]} formats them)')
     return 1
 
 

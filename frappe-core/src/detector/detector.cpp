@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: MIT
 // The Detector: runs the stages of Algorithm 1 in order and times each.
 // Here: the set-up, the front end and the trace; the reading of the
-// candidates is candidate_reader.cpp's, the state both share
-// detector_impl.h's.
+// candidates is detail::CandidateReader's (read/candidate_reader.h), which
+// the detector's state (detector_impl.h) holds.
 #include "frappe/version.h"
 
 #include <algorithm>
