@@ -39,7 +39,8 @@
  *   x0, y0, ..., x3, y3), `hamming` (uint), `margin` (double: how clearly
  *   the code was read, in [0, 1], the weakest code cell's distance from
  *   the black-white threshold as a fraction of half the contrast; near 0
- *   some cell was nearly a coin toss) and, when the pose is known,
+ *   some cell was nearly a coin toss), `tracked` (boolean: mode track found
+ *   it where the last frames predicted it) and, when the pose is known,
  *   `rvec` and `tvec` (GstValueArray of 3 doubles: Rodrigues rotation and
  *   translation in metres), `reprojection-error` (double, RMS pixels) and
  *   `alternative-reprojection-error` (double: the error of the other planar

@@ -58,6 +58,8 @@ void addMarkerFields(GstStructure *s, const frappe::MarkerRecord &r, bool arrays
 			gst_structure_set(s, field, G_TYPE_STRING, text.c_str(), nullptr);
 		} else if constexpr (std::is_same_v<T, frappe::Count>) {
 			gst_structure_set(s, field, G_TYPE_UINT, static_cast<guint>(value.value), nullptr);
+		} else if constexpr (std::is_same_v<T, bool>) {
+			gst_structure_set(s, field, G_TYPE_BOOLEAN, value ? TRUE : FALSE, nullptr);
 		} else if constexpr (std::is_same_v<T, int>) {
 			gst_structure_set(s, field, G_TYPE_INT, value, nullptr);
 		} else if constexpr (std::is_floating_point_v<T>) {
@@ -83,7 +85,7 @@ GstStructure *markerStructure(const Marker &m, const std::optional<frappe::Marke
 			      const char *dictionary)
 {
 	GstStructure *ms = gst_structure_new_empty("marker");
-	addMarkerFields(ms, { &m, dictionary, pose ? &*pose : nullptr }, true);
+	addMarkerFields(ms, { &m, dictionary, pose ? &*pose : nullptr, true }, true);
 	return ms;
 }
 

@@ -173,8 +173,9 @@ frappe::Config Settings::config(bool staged) const
 	frappe::Config config = library;
 	const auto &dict = customDictionary ? *customDictionary : *frappe::findDictionary(library.dictionary);
 	config.custom_dictionary = customDictionary;
-	config.max_hamming = std::min(library.max_hamming, dict.bits * dict.bits / 2);
-	config.threads = pipelined && !staged ? 2 : 1; /* whole frames on two threads */
+	config.max_hamming = std::min(library.max_hamming, dict.codeBits() / 2);
+	/* Whole frames on two threads; track follows the video on one. */
+	config.threads = pipelined && !staged && config.mode != frappe::Mode::Track ? 2 : 1;
 	return config;
 }
 

@@ -24,8 +24,10 @@
 #   --no-opencv        count frappe only (always so with --arch aarch64)
 #   --region-contrast C  Config::region_contrast for frappe (0: no region map
 #                      and no region candidates; default: the Config default)
-#   --mode M           normal (default) or ascale: the list as one video in its
-#                      order (what the Pi Zero model, vc4-zero-model, reads)
+#   --mode M           normal (default), ascale or track: the list as one video in
+#                      its order (ascale: what the Pi Zero model, vc4-zero-model,
+#                      reads; track: Mode::Track, its whole count in the front
+#                      end's column)
 #   --out DIR          where the results go (default: BUILD/arm-count)
 #   --build DIR        cross build dir (default in the checkout: build-armel,
 #                      build-arm64-count, build-arm64-count-scalar)

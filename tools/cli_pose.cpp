@@ -87,6 +87,14 @@ std::string triple(const std::array<double, 3> &v, const char *format)
 
 } // namespace
 
+std::string poseJson(const Pose &pose)
+{
+	char error[32];
+	std::snprintf(error, sizeof error, "%.4f", pose.error);
+	return ", \"rvec\": " + triple(pose.rvec, "[%.6f, %.6f, %.6f]") + ", \"tvec\": " +
+	       triple(pose.tvec, "[%.6f, %.6f, %.6f]") + ", \"pose_error\": " + error;
+}
+
 std::string poseText(const Pose &pose)
 {
 	const auto &t = pose.tvec;

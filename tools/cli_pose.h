@@ -42,6 +42,11 @@ private:
 std::vector<std::optional<MarkerPose>> markerPoses(const std::vector<Marker> &markers, const MarkerSizes &sizes,
 						   const Camera &camera);
 
+/// A bundle's pose as JSON members (frappe-detect --bundle): `, "rvec":
+/// [...], "tvec": [...], "pose_error": e`. A marker's pose is the marker
+/// record's (frappe/marker_record.h).
+std::string poseJson(const Pose &pose);
+
 /// A readable line: the distance, the position and the rotation.
 std::string poseText(const Pose &pose);
 

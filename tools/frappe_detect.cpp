@@ -22,6 +22,10 @@
 #include <string>
 #include <vector>
 
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
+
 #include <opencv2/imgcodecs.hpp>
 
 #include "annotate.h"
@@ -57,7 +61,9 @@ const char kUsageTail[] =
 	"      --json              print one JSON line per image instead of text\n"
 	"      --stats             per-stage timings: a line of text, or with --json a \"stats\"\n"
 	"                          object in each image's line; the first image's also gives\n"
-	"                          the untimed warm-up detection run before it (warm_up_ms)\n"
+	"                          the untimed warm-up detection run before it (warm_up_ms);\n"
+	"                          bytes_read: what the front end read of the frame,\n"
+	"                          whole_frame: whether all of it was searched (track)\n"
 	"      --list FILE         images to process, one path per line (a regular file of\n"
 	"                          at most 64 MiB and 1000000 images)\n"
 	"      --out FILE          JSON lines output, one per listed image, in order; a\n"
@@ -75,6 +81,9 @@ const char kUsageTail[] =
 	"      --marker-size M     the markers' side in metres (the black border's outside)\n"
 	"      --marker-sizes SPEC  sides of some ids, \"0:0.05,7:0.1\"; the others\n"
 	"                          --marker-size's, or no pose\n"
+	"      --bundle FILE       one pose from every marker of a rigid set: apriltag_ros's\n"
+	"                          tags.yaml (tag_bundles) or a grid board (board: grid, rows,\n"
+	"                          cols, size, gap, first_id); its sizes need no --marker-size\n"
 	"\n"
 	"Images are read one at a time and refused, with an error line, when larger\n"
 	"than --max-pixels (read from the header, before decoding) or cut short.\n"
@@ -135,9 +144,10 @@ struct Options {
 	std::string list, out, annotate, backend = "auto";
 	int repeat = 1;
 	bool json = false, stats = false;
-	/* Pose: a camera and the sizes, or neither. */
+	/* Pose: a camera and the sizes (or a bundle), or neither. */
 	std::optional<frappe::Camera> camera;
 	frappe::MarkerSizes sizes;
+	std::optional<frappe::Bundle> bundle;
 };
 
 [[noreturn]] void usageError(const std::string &msg)
@@ -204,8 +214,15 @@ void useDictionary(Options &o, const std::string &name)
 
 /* The pose options, checked together once all are read. */
 void usePose(Options &o, const std::string &calibration, const std::string &camera, double size,
-	     const std::string &sizes)
+	     const std::string &sizes, const std::string &bundle)
 {
+	if (!bundle.empty()) {
+		try {
+			o.bundle = frappe::loadBundle(bundle);
+		} catch (const std::exception &e) {
+			usageError(std::string("--bundle: ") + e.what());
+		}
+	}
 	if (!calibration.empty() && !camera.empty())
 		usageError("--calibration and --camera: give one camera");
 	if (!calibration.empty()) {
@@ -226,8 +243,10 @@ void usePose(Options &o, const std::string &calibration, const std::string &came
 	} catch (const std::exception &e) {
 		usageError(std::string("--marker-sizes: ") + e.what());
 	}
-	if (o.camera && !o.sizes.any())
-		usageError("a camera without marker sizes: add --marker-size M (metres) or --marker-sizes");
+	if (o.camera && !o.sizes.any() && !o.bundle)
+		usageError("a camera without marker sizes: add --marker-size M (metres), --marker-sizes or --bundle");
+	if (!o.camera && o.bundle)
+		usageError("a bundle without a camera: add --calibration FILE or --camera fx,fy,cx,cy");
 	if (!o.camera && o.sizes.any())
 		usageError("marker sizes without a camera: add --calibration FILE or --camera fx,fy,cx,cy");
 }
@@ -244,7 +263,7 @@ const frappe::Setting *cliSetting(const std::string &name)
 Options parse(int argc, char **argv)
 {
 	Options o;
-	std::string calibration, camera, sizes;
+	std::string calibration, camera, sizes, bundle;
 	double size = 0.0;
 	for (int i = 1; i < argc; ++i) {
 		const std::string a = argv[i];
@@ -261,7 +280,11 @@ Options parse(int argc, char **argv)
 			std::exit(0);
 		} else if (a == "--dictionaries") {
 			for (const auto &d : frappe::dictionaries())
-				std::cout << d.name << "  (" << d.bits << "x" << d.bits << ", " << d.size()
+				std::cout << d.name << "  ("
+					  << (d.layout ? std::to_string(d.codeBits()) + " bits in a layout of " +
+								 std::to_string(d.layout->size) + "x" + std::to_string(d.layout->size) + " cells"
+						       : std::to_string(d.bits) + "x" + std::to_string(d.bits))
+					  << ", " << d.size()
 					  << " ids, min distance " << d.min_hamming << ", corrects "
 					  << d.defaultMaxHamming() << ", " << d.weakMaxHamming() << " with weak cells)\n";
 			std::exit(0);
@@ -281,6 +304,10 @@ Options parse(int argc, char **argv)
 				usageError("--marker-size must be a side in metres above 0, got " + std::string(argv[i]));
 		} else if (a == "--marker-sizes") {
 			sizes = value();
+		} else if (a == "--bundle") {
+			bundle = value();
+			if (bundle.empty())
+				usageError("--bundle needs a file");
 		} else if (a == "--backend") {
 			o.backend = value();
 			const auto names = frappe::backendNames();
@@ -315,7 +342,7 @@ Options parse(int argc, char **argv)
 			o.images.push_back(a);
 		}
 	}
-	usePose(o, calibration, camera, size, sizes);
+	usePose(o, calibration, camera, size, sizes, bundle);
 	if (!o.list.empty())
 		readList(o.list, o.images);
 	if (o.images.empty())
@@ -330,8 +357,27 @@ using frappe::cli::jsonEscape;
 /* What a line may carry beyond the contract's fields. */
 struct LineExtras {
 	const std::vector<std::optional<frappe::MarkerPose>> *poses = nullptr; /* one per marker */
+	const frappe::Bundle *bundle = nullptr; /* with its pose, when one was found */
+	const std::optional<frappe::BundlePose> *bundlePose = nullptr;
 	std::string stats; /* `"stats": {...}`, or empty */
+	bool tracking = false; /* Mode::Track: each marker says whether it was tracked */
 };
+
+/* The bundle's pose: `{"name": .., "rvec": .., "tvec": .., "pose_error": ..,
+ * "used": [ids], "rejected": [ids]}`, or null when none. */
+std::string bundleJson(const frappe::Bundle &b, const std::optional<frappe::BundlePose> &p)
+{
+	if (!p)
+		return "null";
+	auto ids = [](const std::vector<int> &v) {
+		std::string s = "[";
+		for (std::size_t i = 0; i < v.size(); ++i)
+			s += (i ? ", " : "") + std::to_string(v[i]);
+		return s + "]";
+	};
+	return "{\"name\": \"" + jsonEscape(b.name) + "\"" + frappe::cli::poseJson(p->pose) + ", \"used\": " + ids(p->used) +
+	       ", \"rejected\": " + ids(p->rejected) + "}";
+}
 
 /* A line of the benchmarks' format: the image, its markers as the
  * library's one writer makes them (frappe/marker_record.h), the time. */
@@ -346,12 +392,15 @@ std::string jsonLine(const std::string &image, const std::vector<Marker> &marker
 		const frappe::MarkerPose *pose = extras.poses && (*extras.poses)[i] ? &*(*extras.poses)[i] : nullptr;
 		if (i)
 			o += ", ";
-		frappe::appendMarkerJson(o, { &markers[i], dictionary, pose }, frappe::JsonNumbers::Rounded);
+		frappe::appendMarkerJson(o, { &markers[i], dictionary, pose, extras.tracking },
+					 frappe::JsonNumbers::Rounded);
 	}
 	char buf[64];
 	std::snprintf(buf, sizeof(buf), "%.4f", ms);
 	o += "], \"time_ms\": ";
 	o += buf;
+	if (extras.bundle)
+		o += ", \"bundle\": " + bundleJson(*extras.bundle, *extras.bundlePose);
 	if (!extras.stats.empty())
 		o += ", " + extras.stats;
 	return o + "}";
@@ -359,7 +408,7 @@ std::string jsonLine(const std::string &image, const std::vector<Marker> &marker
 
 /* The per-stage times as a JSON member; the warm-up's wall time when one
  * ran before this image (below 0: none). */
-std::string statsJson(const frappe::StageTimes &times, double warmUpMs)
+std::string statsJson(const frappe::StageTimes &times, double warmUpMs, std::size_t bytesRead, bool wholeFrame)
 {
 	std::ostringstream o;
 	char buf[32];
@@ -370,6 +419,8 @@ std::string statsJson(const frappe::StageTimes &times, double warmUpMs)
 	}
 	std::snprintf(buf, sizeof(buf), "%.4f", times.total_ms);
 	o << ", \"total_ms\": " << buf;
+	/* What the front end read of the frame: all of it, or Track's regions. */
+	o << ", \"bytes_read\": " << bytesRead << ", \"whole_frame\": " << (wholeFrame ? "true" : "false");
 	if (warmUpMs >= 0.0) {
 		std::snprintf(buf, sizeof(buf), "%.4f", warmUpMs);
 		o << ", \"warm_up_ms\": " << buf;
@@ -384,11 +435,14 @@ struct Frame {
 	std::string error;
 	std::vector<Marker> markers;
 	frappe::StageTimes times;
+	std::size_t bytes_read = 0; /* the last repetition's Result::bytes_read */
+	bool whole_frame = true;
 	std::vector<double> times_ms; /* one per repeat */
 	int in_flight = 0;            /* pushes whose result has not come back */
 	bool all_pushed = false;
 	double warm_up_ms = -1.0;     /* the untimed warm-up run on it, when one was */
 	std::vector<std::optional<frappe::MarkerPose>> poses; /* one per marker, with a camera */
+	std::optional<frappe::BundlePose> bundlePose; /* with --bundle */
 };
 
 /* Reads, checks and decodes one image into f.gray, or sets f.error. The
@@ -598,6 +652,8 @@ private:
 		f.times_ms.push_back(serial_ ? wallMs : res.times.total_ms);
 		f.markers = res.markers; /* the last repetition's */
 		f.times = res.times;
+		f.bytes_read = res.bytes_read;
+		f.whole_frame = res.whole_frame;
 		++detected_;
 	}
 
@@ -637,7 +693,10 @@ private:
 			std::cerr << "frappe-detect: " << f.error << "\n";
 			return;
 		}
-		f.poses = frappe::cli::markerPoses(f.markers, opt_.sizes, *camera);
+		if (opt_.sizes.any())
+			f.poses = frappe::cli::markerPoses(f.markers, opt_.sizes, *camera);
+		if (opt_.bundle)
+			f.bundlePose = frappe::estimateBundlePose(*opt_.bundle, f.markers, *camera);
 	}
 
 	void write(Frame &f)
@@ -648,8 +707,13 @@ private:
 			++failed_;
 		const double ms = f.error.empty() && !f.times_ms.empty() ? median(f.times_ms) : 0.0;
 		LineExtras extras;
+		extras.tracking = opt_.config.mode == frappe::Mode::Track;
 		if (!f.poses.empty())
 			extras.poses = &f.poses;
+		if (opt_.bundle && f.error.empty()) {
+			extras.bundle = &*opt_.bundle;
+			extras.bundlePose = &f.bundlePose;
+		}
 		if (out_) {
 			/* The contract's line, with the poses when asked for. */
 			const std::string line = jsonLine(f.path, f.markers, dictionary(), ms, f.error, extras) + "\n";
@@ -660,7 +724,7 @@ private:
 		if (opt_.json) {
 			/* The stats inside the line: every line stays one JSON object. */
 			if (opt_.stats && f.error.empty())
-				extras.stats = statsJson(f.times, f.warm_up_ms);
+				extras.stats = statsJson(f.times, f.warm_up_ms, f.bytes_read, f.whole_frame);
 			std::cout << jsonLine(f.path, f.markers, dictionary(), ms, f.error, extras) << "\n";
 		} else if (f.error.empty() && opt_.out.empty()) {
 			std::printf("%s: %zu marker%s (%s) in %.2f ms\n", f.path.c_str(), f.markers.size(),
@@ -675,6 +739,12 @@ private:
 				if (!f.poses.empty() && f.poses[i])
 					std::printf("           %s\n", frappe::cli::poseText(f.poses[i]->pose).c_str());
 			}
+			if (f.bundlePose)
+				std::printf("  bundle %s: %zu markers used, %zu rejected  %s\n", opt_.bundle->name.c_str(),
+					    f.bundlePose->used.size(), f.bundlePose->rejected.size(),
+					    frappe::cli::poseText(f.bundlePose->pose).c_str());
+			else if (opt_.bundle)
+				std::printf("  bundle %s: no pose\n", opt_.bundle->name.c_str());
 			if (opt_.stats) {
 				std::printf("  stages:");
 				for (int s = 0; s < frappe::kStageCount; ++s)
@@ -734,7 +804,23 @@ private:
 
 int main(int argc, char **argv)
 {
+#if defined(__GLIBC__)
+	/* Each image's file and decoded frame are freed before the next of the
+	 * same size is allocated. Under glibc's defaults a frame of 300 KB is
+	 * mmap'ed and unmapped each time, and the top of the heap given back
+	 * and taken again: page faults on every image, 3-4x the time of the
+	 * detection itself on a list of small images. Kept, the same pages
+	 * serve every image. (The values of the GLIBC_TUNABLES the peers are
+	 * timed with: trim at 256 MiB, mmap from 32 MiB.) */
+	mallopt(M_MMAP_THRESHOLD, 32 << 20);
+	mallopt(M_TRIM_THRESHOLD, 256 << 20);
+#endif
 	Options opt = parse(argc, argv);
+	if (opt.config.mode == frappe::Mode::Track && opt.config.threads != 1) {
+		/* Frames on several detectors would each see a part of the video. */
+		std::cerr << "frappe-detect: --mode track follows one video on one detector; using --threads 1\n";
+		opt.config.threads = 1;
+	}
 
 	/* Opened before the run: a path that cannot be written fails now, not
 	 * after an hour of detection. */
@@ -754,8 +840,9 @@ int main(int argc, char **argv)
 		std::cerr << "frappe-detect: " << e.what() << "\n";
 		return 2;
 	}
-	if (opt.config.mode == frappe::Mode::AScale && opt.repeat > 1) {
-		std::cerr << "frappe-detect: --mode ascale treats the list as a video; using --repeat 1\n";
+	if (opt.config.mode != frappe::Mode::Normal && opt.repeat > 1) {
+		std::cerr << "frappe-detect: --mode " << (opt.config.mode == frappe::Mode::AScale ? "ascale" : "track")
+			  << " treats the list as a video; using --repeat 1\n";
 		opt.repeat = 1;
 	}
 

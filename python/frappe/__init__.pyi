@@ -4,7 +4,7 @@
 from __future__ import annotations
 
 from os import PathLike
-from typing import Any, Dict, List, Optional, Sequence, Union
+from typing import Any, Dict, Iterable, List, Optional, Sequence, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -58,6 +58,9 @@ class Marker:
     @property
     def dictionary(self) -> str: ...
     @property
+    def tracked(self) -> bool:
+        """mode="track": found where the last frames predicted it."""
+    @property
     def center(self) -> npt.NDArray[np.float64]: ...
 
 class Detector:
@@ -73,6 +76,7 @@ class Detector:
         weak_margin: float = 0.3,
         scaled_size: float = 28.0,
         max_scaled_frames: int = 5,
+        track_cover_frames: int = 4,
         region_contrast: float = 0.16,
         light_floor: float = 0.063,
         corner_cluster_radius: float = 4.0,
@@ -165,3 +169,27 @@ def project_points(
 def undistort_points(
     points: ArrayLike, camera_matrix: CameraMatrix, dist_coeffs: Optional[ArrayLike] = None
 ) -> npt.NDArray[np.float32]: ...
+
+class Bundle:
+    """A rigid set of markers with known corners (issue 32)."""
+    @staticmethod
+    def grid(rows: int, cols: int, size: float, gap: float, first_id: int = 0) -> Bundle: ...
+    @property
+    def name(self) -> str: ...
+    @property
+    def ids(self) -> List[int]: ...
+    def corners(self, id: int) -> npt.NDArray[np.float64]: ...
+    def __len__(self) -> int: ...
+
+class BundlePose:
+    @property
+    def pose(self) -> Pose: ...
+    @property
+    def used(self) -> List[int]: ...
+    @property
+    def rejected(self) -> List[int]: ...
+
+def load_bundle(path: Union[str, bytes, PathLike[str], PathLike[bytes]]) -> Bundle: ...
+def estimate_bundle_pose(
+    bundle: Bundle, markers: Iterable[Marker], camera_matrix: CameraMatrix, dist_coeffs: Optional[ArrayLike] = None
+) -> Optional[BundlePose]: ...

@@ -83,6 +83,8 @@ private:
 		int candidates = 0;
 		int candidates_dropped = 0;
 		bool copied = false;
+		std::size_t bytes_read = 0;
+		bool whole_frame = true;
 	} last_;
 };
 
@@ -122,13 +124,14 @@ py::list PyDetector::detect(py::handle obj)
 			view = ImageView(buffer_.data(), view.width, view.height, view.width);
 		}
 		result = &detector_.detect(view);
-		last_ = { result->times, result->scale, result->candidates, result->candidates_dropped, !direct };
+		last_ = { result->times,	   result->scale,      result->candidates, result->candidates_dropped,
+			  !direct, result->bytes_read, result->whole_frame };
 	}
 
 	py::list markers(result->markers.size());
 	for (std::size_t i = 0; i < result->markers.size(); ++i) {
 		const frappe::Marker &m = result->markers[i];
-		Marker out{ m.id, newFloatArray(4, 2), m.hamming, m.margin, std::string(dict_.dict->name) };
+		Marker out{ m.id, newFloatArray(4, 2), m.hamming, m.margin, std::string(dict_.dict->name), m.tracked };
 		float *c = out.corners.mutable_data();
 		for (int k = 0; k < 4; ++k) {
 			c[2 * k] = m.corners[k].x;
@@ -157,6 +160,8 @@ py::dict PyDetector::stats()
 	out["candidates"] = last.candidates;
 	out["candidates_dropped"] = last.candidates_dropped;
 	out["input_copied"] = last.copied;
+	out["bytes_read"] = last.bytes_read;
+	out["whole_frame"] = last.whole_frame;
 	return out;
 }
 
@@ -277,7 +282,8 @@ dictionary or a value out of range ValueError saying which.
 
 One detector detects one frame at a time: calls from several threads take
 turns (the GIL is released while detecting). Use one detector per thread to
-detect in parallel; with mode='ascale' one detector per video stream.)doc")
+detect in parallel; with mode='ascale' or 'track' one detector per video
+stream, its frames in order.)doc")
 		.def(py::init(&makeDetector), py::arg("dictionary") = d.dictionary)
 		.def("detect", &PyDetector::detect, py::arg("image"), R"doc(
 The markers in `image`, a 2-D uint8 numpy array (height, width) of grey
@@ -287,12 +293,15 @@ into a buffer the detector keeps. A colour image raises ValueError (convert
 it to grey first: cv2.cvtColor(image, cv2.COLOR_BGR2GRAY), or read it with
 cv2.IMREAD_GRAYSCALE as frappe-detect does), another dtype TypeError, an image
 over max_pixels ValueError.)doc")
-		.def("reset", &PyDetector::reset, "Forgets what mode='ascale' learned from earlier frames.")
+		.def("reset", &PyDetector::reset, "Forgets what mode='ascale' or 'track' learned from earlier frames.")
 		.def_property_readonly("stats", &PyDetector::stats, R"doc(
 The last detect() call: {'times_ms': {stage: ms, ..., 'total': ms},
 'scale': the resolution traced at, 'candidates': outlines decoded,
 'candidates_dropped': outlines beyond max_candidates left unread,
-'input_copied': whether the image was copied (its rows not contiguous)}.)doc")
+'input_copied': whether the image was copied (its rows not contiguous),
+'bytes_read': bytes of the frame the front end read (width x height, less
+in mode='track' on a frame read in regions), 'whole_frame': whether all of
+the frame was searched}.)doc")
 		.def_property_readonly("config", &PyDetector::configDict,
 				       "The keyword arguments it was made with: Detector(**d.config) makes another.")
 		.def_property_readonly("dictionary", &PyDetector::dictionary, "Its frappe.Dictionary.")

@@ -32,16 +32,22 @@ std::array<Point2f, 4> cornersArg(py::handle obj)
 
 namespace {
 
-Marker makeMarker(int id, py::handle corners, int hamming, float margin, std::string dictionary)
+Marker makeMarker(int id, py::handle corners, int hamming, float margin, std::string dictionary, bool tracked)
 {
 	const std::array<Point2f, 4> c = cornersArg(corners);
-	Marker m{ id, newFloatArray(4, 2), hamming, margin, std::move(dictionary) };
+	Marker m{ id, newFloatArray(4, 2), hamming, margin, std::move(dictionary), tracked };
 	float *out = m.corners.mutable_data();
 	for (int i = 0; i < 4; ++i) {
 		out[2 * i] = c[i].x;
 		out[2 * i + 1] = c[i].y;
 	}
 	return m;
+}
+
+/* frappe.Marker(...): made by hand, never tracked. */
+Marker newMarker(int id, py::handle corners, int hamming, float margin, std::string dictionary)
+{
+	return makeMarker(id, corners, hamming, margin, std::move(dictionary), false);
 }
 
 std::string repr(const Marker &m)
@@ -74,16 +80,19 @@ corners     (4, 2) float32 array, pixels: the outer corners of the black
 hamming     bits corrected to reach the code
 margin      how clearly the code was read, 0..1: filter on it to trade misses
             for certainty
+tracked     mode='track': found where the last frames predicted it (its corners
+            measured on this frame all the same); False when found afresh
 
 The fields are frappe::forEachMarkerField()'s (frappe.MARKER_FIELDS, the pose's
 aside: frappe.estimate_pose), as frappe-detect's and frappejson's JSON.)doc")
-		.def(py::init(&makeMarker), py::arg("id"), py::arg("corners"), py::arg("hamming") = 0,
+		.def(py::init(&newMarker), py::arg("id"), py::arg("corners"), py::arg("hamming") = 0,
 		     py::arg("margin") = 0.0f, py::arg("dictionary") = "")
 		.def_readonly("id", &Marker::id)
 		.def_readonly("corners", &Marker::corners)
 		.def_readonly("hamming", &Marker::hamming)
 		.def_readonly("margin", &Marker::margin)
 		.def_readonly("dictionary", &Marker::dictionary)
+		.def_readonly("tracked", &Marker::tracked)
 		.def_property_readonly(
 			"center",
 			[](const Marker &mk) {
@@ -98,14 +107,16 @@ aside: frappe.estimate_pose), as frappe-detect's and frappejson's JSON.)doc")
 		.def("__repr__", &repr)
 		.def(py::pickle(
 			[](const Marker &mk) {
-				return py::make_tuple(mk.id, mk.corners, mk.hamming, mk.margin, mk.dictionary);
+				return py::make_tuple(mk.id, mk.corners, mk.hamming, mk.margin, mk.dictionary,
+						      mk.tracked);
 			},
 			[](const py::tuple &t) {
-				/* 4: pickled before the dictionary was a field */
-				if (t.size() != 4 && t.size() != 5)
-					throw py::value_error("a pickled frappe.Marker has 5 fields");
+				/* 4: pickled before the dictionary was a field, 5: before tracked */
+				if (t.size() < 4 || t.size() > 6)
+					throw py::value_error("a pickled frappe.Marker has 6 fields");
 				return makeMarker(t[0].cast<int>(), t[1], t[2].cast<int>(), t[3].cast<float>(),
-						  t.size() == 5 ? t[4].cast<std::string>() : std::string());
+						  t.size() >= 5 ? t[4].cast<std::string>() : std::string(),
+						  t.size() == 6 && t[5].cast<bool>());
 			}));
 	/* The library's one list of a marker's output fields (pose ones last). */
 	py::tuple fields(markerFieldNames().size());

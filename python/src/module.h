@@ -39,6 +39,7 @@ struct Marker {
 	int hamming = 0;
 	float margin = 0.0f;
 	std::string dictionary; ///< the detector's dictionary's name
+	bool tracked = false;   ///< mode='track': found where the last frames predicted it
 };
 
 /// Four corners from a Marker, or an array-like of 8 numbers shaped (4, 2)

@@ -13,6 +13,7 @@
 
 #include <pybind11/stl.h>
 
+#include <frappe/bundle.h>
 #include <frappe/camera.h>
 #include <frappe/pose.h>
 
@@ -157,6 +158,30 @@ py::array_t<float> undistort(py::handle points, py::handle matrix, py::handle di
 	return pointsOut(undistortPoints(in, camera));
 }
 
+/// A bundle's pose: the pose, the ids used and rejected.
+struct PyBundlePose {
+	PyPose pose;
+	std::vector<int> used, rejected;
+};
+
+std::optional<PyBundlePose> estimateBundle(const Bundle &bundle, py::iterable markers, py::handle matrix,
+					   py::handle distortion)
+{
+	std::vector<frappe::Marker> seen;
+	for (py::handle obj : markers) {
+		const Marker &m = obj.cast<const Marker &>();
+		frappe::Marker f;
+		f.id = m.id;
+		f.corners = cornersArg(obj);
+		seen.push_back(f);
+	}
+	const Camera camera = cameraArg(matrix, distortion);
+	const auto bp = estimateBundlePose(bundle, seen, camera);
+	if (!bp)
+		return std::nullopt;
+	return PyBundlePose{ PyPose{ bp->pose, nullptr, INFINITY }, bp->used, bp->rejected };
+}
+
 } // namespace
 
 void bindPose(py::module_ &m)
@@ -285,6 +310,72 @@ the camera gives NaN. E.g. the axes to draw.)doc");
 	      py::arg("dist_coeffs") = py::none(), R"doc(
 Where (N, 2) pixel points would be under the same camera matrix without
 distortion (cv2.undistortPoints with P = K): (N, 2) float32.)doc");
+
+	py::class_<Bundle>(m, "Bundle", R"doc(
+A rigid set of markers with known corners (a board, apriltag_ros's bundle):
+frappe.load_bundle(path) or frappe.Bundle.grid(rows, cols, size, gap,
+first_id=0), for estimate_bundle_pose().)doc")
+		.def_static("grid", &Bundle::grid, py::arg("rows"), py::arg("cols"), py::arg("size"), py::arg("gap"),
+			    py::arg("first_id") = 0, R"doc(
+OpenCV's GridBoard: ids row-major from first_id at the top-left, the origin at
+the board's bottom-left corner, x right, y up, z out of the board.)doc")
+		.def_readonly("name", &Bundle::name)
+		.def_property_readonly(
+			"ids",
+			[](const Bundle &b) {
+				std::vector<int> ids;
+				for (const BundleMarker &mk : b.markers)
+					ids.push_back(mk.id);
+				return ids;
+			},
+			"The ids of its markers.")
+		.def(
+			"corners",
+			[](const Bundle &b, int id) {
+				const BundleMarker *mk = b.find(id);
+				if (!mk)
+					throw py::key_error("id " + std::to_string(id) + " is not in the bundle");
+				py::array_t<double> c({ 4, 3 });
+				for (int i = 0; i < 4; ++i)
+					std::copy(mk->corners[static_cast<std::size_t>(i)].begin(),
+						  mk->corners[static_cast<std::size_t>(i)].end(), c.mutable_data() + 3 * i);
+				return c;
+			},
+			py::arg("id"), "Marker id's four corners in the bundle's frame, (4, 3) float64.")
+		.def("__len__", [](const Bundle &b) { return b.markers.size(); });
+
+	m.def(
+		"load_bundle",
+		[](py::handle path) {
+			const std::string file = pathArg(path);
+			try {
+				return loadBundle(file);
+			} catch (const std::invalid_argument &) {
+				throw;
+			} catch (const std::runtime_error &e) {
+				raiseOSError(e);
+			}
+		},
+		py::arg("path"), R"doc(
+A bundle from apriltag_ros's tags.yaml (its first tag_bundles entry: id, size,
+x, y, z, qw, qx, qy, qz) or a grid board's file (board: grid, rows, cols,
+size, gap, first_id). Raises OSError when the file cannot be read, ValueError
+naming the file and line when it is no bundle.)doc");
+
+	py::class_<PyBundlePose>(m, "BundlePose", "One pose from every marker of a bundle seen.")
+		.def_property_readonly("pose", [](const PyBundlePose &p) { return p.pose; },
+				       "The bundle frame's pose (frappe.Pose; error: RMS over the corners used).")
+		.def_readonly("used", &PyBundlePose::used, "Ids whose corners made the pose.")
+		.def_readonly("rejected", &PyBundlePose::rejected,
+			      "Ids seen but left out: corners that disagree (a marker moved, a wrong read).");
+
+	m.def("estimate_bundle_pose", &estimateBundle, py::arg("bundle"), py::arg("markers"), py::arg("camera_matrix"),
+	      py::arg("dist_coeffs") = py::none(), R"doc(
+One pose from every marker of `bundle` among `markers` (frappe.Marker, as
+detect() gives them): each marker's poses as starting points, the one most
+agree with refined over every agreeing corner with the lens model, markers
+that still disagree rejected. A frappe.BundlePose, or None when no marker of
+the bundle gives a pose.)doc");
 }
 
 } // namespace frappe::python

@@ -98,9 +98,10 @@ void bindRender(py::module_ &m)
 	m.def("render_marker", &renderMarker, py::arg("dictionary"), py::arg("id"), py::arg("cell_px") = 10,
 	      py::arg("quiet_cells") = 1, R"doc(
 Marker `id` of `dictionary` (a name or a frappe.Dictionary), upright, as a
-square uint8 array (0 black, 255 white) of side (bits + 2 + 2 * quiet_cells)
-* cell_px: the code, its black border and a white quiet zone of quiet_cells
-cells. To print, or to paste into test scenes. Raises ValueError for an id
+square uint8 array (0 black, 255 white) of side (cells + 2 * quiet_cells)
+* cell_px, cells = bits + 2 (or a layout family's whole size, AprilTag 3's
+tagStandard41h12 and its kin): the code, its black border and a white quiet
+zone of quiet_cells cells. To print, or to paste into test scenes. Raises ValueError for an id
 not in the dictionary, cell_px < 1, quiet_cells outside 0..32768 or a side
 over 32768.)doc");
 

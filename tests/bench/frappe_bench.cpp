@@ -36,6 +36,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "frappe/frappe.h"
+#include "percentile.h"
 #include "frappe/render.h"
 #include "opencv_dictionary.h"
 
@@ -55,16 +56,7 @@ double ms(Clock::time_point a, Clock::time_point b)
 	return std::chrono::duration<double, std::milli>(b - a).count();
 }
 
-double percentile(std::vector<double> v, double p)
-{
-	if (v.empty())
-		return 0;
-	std::sort(v.begin(), v.end());
-	const double idx = p * static_cast<double>(v.size() - 1);
-	const std::size_t lo = static_cast<std::size_t>(idx);
-	const std::size_t hi = std::min(lo + 1, v.size() - 1);
-	return v[lo] + (idx - static_cast<double>(lo)) * (v[hi] - v[lo]);
-}
+using frappe::bench::percentile;
 
 
 void writeLine(std::ofstream &out, const std::string &image, const std::vector<int> &ids,

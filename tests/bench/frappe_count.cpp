@@ -11,12 +11,14 @@
 //
 //   frappe-count --list LIST.txt [--dictionary aruco_mip_36h12] [--max N]
 //                [--no-opencv] [--out-frappe F.jsonl] [--out-opencv O.jsonl]
-//                [--region-contrast C] [--mode normal|ascale]
+//                [--region-contrast C] [--mode normal|ascale|track]
 //
 // --region-contrast sets Config::region_contrast (0 turns the region map and
 // its candidates off), to measure what that path costs. --mode ascale runs
 // the list as one video in its order (each frame scaled from the markers of
-// the frames before it), for the Pi Zero model's ASCALE figures.
+// the frames before it), for the Pi Zero model's ASCALE figures; --mode
+// track likewise in Mode::Track, through Detector::detect() (which may run a
+// frame twice: a marker lost), its whole count in the front end's column.
 // frappe runs as Detector::detect() does, split into its two halves (the
 // library's internal detail::DetectorStages: the front end, then the back
 // end) with a marker between them; it links the static library. OpenCV gets the
@@ -172,7 +174,7 @@ int main(int argc, char **argv)
 	int maxImages = 0;
 	bool useOpencv = true;
 	float regionContrast = -1.0f; /* < 0: the Config default */
-	bool ascale = false;
+	std::string mode = "normal";
 	for (int i = 1; i < argc; ++i) {
 		const std::string a = argv[i];
 		auto value = [&]() -> std::string {
@@ -195,12 +197,12 @@ int main(int argc, char **argv)
 		else if (a == "--out-opencv")
 			outO = value();
 		else if (a == "--mode")
-			ascale = value() == "ascale";
+			mode = value();
 		else if (a == "--region-contrast")
 			regionContrast = std::stof(value());
 		else {
 			std::cerr << "usage: frappe-count --list L [--dictionary D] [--max N] [--no-opencv] "
-				     "[--out-frappe F] [--out-opencv O] [--region-contrast C] [--mode normal|ascale]\n";
+				     "[--out-frappe F] [--out-opencv O] [--region-contrast C] [--mode normal|ascale|track]\n";
 			return 2;
 		}
 	}
@@ -244,8 +246,14 @@ int main(int argc, char **argv)
 	frappe::Config cfg;
 	cfg.dictionary = dictName;
 	cfg.threads = 1;
-	if (ascale)
+	if (mode == "ascale")
 		cfg.mode = frappe::Mode::AScale;
+	else if (mode == "track")
+		cfg.mode = frappe::Mode::Track;
+	else if (mode != "normal") {
+		std::cerr << "frappe-count: --mode is normal, ascale or track, not " << mode << "\n";
+		return 2;
+	}
 	if (regionContrast >= 0.0f)
 		cfg.region_contrast = regionContrast;
 	frappe::Detector det(cfg);
@@ -283,10 +291,17 @@ int main(int argc, char **argv)
 		const Gray &g = images[k];
 		const frappe::ImageView view(g.pixels.data(), g.width, g.height);
 		armcount_mark_frappe_begin();
-		frappe::detail::DetectorStages::frontEnd(det, view, 0);
-		armcount_mark_frappe_front();
-		const frappe::Result &res = frappe::detail::DetectorStages::backEnd(det, view, 0);
+		const frappe::Result *r = nullptr;
+		if (cfg.mode == frappe::Mode::Track) {
+			r = &det.detect(view);
+			armcount_mark_frappe_front();
+		} else {
+			frappe::detail::DetectorStages::frontEnd(det, view, 0);
+			armcount_mark_frappe_front();
+			r = &frappe::detail::DetectorStages::backEnd(det, view, 0);
+		}
 		armcount_mark_frappe_back();
+		const frappe::Result &res = *r;
 		const int nf = static_cast<int>(res.markers.size());
 		if (fo.is_open()) {
 			std::vector<int> fid;

@@ -206,6 +206,75 @@ def pose(exe, sample, expected, tmp):
               '%s: exit 2, "%s"' % (' '.join(args), what))
 
 
+def track_mode(exe, sample, expected, tmp):
+    """--mode track over a list in frame order: each marker says whether it
+    was tracked, --stats says what the front end read; --threads and
+    --repeat fall back to one."""
+    listed = os.path.join(tmp, 'video.txt')
+    with open(listed, 'w') as f:
+        f.write((sample + '\n') * 4)
+    out = os.path.join(tmp, 'video.jsonl')
+    r = run(exe, '--mode', 'track', '--list', listed, '--out', out, '--json', '--stats', '--threads', '2',
+            '--repeat', '3')
+    check(r.returncode == 0, '--mode track: exit 0 (%s)' % text(r.stderr))
+    check('using --threads 1' in text(r.stderr) and 'using --repeat 1' in text(r.stderr),
+          '--mode track: one thread, one repetition, said on stderr')
+    lines = json_lines(r)
+    ids = sorted(m['id'] for m in expected['markers'])
+    check(len(lines) == 4 and all(sorted(m['id'] for m in l['markers']) == ids for l in lines),
+          '--mode track: every frame finds the sample\'s markers')
+    check(not any(m['tracked'] for m in lines[0]['markers'])
+          and all(m['tracked'] for l in lines[1:] for m in l['markers']),
+          '--mode track: found afresh on the first frame, tracked after')
+    w_h = lines[0]['stats']['bytes_read']
+    check(lines[0]['stats']['whole_frame'] and not lines[1]['stats']['whole_frame'],
+          '--mode track: the first frame whole, the next in regions')
+    check(all('"tracked"' in l for l in open(out)), '--out lines say "tracked" too')
+    normal = json_lines(run(exe, '--json', '--stats', sample))[0]
+    check('tracked' not in normal['markers'][0] and normal['stats']['bytes_read'] == w_h,
+          '--mode normal: no "tracked"; bytes_read is the frame\'s')
+    r = run(exe, '--mode', 'fast', sample)
+    check(r.returncode == 2 and 'normal, ascale or track' in text(r.stderr), '--mode fast: exit 2, the modes named')
+    r = run(exe, '--mode', 'track', '--track-cover-frames', '0', sample)
+    check(r.returncode != 0 and 'track_cover_frames' in text(r.stderr), '--track-cover-frames 0 is refused')
+
+
+def layouts_and_bundles(exe, render, tmp):
+    """Issue 32: a layout family rendered and read with its corners; a board
+    printed by frappe-render --board and its bundle file read back by
+    --bundle: one pose from all its markers, face on at the camera's
+    distance."""
+    tag = os.path.join(tmp, 'tag41.png')
+    check(run(render, '--dictionary', 'tagStandard41h12', '--id', '7', '--cell', '10', tag).returncode == 0,
+          'frappe-render draws a tagStandard41h12 marker')
+    r = run(exe, '--json', '--dictionary', 'tagStandard41h12', tag)
+    m = json_lines(r)[0]['markers']
+    # 11 x 11 cells of 10 px with the quiet cell; the found square is cells 3..8.
+    check(len(m) == 1 and m[0]['id'] == 7 and
+          max(abs(a - b) for p, q in zip(m[0]['corners'], [[29.5, 29.5], [79.5, 29.5], [79.5, 79.5], [29.5, 79.5]])
+              for a, b in zip(p, q)) < 0.1,
+          'tagStandard41h12 id 7 read with the found square\'s corners: %s' % m)
+    board = os.path.join(tmp, 'board.png')
+    check(run(render, '--board', '3x4', '--cell', '8', '--first-id', '5', '--marker-size', '0.08', board).returncode == 0,
+          'frappe-render --board writes a board and its bundle file')
+    bundle = os.path.join(tmp, 'board.yaml')
+    # Squares of 64 px for 8 cm: a focal length of 800 px puts the board 1 m away, face on.
+    r = run(exe, '--json', '--camera', '800,800,167.5,127.5', '--bundle', bundle, board)
+    line = json_lines(r)[0]
+    b = line.get('bundle')
+    check(r.returncode == 0 and len(line['markers']) == 12 and b and b['used'] == list(range(5, 17))
+          and b['rejected'] == [], '--bundle: one pose from the 12 markers: %s' % b)
+    check(abs(b['tvec'][2] - 1.0) < 0.01 and b['pose_error'] < 0.5,
+          '--bundle: the board 1 m away (%.4f m), reprojected within %.3f px' % (b['tvec'][2], b['pose_error']))
+    r = run(exe, '--bundle', bundle, board)
+    check(r.returncode == 2 and 'a bundle without a camera' in text(r.stderr), '--bundle without a camera: exit 2')
+    bad = os.path.join(tmp, 'bad.yaml')
+    with open(bad, 'w') as f:
+        f.write('board: hexagon\n')
+    r = run(exe, '--camera', '800,800,167.5,127.5', '--bundle', bad, board)
+    check(r.returncode == 2 and "board: 'hexagon' is not a known board" in text(r.stderr), '--bundle FILE of no bundle: exit 2')
+
+
 def main():
     exe, render = sys.argv[1], sys.argv[2]
     sample = os.path.join(SAMPLES, 'markers-36h12.png')
@@ -217,6 +286,8 @@ def main():
         standard_input(exe, sample)
         dictionary_files(exe, render, sample, expected, tmp)
         pose(exe, sample, expected, tmp)
+        track_mode(exe, sample, expected, tmp)
+        layouts_and_bundles(exe, render, tmp)
     return 0
 
 

@@ -64,17 +64,18 @@ SETS = {
 # without a false positive. EXPOSURE_ENFORCED holds, per subset, the points
 # enforced where the target is not met yet (a missing entry: the target).
 EXPOSURE_POINTS = {0.3: 3, 0.15: 10, 2.0: 3}
-# Not met yet: at 200% light small blurred markers' black cells, lifted over
-# the midpoint of the clipped range, read white (docs/quality.md, hard
-# light); the lighting subsets, already dim or clipped, darkened or
+# Not met yet: at 200% light small blurred markers lose their black cells
+# to the ceiling (their blur lifts them to within a few grey levels of it;
+# the read on the exponential scale, docs/quality.md, takes back half of
+# what was lost); the lighting subsets, already dim or clipped, darkened or
 # brightened again.
 EXPOSURE_ENFORCED = {
-    ('synth/images', 2.0): 7, ('synth/apriltag36h11', 2.0): 6, ('synth/blur', 2.0): 16,
-    ('synth/blur-apriltag36h11', 2.0): 14, ('synth/4x4_50', 2.0): 14, ('synth/6x6_250', 2.0): 9,
-    ('synth/apriltag_16h5', 2.0): 12,
-    ('synth/lighting', 0.15): 34, ('synth/lighting', 0.3): 14, ('synth/lighting', 2.0): 8,
+    ('synth/images', 2.0): 4, ('synth/blur', 2.0): 12,
+    ('synth/blur-apriltag36h11', 2.0): 12, ('synth/4x4_50', 2.0): 6, ('synth/6x6_250', 2.0): 7,
+    ('synth/apriltag_16h5', 2.0): 6,
+    ('synth/lighting', 0.15): 34, ('synth/lighting', 0.3): 14, ('synth/lighting', 2.0): 6,
     ('synth/lighting-apriltag36h11', 0.15): 29, ('synth/lighting-apriltag36h11', 0.3): 14,
-    ('synth/lighting-apriltag36h11', 2.0): 12,
+    ('synth/lighting-apriltag36h11', 2.0): 9,
 }
 # False positives allowed where the target of none is not met yet: a 15 px
 # marker of synth/images read as another id at 30% (hamming 5, margin 0.03).
@@ -102,6 +103,9 @@ WRONG_IDS_PER_300 = {
     '7x7_50': (1, 1), '7x7_100': (1, 1), '7x7_250': (1, 1), '7x7_1000': (1, 1),
     'apriltag_16h5': (1, 1), 'apriltag_25h9': (1, 1), 'apriltag_36h10': (1, 1),
     'apriltag_36h11': (1, 1), 'aruco_mip_36h12': (1, 1), 'aruco_original': (1, 1),
+    # AprilTag 3's layout families (issue 32): none over any subset, measured.
+    'apriltag_standard41h12': (0, 0), 'apriltag_standard52h13': (0, 0), 'apriltag_circle21h7': (0, 0),
+    'apriltag_circle49h12': (0, 0), 'apriltag_custom48h12': (0, 0),
 }
 
 # Any resolution: each subset upsampled 2x and 3x, bilinear and nearest,
@@ -129,6 +133,20 @@ RESOLUTION = {
 
 def at_target():
     return os.environ.get('FRAPPE_DATA_FLOORS', '') == 'target'
+
+
+# Mode::Track against Mode::Normal on the same sequence, same run (issue 35):
+# how far below NORMAL's sensitivity tracking may fall, how many more false
+# positives and dropouts (the scorer's) it may have, and how many frames after
+# NORMAL first finds a marker tracking may find it (k - 1, k =
+# track_cover_frames' default of 4). Speed is measured, not asserted
+# (docs/tracking.md).
+TRACK = {
+    'sens_below_normal': (0.005, 0.005),
+    'fp_above_normal': (0, 0),
+    'dropouts_above_normal': (0, 0),
+    'frames_late': (3, 3),
+}
 
 
 def enforced(limit):

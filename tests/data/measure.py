@@ -106,10 +106,11 @@ def scaled_truth(sub, scale, path):
     return path
 
 
-def run_detect(detect, sub, dictionary, out, workdir):
-    """frappe-detect at defaults, single thread: the contract's command."""
+def run_detect(detect, sub, dictionary, out, workdir, extra=()):
+    """frappe-detect at defaults, single thread: the contract's command
+    (with `extra` options, e.g. a mode)."""
     lst = write_list(sub, os.path.join(workdir, sub.name.replace('/', '-') + '.txt'))
-    subprocess.run([detect, '--dictionary', dictionary, '--list', lst, '--out', out, '--threads', '1'],
+    subprocess.run([detect, '--dictionary', dictionary, '--list', lst, '--out', out, '--threads', '1'] + list(extra),
                    check=True)
     return out
 

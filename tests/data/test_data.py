@@ -5,11 +5,13 @@ usage: test_data.py FRAPPE_DETECT FRAPPE_SWEEP SHARED_DIR CHECK
 
 CHECK is a synthetic subset (synth/images, synth/blur, ...: frappe-detect with
 the subset's dictionary), real (the photographs), wrong-ids (every built-in
-dictionary over the other families' subsets), resolution (every subset
+dictionary over the other families' subsets), track (Mode::Track against
+Mode::Normal on the sequences), resolution (every subset
 upsampled 2x and 3x) or exposure (every subset darkened and brightened). Each check prints its measurement, the enforced floor
 and the issue's target. Exits 77 (skipped) when the shared folder is absent,
 as on a user's machine. Scoring is ../shared/tools/eval.py's (needs numpy).
 """
+import math
 import os
 import sys
 import tempfile
@@ -122,6 +124,54 @@ def check_exposure(report, name, results):
                        (floors.EXPOSURE_FP_ENFORCED.get((name, g), 0), 0), fmt='%d')
 
 
+def first_found(sub, dets):
+    """Per truth marker id, per episode of frames it is visible in a row
+    (frame order = the truth's), the first frame a detection matches it
+    (the scorer's rule: same id, mean corner distance under max(3 px, 10%
+    of its side)), or None."""
+    by_image = {os.path.basename(d['image']): d['markers'] for d in measure.load_jsonl(dets)}
+    episodes = {}  # (id, first visible frame) -> first found frame
+    visible = {}   # id -> first frame of its current episode
+    for f, rec in enumerate(sub.records):
+        found = by_image.get(os.path.basename(rec['image']), [])
+        now = {}
+        for t in rec['markers']:
+            start = visible.get(t['id'], f)
+            now[t['id']] = start
+            hit = any(m['id'] == t['id'] and sum(math.dist(a, b) for a, b in zip(m['corners'], t['corners'])) / 4
+                      < max(3.0, 0.1 * t['side_px']) for m in found)
+            key = (t['id'], start)
+            if key not in episodes:
+                episodes[key] = None
+            if hit and episodes[key] is None:
+                episodes[key] = f
+        visible = now
+    return episodes
+
+
+def check_track(report, name, sub, normal_res, track_res, normal_dets, track_dets):
+    t = floors.TRACK
+    report.at_least(name + ' track sensitivity', track_res['sensitivity'],
+                    (normal_res['sensitivity'] - floors.enforced(t['sens_below_normal']),
+                     normal_res['sensitivity'] - t['sens_below_normal'][1]),
+                    '%.4f (normal %.4f)' % (track_res['sensitivity'], normal_res['sensitivity']))
+    report.at_most(name + ' track false positives beyond normal', track_res['fp'] - normal_res['fp'],
+                   t['fp_above_normal'], '%+d (%d, normal %d)' % (track_res['fp'] - normal_res['fp'], track_res['fp'], normal_res['fp']),
+                   fmt='%d')
+    report.at_most(name + ' track dropouts beyond normal', track_res['seq_dropouts'] - normal_res['seq_dropouts'],
+                   t['dropouts_above_normal'],
+                   '%+d (%d, normal %d)' % (track_res['seq_dropouts'] - normal_res['seq_dropouts'],
+                                            track_res['seq_dropouts'], normal_res['seq_dropouts']), fmt='%d')
+    n, k = first_found(sub, normal_dets), first_found(sub, track_dets)
+    late = 0
+    for key, f in n.items():
+        if f is not None:
+            late = max(late, (k[key] if k[key] is not None else len(sub.records)) - f)
+    report.at_most(name + ' track frames after normal to find a marker', late, t['frames_late'], fmt='%d')
+    print('%s: normal median %.3f ms, track median %.3f ms (a busy machine\'s; not asserted)'
+          % (name, normal_res['time_ms_median'], track_res['time_ms_median']))
+
+
 def measure_wrong_ids(sweep, scorer, codebook, subsets, dictionaries, tmp):
     """{(dictionary, subset name): WrongIds} for every dictionary but each
     subset's own."""
@@ -150,6 +200,15 @@ def main():
             res = measure.score(scorer, sub.truth, dets)
             print(scorer.fmt(res))
             check_set(report, check, res)
+        elif check == 'track':
+            # Mode::Track against Mode::Normal on the sequences, same run.
+            for name in ('synth/seq01', 'synth/seq02'):
+                sub = measure.subset(shared, name)
+                normal = measure.run_detect(detect, sub, sub.dictionary, os.path.join(tmp, 'normal.jsonl'), tmp)
+                track = measure.run_detect(detect, sub, sub.dictionary, os.path.join(tmp, 'track.jsonl'), tmp,
+                                           ['--mode', 'track'])
+                check_track(report, name, sub, measure.score(scorer, sub.truth, normal),
+                            measure.score(scorer, sub.truth, track), normal, track)
         elif check == 'real':
             for sub in measure.real_subsets(shared):
                 dets = measure.run_detect(detect, sub, sub.dictionary, os.path.join(tmp, 'dets.jsonl'), tmp)

@@ -76,7 +76,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t *data, std::size_t size
 	if (found && frappe::findDictionary(found->name) != found)
 		std::abort(); /* a dictionary's own name finds it */
 
-	c.mode = (in.get<std::uint8_t>() & 1) != 0 ? frappe::Mode::AScale : frappe::Mode::Normal;
+	static constexpr frappe::Mode kModes[] = { frappe::Mode::Normal, frappe::Mode::AScale, frappe::Mode::Track };
+	c.mode = kModes[in.get<std::uint8_t>() % 3];
 	/* Every number of the settings table, from its default (Config{}'s):
 	 * a new setting is fuzzed without a line here. */
 	for (const frappe::Setting &s : frappe::settings()) {

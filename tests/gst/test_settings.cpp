@@ -88,7 +88,7 @@ TEST(Settings, DetectorPropertiesAreTheTable)
 			s.setNumber(lo, specEnd(p, false));
 			s.setNumber(hi, specEnd(p, true));
 			if (s.name == "max_hamming")
-				hi.dictionary = "7x7_1000"; /* the widest dictionary's most */
+				hi.dictionary = "apriltag_standard52h13"; /* the widest dictionary's most */
 			EXPECT_TRUE(accepted([&](frappe::Config &c) { c = lo; })) << specEnd(p, false);
 			if (std::isfinite(s.max)) {
 				EXPECT_TRUE(accepted([&](frappe::Config &c) { c = hi; })) << specEnd(p, true);

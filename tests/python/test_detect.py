@@ -210,3 +210,26 @@ def test_settings_are_the_keywords():
     assert frappe.Detector(**kwargs).config == cfg
     with pytest.raises(TypeError, match="unexpected keyword argument 'edge-threshold'"):
         frappe.Detector(**{"edge-threshold": 0.3})
+
+
+def test_track_mode_reports_tracked_markers_and_reads_less(scene):
+    image, truth = scene
+    det = frappe.Detector(mode="track", track_cover_frames=3)
+    assert det.config["mode"] == "track" and det.config["track_cover_frames"] == 3
+    first = det.detect(image)
+    assert sorted(m.id for m in first) == sorted(truth)
+    assert not any(m.tracked for m in first)
+    assert det.stats["whole_frame"] and det.stats["bytes_read"] == image.size
+    second = det.detect(image)
+    assert sorted(m.id for m in second) == sorted(truth)
+    assert all(m.tracked for m in second)
+    for m in second:
+        assert np.abs(m.corners - np.asarray(truth[m.id], np.float32)).mean() < 0.5
+    s = det.stats
+    # the frame once for the region map, the regions' edges less than it again
+    assert not s["whole_frame"] and image.size < s["bytes_read"] < 2 * image.size
+    det.reset()
+    det.detect(image)
+    assert det.stats["whole_frame"]
+    with pytest.raises(ValueError, match="track_cover_frames"):
+        frappe.Detector(mode="track", track_cover_frames=0)

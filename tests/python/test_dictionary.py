@@ -10,8 +10,11 @@ from conftest import ROOT, check_file_errors, render_scene
 
 def test_names_and_lookup():
     names = frappe.dictionaries()
-    assert len(names) == 22
+    assert len(names) == 27
     assert {"aruco_mip_36h12", "apriltag_36h11", "6x6_250", "4x4_50", "apriltag_16h5"} <= set(names)
+    # AprilTag 3's layout families (issue 32), by their own names too
+    assert frappe.get_dictionary("tagStandard41h12").name == "apriltag_standard41h12"
+    assert frappe.get_dictionary("apriltag_circle49h12").size == 65535
     d = frappe.get_dictionary("DICT_APRILTAG_36h11")
     assert (d.name, d.bits, d.size, len(d), d.min_hamming, d.builtin) == ("apriltag_36h11", 6, 587, 587, 11, True)
     assert frappe.get_dictionary("tag36h11") == d

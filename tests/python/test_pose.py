@@ -184,3 +184,31 @@ def test_sample_calibrations(tmp_path):
         pose = frappe.estimate_pose(corners, 0.05, cam)
         np.testing.assert_allclose(pose.tvec, t, atol=1e-5)
         assert rotation_angle(pose.rotation_matrix, R) < 0.01
+
+
+def test_bundle_pose_of_a_rendered_board(tmp_path):
+    """Issue 32: a 2 x 3 grid board drawn through a known pose; its pose
+    from all six markers, from a bundle file or Bundle.grid()."""
+    board = frappe.Bundle.grid(2, 3, 0.05, 0.01, first_id=10)
+    assert len(board) == 6 and board.ids == list(range(10, 16))
+    path = tmp_path / "board.yaml"
+    path.write_text("board: grid\nrows: 2\ncols: 3\nsize: 0.05\ngap: 0.01\nfirst_id: 10\n")
+    loaded = frappe.load_bundle(path)
+    np.testing.assert_allclose(loaded.corners(12), board.corners(12))
+    R, t = rotation(20, -15, 10), np.array([-0.08, 0.03, 0.6])
+    image = np.full((480, 640), 140, np.uint8)
+    for i in board.ids:
+        corners = (K640 @ (R @ board.corners(i).T + t[:, None])).T
+        frappe.draw_marker(image, "aruco_mip_36h12", i, corners[:, :2] / corners[:, 2:])
+    markers = frappe.Detector().detect(image)
+    bp = frappe.estimate_bundle_pose(loaded, markers, K640)
+    assert bp is not None and bp.used == list(range(10, 16)) and bp.rejected == []
+    assert np.linalg.norm(bp.pose.tvec - t) < 0.005 * np.linalg.norm(t)
+    assert rotation_angle(bp.pose.rotation_matrix, R) < 0.5
+    assert frappe.estimate_bundle_pose(loaded, [], K640) is None
+    with pytest.raises(ValueError, match="board: 'hexagon'"):
+        bad = tmp_path / "bad.yaml"
+        bad.write_text("board: hexagon\n")
+        frappe.load_bundle(bad)
+    with pytest.raises(OSError):
+        frappe.load_bundle(tmp_path / "missing.yaml")

@@ -18,6 +18,22 @@ enum class Mode {
 	/// on video with large markers, at the price of missing small markers that
 	/// appear while scaled; every `max_scaled_frames` frames one is at full size.
 	AScale,
+	/// Video: the markers of the last frames predict where each will be (a
+	/// constant-velocity model of its corners) and the full detector runs
+	/// in a region around each prediction, at full resolution. The rest of
+	/// the frame is searched for new markers by the full detector a band
+	/// of rows at a time, all of it at least every `track_cover_frames`
+	/// frames, and by the whole frame's region map (half resolution) on
+	/// every frame; all of it at once after a scene change or when a
+	/// tracked marker is not found where predicted (then the same frame is
+	/// searched again, whole). Marker::tracked says which markers were
+	/// tracked; corners are always measured on the frame. 0.55-0.7 of
+	/// NORMAL's instructions on the synthetic sequences, the same markers
+	/// found (docs/tracking.md). Needs a front end that can run on regions
+	/// (the CPU's); others run every frame whole. One detector per video,
+	/// its frames in order (a Pipeline's Overlap::Frames on several threads
+	/// gives each detector a part of them; Overlap::Stages keeps one).
+	Track,
 };
 
 /// Detector parameters. Defaults are the paper's Table 1. Each field says what
@@ -70,6 +86,15 @@ struct Config {
 	/// n_max_scaled (AScale only): at most this many scaled frames in a row
 	/// before one at full resolution, so small new markers are seen.
 	int max_scaled_frames = 5;
+
+	/// k (Track only): every part of the frame is searched for new markers
+	/// at least once every this many frames, a band of rows at a time. A
+	/// marker that enters the scene is found at most k - 1 frames after
+	/// the frame it is first whole in. The default, 4, finds it within
+	/// 100 ms at 30 frames a second; lower finds it sooner at a higher
+	/// cost a frame, 1 searches every frame whole (Normal's cost, with
+	/// Marker::tracked). Range [1, 1000].
+	int track_cover_frames = 4;
 
 	/// The second source of candidates, for blurred markers: dark regions
 	/// of the frame at half resolution, whose borders stay closed where blur

@@ -64,6 +64,14 @@ struct Result {
 	/// the frame was read in place. Carried here because in a Pipeline
 	/// that detector may already be running a later frame.
 	std::size_t copy_bytes = 0;
+	/// Bytes of the frame the front end read: width x height (each pixel
+	/// once) when it read the whole frame; in Mode::Track, on a frame read
+	/// in regions, the regions' with the margins their filters need.
+	std::size_t bytes_read = 0;
+	/// Whether the whole frame was searched: always, but in Mode::Track,
+	/// where only the first frame, a scene change, a marker lost or a
+	/// frame whose regions would cover most of it is.
+	bool whole_frame = true;
 };
 
 /// The longest image side detect() accepts (it throws
@@ -112,7 +120,8 @@ public:
 	/// tests.
 	const EdgeMap &edgeMap() const;
 
-	/// Forgets what AScale learned from earlier frames.
+	/// Forgets what AScale and Track learned from earlier frames: the next
+	/// frame is searched whole.
 	void reset();
 
 	const Config &config() const;

@@ -3,6 +3,7 @@
 #pragma once
 
 #include "frappe/export.h"
+#include "frappe/layout.h"
 
 #include <cstdint>
 #include <memory>
@@ -15,13 +16,24 @@ namespace frappe {
 
 /// One family of square markers: each code is the n x n inner grid read
 /// row-major from the top-left cell, most significant used bit first,
-/// 1 = white (see frappe-core/dictionaries/README.md).
+/// 1 = white (see frappe-core/dictionaries/README.md); or, for a family
+/// with a `layout`, its cells as the layout places them.
 struct FRAPPE_EXPORT Dictionary {
 	std::string_view name;                ///< e.g. "aruco_mip_36h12"
-	int bits = 0;                         ///< n: cells per side of the inner grid
+	/// n: cells per side of the inner grid. With a layout: the detected
+	/// square's cells less 2, so that bits + 2 is the square's side in cells.
+	int bits = 0;
 	int min_hamming = 0;                  ///< minimum distance, rotations included
 	int opencv_max_correction = 0;        ///< what OpenCV corrects for it, for reference
 	std::span<const std::uint64_t> codes; ///< codes[id]
+	/// The cells, when not n x n bits in a one-cell black border (AprilTag
+	/// 3's tagStandard41h12 and its kin); nullptr for those.
+	const MarkerLayout *layout = nullptr;
+
+	/// Bits of a code: n * n, or the layout's.
+	int codeBits() const { return layout ? layout->code_bits : bits * bits; }
+	/// The code turned a quarter turn clockwise: rotateCode(), or the layout's.
+	std::uint64_t rotate(std::uint64_t code) const;
 
 	/// The bit errors the detector corrects unless told otherwise, among
 	/// cells read clearly: the most, up to min(5, (dmin - 1) / 2), for which a
@@ -40,7 +52,7 @@ struct FRAPPE_EXPORT Dictionary {
 	int weakMaxHamming() const;
 	/// The chance that a pattern of random bits lies within `bits` bits of
 	/// some codeword in some rotation: 4 x codes x patterns within `bits`
-	/// / 2^(bits^2). What a read corrected by that much is worth as
+	/// / 2^codeBits(). What a read corrected by that much is worth as
 	/// evidence on its own.
 	double randomDecodeChance(int bits) const;
 	int size() const { return static_cast<int>(codes.size()); }

@@ -8,11 +8,13 @@
 //      tests/support, linked through frappe-core-internal, never installed.
 #pragma once
 
+#include "frappe/bundle.h"
 #include "frappe/camera.h"
 #include "frappe/config.h"
 #include "frappe/detector.h"
 #include "frappe/dictionary.h"
 #include "frappe/image.h"
+#include "frappe/layout.h"
 #include "frappe/marker.h"
 #include "frappe/marker_record.h"
 #include "frappe/pipeline.h"

@@ -27,6 +27,10 @@ struct Marker {
 	/// glint, a cell cut by the edge of a shadow). Filter on it to trade
 	/// misses for certainty.
 	float margin = 0.0f;
+	/// Mode::Track: the marker was found where earlier frames predicted it
+	/// (its corners are still measured on this frame, never extrapolated);
+	/// false when it was found afresh, and in the other modes.
+	bool tracked = false;
 };
 
 } // namespace frappe

@@ -30,6 +30,9 @@ struct MarkerRecord {
 	const Marker *marker = nullptr;
 	std::string_view dictionary;
 	const MarkerPose *pose = nullptr; ///< nullptr: no pose
+	/// The output says whether the marker was tracked (Mode::Track's
+	/// outputs, the element's message); false: no `tracked` field.
+	bool tracking = false;
 };
 
 /// A count that outputs typed by kind write unsigned (GStreamer's uint).
@@ -38,7 +41,8 @@ struct Count {
 };
 
 /// Calls f(name, value) for each output field of `r`, in the outputs'
-/// order; name is snake_case. The pose's fields only with a pose.
+/// order; name is snake_case. `tracked` only when r.tracking, the pose's
+/// fields only with a pose.
 template<typename F>
 void forEachMarkerField(const MarkerRecord &r, F &&f)
 {
@@ -48,6 +52,8 @@ void forEachMarkerField(const MarkerRecord &r, F &&f)
 	f(std::string_view("corners"), m.corners);
 	f(std::string_view("hamming"), Count{ m.hamming });
 	f(std::string_view("margin"), m.margin);
+	if (r.tracking)
+		f(std::string_view("tracked"), m.tracked);
 	if (r.pose) {
 		f(std::string_view("rvec"), r.pose->pose.rvec);
 		f(std::string_view("tvec"), r.pose->pose.tvec);
@@ -56,7 +62,8 @@ void forEachMarkerField(const MarkerRecord &r, F &&f)
 	}
 }
 
-/// Every field's name forEachMarkerField() gives with a pose, in order.
+/// Every field's name forEachMarkerField() gives with tracking and a pose,
+/// in order.
 FRAPPE_EXPORT std::span<const std::string_view> markerFieldNames();
 
 /// How numbers are written. Exact: the shortest text that reads back the

@@ -32,7 +32,10 @@ struct RenderOptions {
 
 /// Draws marker `id` so that the outer corners of its black border land on
 /// `corners` (top-left, top-right, bottom-right, bottom-left in the marker's
-/// canonical orientation; pixel centres at integers), through the
+/// canonical orientation; pixel centres at integers); for a dictionary with
+/// a layout, the corners of its detected square (where its black ring meets
+/// its white one: the corners the detector reports), the cells outside it
+/// drawn beyond them. Through the
 /// homography those corners define. Pixels are area-averaged, so edges fall
 /// at their exact sub-pixel place. Throws std::out_of_range for an id not
 /// in `dict`, and std::invalid_argument (the message says which argument
@@ -53,7 +56,8 @@ FRAPPE_EXPORT std::array<Point2f, 4> perspectiveSquare(float cx, float cy, float
 					 float distance = 4.0f);
 
 /// An upright marker image, `cell_px` pixels a cell, with its quiet zone:
-/// side = (bits + 2 + 2 * quiet_cells) * cell_px. Throws
+/// side = (cells + 2 * quiet_cells) * cell_px, cells = bits + 2 or the
+/// layout's size. Throws
 /// std::out_of_range for an id not in `dict`, and std::invalid_argument
 /// for a cell_px under 1, a negative quiet_cells, or a side beyond 32768.
 FRAPPE_EXPORT std::vector<std::uint8_t> markerImage(const Dictionary &dict, int id, int cell_px,

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cstring>
+#include <stdexcept>
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -89,6 +90,21 @@ SmallFile readSmallFile(const std::string &path, std::size_t maxBytes)
 	}
 	f.text.resize(got);
 	return f;
+}
+
+void throwFileFault(const SmallFile &f, const std::string &where, std::string_view limit, std::string_view kind)
+{
+	using Fault = SmallFile::Fault;
+	switch (f.fault) {
+	case Fault::None: return;
+	case Fault::NotFound: throw std::runtime_error(where + ": no such file");
+	case Fault::Directory: throw std::runtime_error(where + ": not a regular file (a directory)");
+	case Fault::NotRegular: throw std::runtime_error(where + ": not a regular file (" + f.reason + ")");
+	case Fault::TooLarge:
+		throw std::runtime_error(where + ": " + std::to_string(f.size) + " bytes, over the " + std::string(limit) + " a " +
+					 std::string(kind) + " may have");
+	case Fault::Unreadable: throw std::runtime_error(where + ": cannot be read: " + f.reason);
+	}
 }
 
 } // namespace frappe::detail

@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <string>
+#include <string_view>
 
 namespace frappe::detail {
 
@@ -22,5 +23,11 @@ struct SmallFile {
 /// file of at most `maxBytes`, and reads at most `maxBytes` + 1 bytes of it
 /// (a file growing while read is TooLarge, never read without end).
 SmallFile readSmallFile(const std::string &path, std::size_t maxBytes);
+
+/// Throws std::runtime_error for f's fault (none: returns), naming the file
+/// `where`: "WHERE: no such file", "WHERE: not a regular file (...)",
+/// "WHERE: N bytes, over the LIMIT a KIND may have", "WHERE: cannot be
+/// read: ...".
+void throwFileFault(const SmallFile &f, const std::string &where, std::string_view limit, std::string_view kind);
 
 } // namespace frappe::detail

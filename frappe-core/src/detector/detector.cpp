@@ -21,6 +21,11 @@ namespace frappe {
 
 namespace {
 
+/* The exponential scale of the read of clipped candidates (Tone::expScale):
+ * the midpoint of a black at 60 and the ceiling lands near 220 grey levels.
+ * 32 to 64 read the same on every subset at 200% light. */
+constexpr float kClipScale = 48.0f;
+
 using detail::quadArea;
 using detail::StageTimer;
 using detail::toFullResolution;
@@ -42,6 +47,9 @@ public:
 	 * samples (finish() uses both before refining). */
 	bool isMarker(detail::Quad &quad) override
 	{
+		/* A layout's square is read by finish() alone (layout_candidate.cpp). */
+		if (dict_.layout)
+			return false;
 		std::array<Point2f, 4> corners;
 		for (int i = 0; i < 4; ++i)
 			corners[i] = toFullResolution(quad.corners[i], scale_);
@@ -188,9 +196,19 @@ Detector::Detector(const Config &config) : impl_(std::make_unique<Impl>())
 	 * many, and they made wrong ids. */
 	impl_->logPolicy = impl_->policy;
 	impl_->logPolicy.maxTotal = impl_->policy.maxHamming;
-	if (impl_->params.light_floor < FrontEndParams::kLightReference)
+	if (impl_->params.light_floor < FrontEndParams::kLightReference) {
 		impl_->logPolicy.tone.logFloor = static_cast<float>(std::max(1, impl_->params.light_floor));
+		impl_->logPolicy.tone.fillTable(impl_->logTable.data());
+		impl_->logPolicy.tone.table = impl_->logTable.data();
+		impl_->clipPolicy = impl_->logPolicy;
+		impl_->clipPolicy.tone = {};
+		impl_->clipPolicy.tone.expScale = kClipScale;
+		impl_->clipPolicy.tone.fillTable(impl_->clipTable.data());
+		impl_->clipPolicy.tone.table = impl_->clipTable.data();
+	}
 	impl_->frontEnd = makeCpuFrontEnd(config.threads);
+	if (config.mode == Mode::Track)
+		impl_->tracker = std::make_unique<detail::Tracker>(config.track_cover_frames);
 }
 
 Detector::~Detector() = default;
@@ -199,8 +217,23 @@ Detector &Detector::operator=(Detector &&) noexcept = default;
 
 const Result &Detector::detect(const ImageView &image)
 {
+	Impl &d = *impl_;
+	d.mayRetry = d.tracker != nullptr;
 	detail::DetectorStages::frontEnd(*this, image, 0);
-	return detail::DetectorStages::backEnd(*this, image, 0);
+	const Result &first = detail::DetectorStages::backEnd(*this, image, 0);
+	d.mayRetry = false;
+	if (!d.tracker || first.whole_frame || !d.tracker->retrying())
+		return first;
+	/* Track: a marker of the last frame was not where predicted. The
+	 * same frame again, whole (the tracker planned it so), so that it
+	 * does not drop out; the frame's time is both searches'. */
+	const StageTimes partial = first.times;
+	detail::DetectorStages::frontEnd(*this, image, 0);
+	Result &again = const_cast<Result &>(detail::DetectorStages::backEnd(*this, image, 0));
+	for (int i = 0; i < kStageCount; ++i)
+		again.times.ms[i] += partial.ms[i];
+	again.times.total_ms += partial.total_ms;
+	return again;
 }
 
 namespace detail {
@@ -222,6 +255,20 @@ void DetectorStages::frontEnd(Detector &detector, const ImageView &image, int sl
 		scale = 1.0f;
 	s.image = image;
 	timer.lap(Stage::FrontEnd);
+	/* Track: the CPU front end over the regions the tracks predict and a
+	 * band of the rest, or the whole frame. */
+	const bool regions = d.tracker && d.tracker->plan(image, std::string_view(d.frontEnd->name()) == "cpu");
+	s.result.whole_frame = !regions;
+	s.result.bytes_read = static_cast<std::size_t>(image.width) * image.height;
+	if (regions) {
+		d.tracker->runRegions(image, d.params, s.edges);
+		s.result.bytes_read = d.tracker->bytesRead();
+		s.result.scale = 1.0f;
+		s.result.copy_bytes = 0;
+		return;
+	}
+	if (d.tracker)
+		d.tracker->ranWhole();
 	d.frontEnd->run(image, scale, d.params, s.edges);
 	if (!d.frontEnd->makesRegionMap()) {
 		/* A front end without a region map (one of the caller's): the
@@ -261,6 +308,8 @@ const Result &DetectorStages::finish(Detector &detector, const ImageView &image,
 		std::lock_guard<std::mutex> lock(d.adaptiveLock);
 		d.adaptive.update(s.result.markers);
 	}
+	if (d.tracker)
+		d.tracker->update(s.result.markers, image.width, image.height, !s.result.whole_frame, d.mayRetry);
 	double total = 0;
 	for (double ms : s.result.times.ms)
 		total += ms;
@@ -288,8 +337,12 @@ const CandidateWarper *Detector::warper() const { return impl_->warper.get(); }
 const EdgeMap &Detector::edgeMap() const { return impl_->slots[0].edges; }
 void Detector::reset()
 {
-	std::lock_guard<std::mutex> lock(impl_->adaptiveLock);
-	impl_->adaptive.reset();
+	{
+		std::lock_guard<std::mutex> lock(impl_->adaptiveLock);
+		impl_->adaptive.reset();
+	}
+	if (impl_->tracker)
+		impl_->tracker->reset();
 }
 const Config &Detector::config() const { return impl_->config; }
 const Dictionary &Detector::dictionary() const { return *impl_->dict; }

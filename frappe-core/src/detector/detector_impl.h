@@ -21,6 +21,7 @@
 #include "front_end_rows.h"
 #include "region_map.h"
 #include "stage_timer.h"
+#include "tracker.h"
 #include "verify.h"
 
 namespace frappe {
@@ -37,6 +38,11 @@ struct FRAPPE_HIDDEN Detector::Impl {
 	/* policy on the log scale (Tone), the second read of a candidate;
 	 * grey levels (no second read) when light_floor keeps thresholds absolute. */
 	detail::DecodePolicy logPolicy;
+	std::array<float, 256> logTable; /* logPolicy.tone's value of each grey level */
+	/* policy on the exponential scale, the last read of a candidate whose
+	 * whites clip (none when light_floor keeps thresholds absolute). */
+	detail::DecodePolicy clipPolicy;
+	std::array<float, 256> clipTable;
 	FrontEndParams params;
 	std::unique_ptr<FrontEnd> frontEnd;
 	std::unique_ptr<CandidateWarper> warper; /* nullptr: warp on the CPU, one by one */
@@ -44,6 +50,10 @@ struct FRAPPE_HIDDEN Detector::Impl {
 	 * they run on different threads. */
 	std::mutex adaptiveLock;
 	detail::AdaptiveScale adaptive;
+	/* Mode::Track's tracks and regions (nullptr in the other modes); under
+	 * its own lock. mayRetry: detect() may search a frame again whole. */
+	std::unique_ptr<detail::Tracker> tracker;
+	bool mayRetry = false;
 
 	/* One frame in flight: its edges, its candidates, its result. */
 	struct Slot {
@@ -67,7 +77,7 @@ struct FRAPPE_HIDDEN Detector::Impl {
 	TraceMap shadeRegions;
 	/* The read stage's own state (halved frames, the warp batch, the
 	 * marker grids), reading through the settings above. */
-	detail::CandidateReader reader{ config, dict, codes, policy, logPolicy, params, warper };
+	detail::CandidateReader reader{ config, dict, codes, policy, logPolicy, clipPolicy, params, warper };
 
 	void checkImage(const ImageView &image) const;
 	void trace(Slot &slot);

@@ -18,6 +18,7 @@ constexpr std::string_view kFieldNames[] = { "id",
 					     "corners",
 					     "hamming",
 					     "margin",
+					     "tracked",
 					     "rvec",
 					     "tvec",
 					     "reprojection_error",
@@ -103,6 +104,8 @@ void appendMarkerJson(std::string &out, const MarkerRecord &r, JsonNumbers numbe
 		out += "\": ";
 		if constexpr (std::is_same_v<T, std::string_view>) {
 			appendJsonString(out, value);
+		} else if constexpr (std::is_same_v<T, bool>) {
+			out += value ? "true" : "false";
 		} else if constexpr (std::is_same_v<T, Count>) {
 			appendNumber(out, value.value, -1);
 		} else if constexpr (std::is_same_v<T, std::array<Point2f, 4>>) {

@@ -35,7 +35,7 @@ constexpr std::size_t memberCount()
 /* A new Config member needs its entry below (or a word here on why no
  * surface can show it, as custom_dictionary, a shared object). */
 constexpr std::size_t kFieldsWithoutSetting = 1;
-constexpr std::size_t kSettingCount = 15;
+constexpr std::size_t kSettingCount = 16;
 static_assert(memberCount<Config>() == kSettingCount + kFieldsWithoutSetting,
 	      "a Config field was added or removed: describe it in settings.cpp's table (frappe/settings.h)");
 
@@ -45,7 +45,7 @@ int largestMaxHamming()
 {
 	int most = 0;
 	for (const Dictionary &d : dictionaries())
-		most = std::max(most, d.bits * d.bits / 2);
+		most = std::max(most, d.codeBits() / 2);
 	return most;
 }
 
@@ -59,7 +59,8 @@ std::vector<Setting> makeTable()
 		  kEverywhere },
 		{ "mode", &C::mode, 0, 0, false, "MODE",
 		  "normal: every frame at full resolution; ascale: scale frames down from the smallest marker of the "
-		  "previous frame (video)",
+		  "previous frame (video); track: search around the last frames' markers and a band of the rest "
+		  "(video)",
 		  kEverywhere },
 		{ "edge_threshold", &C::edge_threshold, 0.0, 4.0, true, "E",
 		  "Sobel magnitude (intensities in [0, 1]) an edge pixel must exceed; lower finds fainter markers, "
@@ -81,6 +82,9 @@ std::vector<Setting> makeTable()
 		  "ascale: side in pixels of the smallest marker after scaling", kEverywhere },
 		{ "max_scaled_frames", &C::max_scaled_frames, 0, 1000, false, "N",
 		  "ascale: at most this many scaled frames in a row before one at full resolution", kEverywhere },
+		{ "track_cover_frames", &C::track_cover_frames, 1, 1000, false, "K",
+		  "track: every part of the frame is searched for new markers at least once every K frames",
+		  kEverywhere },
 		{ "region_contrast", &C::region_contrast, 0.0, 1.0, false, "R",
 		  "contrast (intensities in [0, 1]) of the dark-region candidates that find blurred markers; 0: off "
 		  "(faster)",
@@ -248,7 +252,7 @@ std::vector<std::string> Setting::choices() const
 {
 	std::vector<std::string> out;
 	if (std::holds_alternative<Mode Config::*>(member)) {
-		out = { "normal", "ascale" };
+		out = { "normal", "ascale", "track" };
 	} else if (std::holds_alternative<std::string Config::*>(member)) {
 		for (const Dictionary &d : dictionaries())
 			out.emplace_back(d.name);
@@ -307,7 +311,7 @@ const Setting *findSetting(std::string_view name)
 
 std::string_view modeName(Mode mode)
 {
-	return mode == Mode::AScale ? "ascale" : "normal";
+	return mode == Mode::AScale ? "ascale" : mode == Mode::Track ? "track" : "normal";
 }
 
 bool parseMode(std::string_view name, Mode &mode)
@@ -317,6 +321,8 @@ bool parseMode(std::string_view name, Mode &mode)
 		mode = Mode::Normal;
 	else if (n == "ascale")
 		mode = Mode::AScale;
+	else if (n == "track")
+		mode = Mode::Track;
 	else
 		return false;
 	return true;
@@ -324,7 +330,7 @@ bool parseMode(std::string_view name, Mode &mode)
 
 std::string modeNames(std::string_view separator)
 {
-	return "normal" + std::string(separator) + "ascale";
+	return "normal, ascale" + std::string(separator) + "track";
 }
 
 void validate(const Config &c)
@@ -339,14 +345,17 @@ void validate(const Config &c)
 	if (c.custom_dictionary) {
 		/* One made by hand rather than by loadDictionary(): what the
 		 * decoder and the sample grid rely on. */
-		if (d.bits < 3 || d.bits > 8)
+		if (!d.layout && (d.bits < 3 || d.bits > 8))
 			fail("custom_dictionary: bits must be 3..8, got " + std::to_string(d.bits));
+		if (d.layout && (d.layout->size + 2 > 16 || d.bits != d.layout->square_cells - 2))
+			fail("custom_dictionary: a layout of at most 14 cells a side, with bits its square's cells "
+			     "less 2");
 		if (d.codes.empty())
 			fail("custom_dictionary: no codes");
 		/* Every output carries the name: JSON, GStreamer, Python. */
 		if (detail::invalidUtf8At(d.name) != std::string_view::npos)
 			fail("custom_dictionary: the name is not UTF-8 text");
-		const int cells = d.bits * d.bits;
+		const int cells = d.codeBits();
 		for (std::uint64_t code : d.codes) {
 			if (cells < 64 && code >> cells)
 				fail("custom_dictionary: a code with bits beyond the " + std::to_string(cells) +
@@ -360,10 +369,12 @@ void validate(const Config &c)
 			fail(std::string(s.name) + " must be " + (std::isinf(s.max) ? "" : "in ") + s.rangeText() +
 			     ", got " + s.text(c));
 	}
+	if (c.mode != Mode::Normal && c.mode != Mode::AScale && c.mode != Mode::Track)
+		fail("mode must be Normal, AScale or Track");
 	/* The table's range is the widest over the dictionaries: this one's. */
-	if (c.max_hamming > d.bits * d.bits / 2)
-		fail("max_hamming must be -1 (dictionary default) or 0.." + std::to_string(d.bits * d.bits / 2) +
-		     " for " + std::string(d.name) + ", got " + std::to_string(c.max_hamming));
+	if (c.max_hamming > d.codeBits() / 2)
+		fail("max_hamming must be -1 (dictionary default) or 0.." + std::to_string(d.codeBits() / 2) + " for " +
+		     std::string(d.name) + ", got " + std::to_string(c.max_hamming));
 }
 
 } // namespace frappe

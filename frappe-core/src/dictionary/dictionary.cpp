@@ -24,10 +24,15 @@ int mostWithin(const Dictionary &d, int limit, double chance)
 
 } // namespace
 
+std::uint64_t Dictionary::rotate(std::uint64_t code) const
+{
+	return layout ? layout->rotate(code) : rotateCode(code, bits);
+}
+
 /* A union bound: 4 n C(bits^2, <= t) / 2^bits^2. */
 double Dictionary::randomDecodeChance(int t) const
 {
-	const int cells = bits * bits;
+	const int cells = codeBits();
 	double within = 0.0, choose = 1.0;
 	for (int i = 0; i <= t && i <= cells; ++i) {
 		within += choose;
@@ -75,6 +80,11 @@ std::string canonicalName(std::string_view name)
 	}
 	if (n.starts_with("tag") && n.size() > 3 && std::isdigit(static_cast<unsigned char>(n[3])))
 		n = "apriltag_" + n.substr(3);
+	/* AprilTag 3's own names: tagStandard41h12 -> apriltag_standard41h12. */
+	for (std::string_view kind : { "standard", "circle", "custom" }) {
+		if (n.starts_with("tag") && n.substr(3).starts_with(kind))
+			n = "apriltag_" + n.substr(3);
+	}
 	if (n == "aruco_mip_36h12" || n == "mip_36h12" || n == "arucomip36h12")
 		n = "aruco_mip_36h12";
 	return n;

@@ -30,6 +30,10 @@ constexpr std::size_t kMaxNameBytes = 128;
 /* The min_hamming check compares every pair of codes in 4 rotations: at
  * 4096 codes that is 34 million comparisons, a few tens of milliseconds. */
 constexpr int kMaxCodes = 4096;
+/* A layout family's file may hold a family as large as AprilTag 3's
+ * (tagCircle49h12: 65535 codes); beyond kMaxCodes its header's distance
+ * is taken, the codes only checked for repeats. */
+constexpr int kMaxLayoutCodes = 65536;
 constexpr int kMinSide = 3, kMaxSide = 8;
 
 /* The storage a loaded Dictionary's name and codes point into, kept alive
@@ -37,6 +41,7 @@ constexpr int kMinSide = 3, kMaxSide = 8;
 struct OwnedDictionary {
 	std::string name;
 	std::vector<std::uint64_t> codes;
+	MarkerLayout layout;
 	Dictionary dict;
 };
 
@@ -141,7 +146,25 @@ struct Parsed {
 	int sideLine = 0;
 	int opencvMaxCorrection = 0;
 	std::vector<CodeLine> codes;
+	/* `layout` rows, and the first one's line; a declared distance. */
+	std::vector<std::string> layoutRows;
+	int layoutLine = 0;
+	std::optional<int> declaredHamming;
+	int declaredHammingLine = 0;
 };
+
+/* "... min_hamming_distance 12, ..." in a `# layout:` header. */
+std::optional<int> hammingInNote(std::string_view note)
+{
+	const std::string_view key = "min_hamming_distance";
+	const std::size_t at = note.find(key);
+	if (at == std::string_view::npos)
+		return std::nullopt;
+	std::string_view rest = trim(note.substr(at + key.size()));
+	if (!rest.empty() && rest.front() == ':')
+		rest = trim(rest.substr(1));
+	return parseCount(rest.substr(0, rest.find_first_of(" \t,")));
+}
 
 /* The text format: `# key: value` headers, one 0x codeword a line. */
 Parsed parseText(Source &src)
@@ -176,12 +199,26 @@ Parsed parseText(Source &src)
 				declaredLine = src.line();
 				if (!declared)
 					src.fail(src.line(), "codes is not a number: '" + std::string(word) + "'");
+			} else if (key == "layout" || key == "min_hamming_distance") {
+				if (const auto h = key == "layout" ? hammingInNote(value) : parseCount(word)) {
+					p.declaredHamming = h;
+					p.declaredHammingLine = src.line();
+				}
 			} else if (key.starts_with("opencv") && key.ends_with("max_correction_bits")) {
 				const auto n = parseCount(word);
 				if (!n || *n > 64)
 					src.fail(src.line(), std::string(key) + " must be 0..64, got '" + std::string(word) + "'");
 				p.opencvMaxCorrection = *n;
 			}
+			continue;
+		}
+		/* A row of the layout: `layout` and its cells. */
+		if (line.starts_with("layout") && (line.size() == 6 || line[6] == ' ' || line[6] == '\t')) {
+			if (!p.codes.empty())
+				src.fail(src.line(), "a layout row after the codes (the layout comes first)");
+			if (p.layoutRows.empty())
+				p.layoutLine = src.line();
+			p.layoutRows.emplace_back(trim(line.substr(6)));
 			continue;
 		}
 		/* A codeword, then perhaps a comment. */
@@ -198,8 +235,9 @@ Parsed parseText(Source &src)
 		if (hex.empty() || ec != std::errc() || end != hex.data() + hex.size())
 			src.fail(src.line(), "a codeword must be a 0x hex number of at most 64 bits, got '" +
 						     std::string(token.substr(0, 40)) + "'");
-		if (static_cast<int>(p.codes.size()) == kMaxCodes)
-			src.fail(src.line(), "more than " + std::to_string(kMaxCodes) + " codes");
+		const int limit = p.layoutRows.empty() ? kMaxCodes : kMaxLayoutCodes;
+		if (static_cast<int>(p.codes.size()) == limit)
+			src.fail(src.line(), "more than " + std::to_string(limit) + " codes");
 		c.digits = static_cast<int>(hex.size());
 		c.line = src.line();
 		p.codes.push_back(c);
@@ -209,6 +247,11 @@ Parsed parseText(Source &src)
 	if (declared && *declared != static_cast<int>(p.codes.size()))
 		src.fail(declaredLine, "the header says " + std::to_string(*declared) + " codes, the file has " +
 					       std::to_string(p.codes.size()));
+	if (!p.layoutRows.empty()) {
+		if (p.sideLine)
+			src.fail(p.sideLine, "marker_side_bits and layout rows: a layout gives the side");
+		return p;
+	}
 	if (!p.sideLine) {
 		/* No header: the side from the digits, zero-padded to
 		 * ceil(n * n / 4) (3, 4, 7, 9, 13, 16 for n = 3..8). */
@@ -362,24 +405,24 @@ Parsed parseOpenCv(Source &src, bool xml)
 	return p;
 }
 
-std::array<std::uint64_t, 4> rotations(std::uint64_t code, int n)
+std::array<std::uint64_t, 4> rotations(std::uint64_t code, const Dictionary &d)
 {
 	std::array<std::uint64_t, 4> r{ code };
 	for (int k = 1; k < 4; ++k)
-		r[k] = rotateCode(r[k - 1], n);
+		r[k] = d.rotate(r[k - 1]);
 	return r;
 }
 
 /* The distance between ids (a code and every rotation of another) and of
  * each code to its own rotations; two ids alike in some rotation could not
  * be told apart. */
-int minHamming(const Source &src, const std::vector<CodeLine> &codes, int n)
+int minHamming(const Source &src, const std::vector<CodeLine> &codes, const Dictionary &d)
 {
-	int best = n * n;
+	int best = d.codeBits();
 	std::vector<std::array<std::uint64_t, 4>> turned;
 	turned.reserve(codes.size());
 	for (std::size_t j = 0; j < codes.size(); ++j) {
-		turned.push_back(rotations(codes[j].code, n));
+		turned.push_back(rotations(codes[j].code, d));
 		const auto &r = turned.back();
 		for (int k = 1; k < 4; ++k)
 			best = std::min(best, std::popcount(r[0] ^ r[k]));
@@ -397,6 +440,29 @@ int minHamming(const Source &src, const std::vector<CodeLine> &codes, int n)
 	return best;
 }
 
+/* Too many codes to compare every pair: no two ids alike in any rotation
+ * (each code's smallest rotation, sorted), the distance the file declares. */
+int declaredHamming(const Source &src, const Parsed &p, const Dictionary &d)
+{
+	std::vector<std::pair<std::uint64_t, std::size_t>> least;
+	least.reserve(p.codes.size());
+	for (std::size_t j = 0; j < p.codes.size(); ++j) {
+		const auto r = rotations(p.codes[j].code, d);
+		least.emplace_back(*std::min_element(r.begin(), r.end()), j);
+	}
+	std::sort(least.begin(), least.end());
+	for (std::size_t k = 1; k < least.size(); ++k) {
+		if (least[k].first == least[k - 1].first)
+			src.fail(p.codes[least[k].second].line,
+				 "id " + std::to_string(least[k].second) + " has the code of id " +
+					 std::to_string(least[k - 1].second) + " in some rotation");
+	}
+	if (!p.declaredHamming)
+		src.fail(src.lastLine(), "over " + std::to_string(kMaxCodes) +
+						 " codes: the header must give min_hamming_distance (too many to compare)");
+	return *p.declaredHamming;
+}
+
 std::shared_ptr<const Dictionary> parseAny(std::string_view text, std::string_view source,
 					    std::string_view fallbackName, std::string_view caller)
 {
@@ -410,22 +476,35 @@ std::shared_ptr<const Dictionary> parseAny(std::string_view text, std::string_vi
 			if (line.empty() || line.front() == '#')
 				continue;
 			xml = line.front() == '<';
-			openCv = !(line.starts_with("0x") || line.starts_with("0X"));
+			openCv = !(line.starts_with("0x") || line.starts_with("0X") || line.starts_with("layout"));
 			break;
 		}
 	}
 	Parsed p = openCv ? parseOpenCv(src, xml) : parseText(src);
-	const int cells = p.side * p.side;
+	auto owned = std::make_shared<OwnedDictionary>();
+	if (!p.layoutRows.empty()) {
+		try {
+			owned->layout = MarkerLayout::fromRows(p.layoutRows);
+		} catch (const std::invalid_argument &e) {
+			src.fail(p.layoutLine, e.what());
+		}
+		if (owned->layout.size + 2 > 16)
+			src.fail(p.layoutLine, "a layout of " + std::to_string(owned->layout.size) +
+						       " cells a side; the detector reads at most 14");
+		p.side = owned->layout.square_cells - 2;
+	}
+	const int cells = p.layoutRows.empty() ? p.side * p.side : owned->layout.code_bits;
 	for (const CodeLine &c : p.codes) {
 		if (cells < 64 && c.code >> cells)
-			src.fail(c.line, "a code with bits beyond the " + std::to_string(cells) + " cells of a " +
-						 std::to_string(p.side) + "x" + std::to_string(p.side) + " marker");
+			src.fail(c.line, p.layoutRows.empty()
+						 ? "a code with bits beyond the " + std::to_string(cells) + " cells of a " +
+							   std::to_string(p.side) + "x" + std::to_string(p.side) + " marker"
+						 : "a code with bits beyond the layout's " + std::to_string(cells));
 	}
 	/* A file's stem may be any bytes: made UTF-8 and cut, not refused. */
 	if (p.name.empty())
 		p.name = fallbackName.empty() ? "custom" : detail::toUtf8(fallbackName, kMaxNameBytes);
 
-	auto owned = std::make_shared<OwnedDictionary>();
 	owned->name = std::move(p.name);
 	owned->codes.reserve(p.codes.size());
 	for (const CodeLine &c : p.codes)
@@ -433,7 +512,10 @@ std::shared_ptr<const Dictionary> parseAny(std::string_view text, std::string_vi
 	Dictionary &d = owned->dict;
 	d.name = owned->name;
 	d.bits = p.side;
-	d.min_hamming = minHamming(src, p.codes, p.side);
+	if (!p.layoutRows.empty())
+		d.layout = &owned->layout;
+	d.min_hamming = static_cast<int>(p.codes.size()) > kMaxCodes ? declaredHamming(src, p, d)
+								    : minHamming(src, p.codes, d);
 	d.opencv_max_correction = p.opencvMaxCorrection;
 	d.codes = owned->codes;
 	return std::shared_ptr<const Dictionary>(owned, &owned->dict);

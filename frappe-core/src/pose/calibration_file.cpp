@@ -266,19 +266,8 @@ Camera parseCalibration(std::string_view text, std::string_view origin)
 
 Camera readCalibration(const std::string &path)
 {
-	using Fault = detail::SmallFile::Fault;
 	const detail::SmallFile f = detail::readSmallFile(path, detail::kMarkupMaxBytes);
-	const std::string where = detail::toUtf8(path, std::string::npos);
-	switch (f.fault) {
-	case Fault::None: break;
-	case Fault::NotFound: throw std::runtime_error(where + ": no such file");
-	case Fault::Directory: throw std::runtime_error(where + ": not a regular file (a directory)");
-	case Fault::NotRegular: throw std::runtime_error(where + ": not a regular file (" + f.reason + ")");
-	case Fault::TooLarge:
-		throw std::runtime_error(where + ": " + std::to_string(f.size) +
-					 " bytes, over the 1 MiB a calibration file may have");
-	case Fault::Unreadable: throw std::runtime_error(where + ": cannot be read: " + f.reason);
-	}
+	detail::throwFileFault(f, detail::toUtf8(path, std::string::npos), "1 MiB", "calibration file");
 	return parseCalibration(f.text, path);
 }
 

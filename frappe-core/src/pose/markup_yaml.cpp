@@ -269,7 +269,14 @@ private:
 		}
 		MarkupNode value;
 		if (rest.empty()) {
-			if (pos_ < lines_.size() && lines_[pos_].indent > indent)
+			const bool flowBelow = pos_ < lines_.size() && lines_[pos_].indent > indent &&
+					       !lines_[pos_].text.empty() &&
+					       (lines_[pos_].text[0] == '[' || lines_[pos_].text[0] == '{');
+			if (flowBelow) {
+				/* key:\n  [ ... ] (apriltag_ros's tags.yaml writes its lists so). */
+				const Line &below = lines_[pos_++];
+				value = parseFlowText(below.text, below.number, depth);
+			} else if (pos_ < lines_.size() && lines_[pos_].indent > indent)
 				value = parseBlock(depth + 1, indent + 1);
 			else if (in_map && pos_ < lines_.size() && lines_[pos_].indent == indent &&
 				 isSeqItem(lines_[pos_].text))

@@ -17,6 +17,7 @@
 #include <Eigen/LU>
 
 #include "lens.h"
+#include "rigid_fit.h"
 #include "rodrigues.h"
 
 namespace frappe {
@@ -38,16 +39,13 @@ struct Rigid {
 	double error = kInf;
 };
 
-/* Where a marker-frame point lands in distorted pixels; false at or behind
- * the camera's plane. */
-bool project(const Vector3d &p, const Lens &lens, double &u, double &v)
+/* The corners in the marker frame for a side of 2 * half. */
+std::array<Vector3d, 4> squareCorners(double half)
 {
-	if (!(p.z() > 0.0))
-		return false;
-	double xd, yd;
-	lens.distort(p.x() / p.z(), p.y() / p.z(), xd, yd);
-	lens.toPixel(xd, yd, u, v);
-	return std::isfinite(u) && std::isfinite(v);
+	std::array<Vector3d, 4> m;
+	for (int i = 0; i < 4; ++i)
+		m[static_cast<std::size_t>(i)] = Vector3d(half * kSquare[i][0], half * kSquare[i][1], 0.0);
+	return m;
 }
 
 /* RMS over the corners of the distance between projection and observation,
@@ -55,16 +53,7 @@ bool project(const Vector3d &p, const Lens &lens, double &u, double &v)
 double reprojectionError(const Matrix3d &R, const Vector3d &t, double half, const Lens &lens,
 			 const std::array<Point2f, 4> &corners)
 {
-	double sum = 0.0;
-	for (int i = 0; i < 4; ++i) {
-		const Vector3d p = R * Vector3d(half * kSquare[i][0], half * kSquare[i][1], 0.0) + t;
-		double u, v;
-		if (!project(p, lens, u, v))
-			return kInf;
-		const double du = u - corners[i].x, dv = v - corners[i].y;
-		sum += du * du + dv * dv;
-	}
-	return std::sqrt(sum / 4.0);
+	return std::sqrt(detail::squaredReprojection(R, t, squareCorners(half), corners, lens) / 4.0);
 }
 
 /* A convex quadrilateral with some area: no three corners collinear or
@@ -182,67 +171,10 @@ bool ippeRotations(const Matrix3d &H, Matrix3d &R1, Matrix3d &R2)
 }
 
 /* Levenberg-Marquardt on the pose, minimising the corners' reprojection
- * error in distorted pixels. Six parameters: a small rotation w applied on
- * the left (R <- exp([w]x) R) and the translation; the derivative of a
- * corner p = R m + t is then -[R m]x for w and I for t. */
+ * error in distorted pixels (rigid_fit.h). */
 void refine(Rigid &pose, double half, const Lens &lens, const std::array<Point2f, 4> &corners)
 {
-	constexpr int kIterations = 20;
-	double lambda = 1e-3;
-	for (int it = 0; it < kIterations; ++it) {
-		Eigen::Matrix<double, 6, 6> JtJ = Eigen::Matrix<double, 6, 6>::Zero();
-		Eigen::Matrix<double, 6, 1> Jtr = Eigen::Matrix<double, 6, 1>::Zero();
-		const Eigen::Matrix2d K = Eigen::Map<const Eigen::Matrix<double, 2, 2, Eigen::RowMajor>>(
-			lens.pixelJacobian().data());
-		for (int i = 0; i < 4; ++i) {
-			const Vector3d q = pose.R * Vector3d(half * kSquare[i][0], half * kSquare[i][1], 0.0);
-			const Vector3d p = q + pose.t;
-			if (!(p.z() > 0.0))
-				return;
-			const double x = p.x() / p.z(), y = p.y() / p.z();
-			double xd, yd, u, v;
-			detail::Jacobian2 jd;
-			lens.distort(x, y, xd, yd, &jd);
-			lens.toPixel(xd, yd, u, v);
-			Eigen::Matrix<double, 2, 3> dpi;
-			dpi << 1.0, 0.0, -x, 0.0, 1.0, -y;
-			dpi /= p.z();
-			const Eigen::Matrix<double, 2, 3> D =
-				K * Eigen::Map<const Eigen::Matrix<double, 2, 2, Eigen::RowMajor>>(jd.data()) * dpi;
-			Matrix3d qx;
-			qx << 0.0, -q.z(), q.y(), q.z(), 0.0, -q.x(), -q.y(), q.x(), 0.0;
-			Eigen::Matrix<double, 2, 6> Ji;
-			Ji.leftCols<3>() = -D * qx;
-			Ji.rightCols<3>() = D;
-			const Eigen::Vector2d r(u - corners[i].x, v - corners[i].y);
-			JtJ += Ji.transpose() * Ji;
-			Jtr += Ji.transpose() * r;
-		}
-		bool improved = false;
-		for (int tries = 0; tries < 8 && !improved; ++tries) {
-			Eigen::Matrix<double, 6, 6> A = JtJ;
-			A.diagonal() += lambda * JtJ.diagonal();
-			const Eigen::Matrix<double, 6, 1> step = -A.ldlt().solve(Jtr);
-			if (!step.allFinite())
-				return;
-			Rigid next;
-			next.R = detail::rotationMatrix(step.head<3>()) * pose.R;
-			next.t = pose.t + step.tail<3>();
-			next.error = reprojectionError(next.R, next.t, half, lens, corners);
-			if (next.error < pose.error) {
-				const bool converged = step.norm() < 1e-12 * (1.0 + pose.t.norm());
-				pose = next;
-				lambda = std::max(lambda * 0.1, 1e-9);
-				improved = true;
-				if (converged)
-					return;
-			} else {
-				lambda *= 10.0;
-			}
-		}
-		if (!improved)
-			return;
-	}
+	pose.error = std::sqrt(detail::refineRigid(pose.R, pose.t, squareCorners(half), corners, lens, 20) / 4.0);
 }
 
 Pose toPose(const Rigid &r)
@@ -319,7 +251,7 @@ void projectPoints(std::span<const std::array<double, 3>> points, const Pose &po
 	for (std::size_t i = 0; i < points.size(); ++i) {
 		const auto &m = points[i];
 		double u, v;
-		if (project(R * Vector3d(m[0], m[1], m[2]) + t, lens, u, v))
+		if (detail::projectPoint(R * Vector3d(m[0], m[1], m[2]) + t, lens, u, v))
 			out[i] = { static_cast<float>(u), static_cast<float>(v) };
 		else
 			out[i] = { std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::quiet_NaN() };

@@ -21,7 +21,7 @@ namespace {
 using detail::bigEnough;
 using detail::cellSide;
 using detail::kMaxReadBlock;
-using detail::kReadCell;
+using detail::readBlock;
 using detail::quadArea;
 using detail::sidesAtLeast;
 using detail::StageTimer;
@@ -33,16 +33,6 @@ using detail::toFullResolution;
 bool smallCells(const std::array<Point2f, 4> &q, int bits)
 {
 	return !sidesAtLeast(q, 4.0f * static_cast<float>(bits + 2));
-}
-
-/* The block (1: the frame itself) a candidate with cells of `cell` pixels
- * is read at. */
-int readBlock(float cell)
-{
-	int f = 1;
-	while (2 * f <= kMaxReadBlock && cell >= static_cast<float>(2 * f) * kReadCell)
-		f *= 2;
-	return f;
 }
 
 /* The corner refinement window for cells large enough (refineQuad). */
@@ -263,8 +253,12 @@ void detail::CandidateReader::sampleRefined(Reading &r, const detail::Quad &q, s
 void detail::CandidateReader::readInset(Reading &r, detail::Quad &q, const detail::DecodePolicy &pol, StageTimer &timer)
 {
 	timer.lap(Stage::Refine);
-	q.corners = r.outline;
-	const bool inset = detail::insetQuad(r.block.view, q.corners, dict->bits, warped, pol.tone);
+	if (r.inset == 0) {
+		r.insetCorners = r.outline;
+		r.inset = detail::insetCorners(r.block.view, r.insetCorners, dict->bits) ? 1 : -1;
+	}
+	q.corners = r.inset > 0 ? r.insetCorners : r.outline;
+	const bool inset = r.inset > 0 && detail::warpMarker(r.block.view, q.corners, dict->bits, warped, pol.tone);
 	r.readable = inset && bigEnough(q.corners, r.minSide);
 	if (!r.readable)
 		return;
@@ -320,12 +314,30 @@ detail::MarkerRead detail::CandidateReader::decodeCandidate(const Reading &r, de
 	return read;
 }
 
+/* Whether a candidate's whites reach the sensor's ceiling (an eighth of
+ * its samples: an overexposed marker's white cells, not a glint or the
+ * brightest paper of an evenly lit frame, whose reads would only cost
+ * time), so that the midpoint between black and white is too dark a
+ * threshold (Tone's exponential scale). */
+constexpr int kClippedShare = 8;
+namespace {
+bool clipsWhite(const detail::WarpedMarker &w)
+{
+	int n = 0;
+	for (int i = 0; i < w.side * w.side; ++i)
+		n += w.samples[static_cast<std::size_t>(i)] >= detail::kClippedGrey;
+	return n * kClippedShare >= w.side * w.side;
+}
+} // namespace
+
 /* Reads candidate k: refine, warp, binarise; the inset read when that finds
  * no dark frame; then decoding and its fallbacks. A marker read is left in
  * `m`, its corners in frame pixels from the code's first. */
 bool detail::CandidateReader::readCandidate(const ImageView &image, Slot &slot, std::size_t k, float search,
 					    StageTimer &timer, Marker &m)
 {
+	if (dict->layout)
+		return readLayoutCandidate(image, slot, k, search, timer, m);
 	detail::Quad &q = slot.quads[k];
 	const std::array<Point2f, 4> tracedOutline = warper ? batch.outlines[k] : q.corners;
 	if (skipCandidate(q, tracedOutline, slot.result.markers))
@@ -340,7 +352,9 @@ bool detail::CandidateReader::readCandidate(const ImageView &image, Slot &slot, 
 					refineQuad(r.block.view, slot, q, std::max(search / ff, kSearch), r.f);
 	/* Read on grey levels; where that fails, once more on the log scale
 	 * (Tone), from the same refined corners: a marker under a shadow's
-	 * stripes or in a dim room. */
+	 * stripes or in a dim room; and where the first read's whites clipped,
+	 * on the exponential scale: an overexposed marker, whose blurred black
+	 * cells the midpoint below the ceiling reads white. */
 	const Reading refined = r;
 	const std::array<Point2f, 4> refinedCorners = q.corners;
 	auto readWith = [&](const detail::DecodePolicy &pol) {
@@ -352,16 +366,34 @@ bool detail::CandidateReader::readCandidate(const ImageView &image, Slot &slot, 
 	};
 	detail::MarkerRead read = readWith(policy);
 	const bool counted = r.counted;
-	if (!read.ok() && !logPolicy.tone.linear()) {
+	/* Whites at the sensor's ceiling in what the first read sampled. */
+	const bool clipped = !read.ok() && r.samples && clipsWhite(*r.samples);
+	auto readAgain = [&](const detail::DecodePolicy &pol) {
+		const int inset = r.inset;
+		const std::array<Point2f, 4> insetCorners = r.insetCorners;
 		r = refined;
+		r.inset = inset;
+		r.insetCorners = insetCorners;
 		q.corners = refinedCorners;
-		read = readWith(logPolicy);
-	}
+		read = readWith(pol);
+	};
+	if (!read.ok() && !logPolicy.tone.linear())
+		readAgain(logPolicy);
+	if (!read.ok() && clipped && !clipPolicy.tone.linear())
+		readAgain(clipPolicy);
 	slot.result.candidates += counted || r.counted;
 	if (!read.ok())
 		return false;
-	if (r.f > 1) {
-		const Point2f origin{ static_cast<float>(r.block.ox), static_cast<float>(r.block.oy) };
+	toMarker(q, r.f, r.block, read, m);
+	return true;
+}
+
+void detail::CandidateReader::toMarker(detail::Quad &q, int f, const BlockView &block, const detail::MarkerRead &read,
+				       Marker &m)
+{
+	if (f > 1) {
+		const float ff = static_cast<float>(f);
+		const Point2f origin{ static_cast<float>(block.ox), static_cast<float>(block.oy) };
 		for (Point2f &p : q.corners) {
 			p = toFullResolution(p, 1.0f / ff);
 			p = { p.x + origin.x, p.y + origin.y };
@@ -373,7 +405,6 @@ bool detail::CandidateReader::readCandidate(const ImageView &image, Slot &slot, 
 	m.margin = read.margin;
 	for (int i = 0; i < 4; ++i)
 		m.corners[i] = q.corners[(i + d.rotation) & 3];
-	return true;
 }
 
 /* The candidates in order, smallest first: each read, each marker kept
@@ -399,7 +430,9 @@ void detail::CandidateReader::finish(const ImageView &image, Slot &slot)
 	 * 32 px; a large candidate's box spans many, and then the grid visits
 	 * every entry instead. */
 	markerCentres.reset(2 * slot.quads.size(), 32.0f);
-	if (warper)
+	if (warper && dict->layout)
+		refineAndWarpLayouts(image, slot, search);
+	else if (warper)
 		refineAndWarpAll(image, slot, search);
 	for (std::size_t k = 0; k < slot.quads.size(); ++k) {
 		StageTimer timer(res.times, Stage::Refine);

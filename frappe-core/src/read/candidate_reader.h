@@ -37,16 +37,26 @@ namespace frappe::detail {
 constexpr float kReadCell = 6.0f;
 constexpr int kMaxReadBlock = 8;
 
+/* The block (1: the frame itself) a candidate with cells of `cell` pixels
+ * is read at. */
+inline int readBlock(float cell)
+{
+	int f = 1;
+	while (2 * f <= kMaxReadBlock && cell >= static_cast<float>(2 * f) * kReadCell)
+		f *= 2;
+	return f;
+}
+
 class CandidateReader {
 public:
 	/* The detector's settings, by reference: they are set after the
 	 * reader is made (Detector's constructor) and the warper may change
 	 * (Detector::setWarper()). */
 	CandidateReader(const Config &config, const Dictionary *const &dict, const std::unique_ptr<CodeBook> &codes,
-			const DecodePolicy &policy, const DecodePolicy &logPolicy, const FrontEndParams &params,
-			const std::unique_ptr<CandidateWarper> &warper)
-		: config(config), dict(dict), codes(codes), policy(policy), logPolicy(logPolicy), params(params),
-		  warper(warper)
+			const DecodePolicy &policy, const DecodePolicy &logPolicy, const DecodePolicy &clipPolicy,
+			const FrontEndParams &params, const std::unique_ptr<CandidateWarper> &warper)
+		: config(config), dict(dict), codes(codes), policy(policy), logPolicy(logPolicy),
+		  clipPolicy(clipPolicy), params(params), warper(warper)
 	{}
 	CandidateReader(const CandidateReader &) = delete;
 	CandidateReader &operator=(const CandidateReader &) = delete;
@@ -74,6 +84,9 @@ private:
 	const DecodePolicy &policy;
 	/* policy on the log scale (Tone), the second read of a candidate. */
 	const DecodePolicy &logPolicy;
+	/* policy on the exponential scale, the last read of a candidate whose
+	 * whites clip (linear: none). */
+	const DecodePolicy &clipPolicy;
 	const FrontEndParams &params;
 	const std::unique_ptr<CandidateWarper> &warper; /* nullptr: warp on the CPU, one by one */
 
@@ -120,6 +133,10 @@ private:
 		detail::Binarised b;
 		const detail::WarpedMarker *samples = nullptr;
 		bool counted = false; /* sampled for a read: one of Result::candidates */
+		/* The inset outline (insetCorners()), measured once for every read:
+		 * 0 not yet, 1 measured, -1 not measurable. */
+		int inset = 0;
+		std::array<Point2f, 4> insetCorners;
 	};
 
 	void finish(const ImageView &image, Slot &slot);
@@ -134,6 +151,14 @@ private:
 	void sampleRefined(Reading &r, const Quad &q, std::size_t k, const DecodePolicy &pol, StageTimer &timer);
 	void readInset(Reading &r, Quad &q, const DecodePolicy &pol, StageTimer &timer);
 	MarkerRead decodeCandidate(const Reading &r, Quad &q, const DecodePolicy &pol);
+	/* A read's marker: q's corners back in frame pixels from the block
+	 * of f pixels they were read on, the code's first corner first. */
+	static void toMarker(Quad &q, int f, const BlockView &block, const MarkerRead &read, Marker &m);
+	/* The same for a dictionary with a layout (layout_candidate.cpp). */
+	bool refineLayoutQuad(const ImageView &image, Quad &q, float search) const;
+	void refineAndWarpLayouts(const ImageView &image, Slot &slot, float search);
+	bool readLayoutCandidate(const ImageView &image, Slot &slot, std::size_t k, float search, StageTimer &timer,
+				 Marker &m);
 	/* Border cells that make a white frame: three quarters of the
 	 * 4(n+1). */
 	int whiteFrame() const { return 3 * dict->bits + 3; }

@@ -17,6 +17,8 @@ float Tone::apply(float v) const
 {
 	if (linear())
 		return v;
+	if (expScale > 0.0f)
+		return 255.0f * std::expm1(std::clamp(v, 0.0f, 255.0f) / expScale) / std::expm1(255.0f / expScale);
 	return 255.0f * std::log1p(std::max(v, 0.0f) / logFloor) / std::log1p(255.0f / logFloor);
 }
 
@@ -24,16 +26,45 @@ float Tone::invert(float v) const
 {
 	if (linear())
 		return v;
+	if (expScale > 0.0f)
+		return expScale * std::log1p(std::max(v, 0.0f) / 255.0f * std::expm1(255.0f / expScale));
 	return logFloor * std::expm1(v / 255.0f * std::log1p(255.0f / logFloor));
 }
+
+/* The log scale's samples as they have always been computed (a factor,
+ * not a division: a read's floats do not move). */
+namespace {
+float logSample(float v, float k, float norm)
+{
+	return norm * std::log1p(std::max(v, 0.0f) * k);
+}
+} // namespace
 
 void Tone::apply(WarpedMarker &w) const
 {
 	if (linear())
 		return;
 	const float k = 1.0f / logFloor, norm = 255.0f / std::log1p(255.0f * k);
-	for (int i = 0; i < w.side * w.side; ++i)
-		w.samples[static_cast<std::size_t>(i)] = norm * std::log1p(std::max(w.samples[static_cast<std::size_t>(i)], 0.0f) * k);
+	for (int i = 0; i < w.side * w.side; ++i) {
+		float &v = w.samples[static_cast<std::size_t>(i)];
+		if (table) {
+			/* Between whole levels, along the chord: within 0.05 of a
+			 * grey level of the curve, at a fraction of a log's cost
+			 * (soft-float on ARMv6). */
+			const float c = std::clamp(v, 0.0f, 255.0f);
+			const int g = std::min(static_cast<int>(c), 254);
+			v = table[g] + (c - static_cast<float>(g)) * (table[g + 1] - table[g]);
+		} else {
+			v = expScale > 0.0f ? apply(v) : logSample(v, k, norm);
+		}
+	}
+}
+
+void Tone::fillTable(float *out256) const
+{
+	const float k = 1.0f / logFloor, norm = 255.0f / std::log1p(255.0f * k);
+	for (int g = 0; g < 256; ++g)
+		out256[g] = expScale > 0.0f ? apply(static_cast<float>(g)) : logSample(static_cast<float>(g), k, norm);
 }
 
 bool warpMarker(const ImageView &image, const std::array<Point2f, 4> &corners, int bits,
@@ -138,8 +169,7 @@ bool warpCellCentres(const ImageView &image, const std::array<Point2f, 4> &corne
 	return true;
 }
 
-bool insetQuad(const ImageView &image, std::array<Point2f, 4> &corners, int bits,
-	       WarpedMarker &out, Tone tone)
+bool insetCorners(const ImageView &image, std::array<Point2f, 4> &corners, int bits)
 {
 	const auto H = Homography::fromUnitSquare(corners);
 	if (!H)
@@ -153,7 +183,15 @@ bool insetQuad(const ImageView &image, std::array<Point2f, 4> &corners, int bits
 	}
 	if (!refineCorners(image, inner, std::max(1.5f, 1.2f * cell)))
 		return false;
-	if (!warpMarker(image, inner, bits, out, tone))
+	corners = inner;
+	return true;
+}
+
+bool insetQuad(const ImageView &image, std::array<Point2f, 4> &corners, int bits,
+	       WarpedMarker &out, Tone tone)
+{
+	std::array<Point2f, 4> inner = corners;
+	if (!insetCorners(image, inner, bits) || !warpMarker(image, inner, bits, out, tone))
 		return false;
 	corners = inner;
 	return true;
@@ -213,10 +251,10 @@ inline int bitCount(std::uint64_t v)
 /* rotations[r]: the code as read with quad corner r as the top-left. Reading
  * from corner 1 sees the grid turned a quarter anticlockwise, i.e. three
  * quarter turns clockwise; from corner 3, one. */
-std::array<std::uint64_t, 4> rotationsOf(std::uint64_t code, int bits)
+std::array<std::uint64_t, 4> rotationsOf(std::uint64_t code, const Dictionary &dict)
 {
-	const std::uint64_t one = rotateCode(code, bits), two = rotateCode(one, bits);
-	return { code, rotateCode(two, bits), two, one };
+	const std::uint64_t one = dict.rotate(code), two = dict.rotate(one);
+	return { code, dict.rotate(two), two, one };
 }
 
 } // namespace
@@ -235,10 +273,10 @@ __attribute__((target_clones("popcnt", "default")))
 #endif
 Decoded nearestCode(const Dictionary &dict, std::uint64_t code, int maxHamming)
 {
-	const std::array<std::uint64_t, 4> rotations = rotationsOf(code, dict.bits);
+	const std::array<std::uint64_t, 4> rotations = rotationsOf(code, dict);
 	/* The nearest id and the nearest other id: an id's distance is its
 	 * nearest rotation's. Ids further than the runner-up cannot matter. */
-	const int words = dict.bits * dict.bits;
+	const int words = dict.codeBits();
 	Decoded best;
 	best.hamming = words + 1;
 	best.runnerUp = words + 1;
@@ -285,11 +323,31 @@ Decoded decode(const Dictionary &dict, std::uint64_t code, int maxHamming)
 	return nearestCode(dict, code, maxHamming);
 }
 
+bool plainCode(std::uint64_t code, int n)
+{
+	/* Cell (r, c) of the code with its border: 0 (black) outside the code. */
+	auto cell = [&](int r, int c) {
+		if (r < 0 || c < 0 || r >= n || c >= n)
+			return 0;
+		return static_cast<int>((code >> (n * n - 1 - (r * n + c))) & 1u);
+	};
+	int changes = 0;
+	for (int r = -1; r < n; ++r)
+		for (int c = -1; c < n; ++c) {
+			changes += r >= 0 && cell(r, c) != cell(r, c + 1); /* rows: code cells and the border's */
+			changes += c >= 0 && cell(r, c) != cell(r + 1, c); /* columns */
+		}
+	return 5 * changes <= 3 * n * (n + 1);
+}
+
 CodeBook::CodeBook(const Dictionary &dict) : dict_(&dict)
 {
 	sorted_.reserve(dict.codes.size());
-	for (int id = 0; id < dict.size(); ++id)
+	plain_.reserve(dict.codes.size());
+	for (int id = 0; id < dict.size(); ++id) {
 		sorted_.emplace_back(dict.codes[id], id);
+		plain_.push_back(plainCode(dict.codes[id], dict.bits) ? 1 : 0);
+	}
 	std::sort(sorted_.begin(), sorted_.end());
 }
 
@@ -299,7 +357,7 @@ Decoded CodeBook::decode(std::uint64_t code, int maxHamming) const
 		return {};
 	/* decode() takes the lowest id at distance 0 and the lowest rotation
 	 * for it, and calls two ids at distance 0 ambiguous. */
-	const std::array<std::uint64_t, 4> rotations = rotationsOf(code, dict_->bits);
+	const std::array<std::uint64_t, 4> rotations = rotationsOf(code, *dict_);
 	Decoded exact;
 	for (int r = 0; r < 4; ++r) {
 		auto it = std::lower_bound(sorted_.begin(), sorted_.end(), std::make_pair(rotations[r], -1));

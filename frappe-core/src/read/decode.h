@@ -24,13 +24,29 @@ using WarpedMarker = CandidateSamples;
 /// where the light is dim or changes across the marker (a blind's stripes,
 /// a cast shadow's edge), a log scale: light that multiplies every grey
 /// level (a shadow, a dim room) only shifts it there, so one threshold
-/// between black and white holds across a shadow's edge.
+/// between black and white holds across a shadow's edge. Where the whites
+/// clip, an exponential scale: the true white lies somewhere above 255, so
+/// the midpoint between black and the clipped white is too dark a
+/// threshold (a blurred black cell among white ones reads white); on this
+/// scale the threshold rises towards the ceiling.
+/// A grey level at or above which a sample is taken as clipped.
+constexpr float kClippedGrey = 250.0f;
+
 struct Tone {
-	/// 0: grey levels. Otherwise the grey level added before the log,
-	/// which keeps the darkest levels' noise from being magnified without
-	/// bound: v -> 255 ln(1 + v / floor) / ln(1 + 255 / floor), 0 .. 255.
+	/// 0: not the log scale. Otherwise the grey level added before the
+	/// log, which keeps the darkest levels' noise from being magnified
+	/// without bound: v -> 255 ln(1 + v / floor) / ln(1 + 255 / floor).
 	float logFloor = 0.0f;
-	bool linear() const { return logFloor <= 0.0f; }
+	/// 0: not the exponential scale. Otherwise its grey levels per e-fold:
+	/// v -> 255 (e^(v / s) - 1) / (e^(255 / s) - 1); the midpoint of a
+	/// black at 60 and the ceiling is about 255 - 0.7 s in grey levels.
+	float expScale = 0.0f;
+	/// Optional: apply()'s value of each grey level 0 .. 255 (fillTable()):
+	/// apply(WarpedMarker) then takes whole grey levels (the fixed-point
+	/// warp's samples) from it and interpolates between them.
+	const float *table = nullptr;
+	bool linear() const { return logFloor <= 0.0f && expScale <= 0.0f; }
+	void fillTable(float *out256) const;
 	float apply(float v) const;
 	/// apply()'s inverse: the grey level of a value on this scale.
 	float invert(float v) const;
@@ -57,8 +73,12 @@ bool warpMarker(const ImageView &image, const std::array<Point2f, 4> &corners, i
 		WarpedMarker &out, Tone tone = {});
 
 /// Treats `corners` as the outline of a one-cell quiet zone: moves them one
-/// cell inwards, re-measures the sides there and warps the result. False
-/// when the inner outline cannot be measured.
+/// cell inwards and re-measures the sides there. False when the inner
+/// outline cannot be measured. Grey levels only: a second read on another
+/// Tone reuses it.
+bool insetCorners(const ImageView &image, std::array<Point2f, 4> &corners, int bits);
+
+/// insetCorners(), then warpMarker() at the result.
 bool insetQuad(const ImageView &image, std::array<Point2f, 4> &corners, int bits,
 	       WarpedMarker &out, Tone tone = {});
 
@@ -123,10 +143,21 @@ public:
 	explicit CodeBook(const Dictionary &dict);
 	const Dictionary &dictionary() const { return *dict_; }
 	Decoded decode(std::uint64_t code, int maxHamming) const;
+	/// Whether codeword `id` is a plain shape (plainCode()).
+	bool plain(int id) const { return plain_[static_cast<std::size_t>(id)] != 0; }
 
 private:
 	const Dictionary *dict_;
 	std::vector<std::pair<std::uint64_t, int>> sorted_; ///< (code, id), by code
+	std::vector<std::uint8_t> plain_;
 };
+
+/// Whether an n x n code inside its black border is a plain shape: at most
+/// 0.6 of the black-white changes between neighbouring cells that random
+/// bits make on average (n (n + 1), the border's neighbours counted). A
+/// hollow square, a bar, an L: letters and their strokes read as these far
+/// more often than chance says (ArUco's original dictionary has 12, 4x4_1000
+/// 29; AprilTag's families none).
+bool plainCode(std::uint64_t code, int n);
 
 } // namespace frappe::detail

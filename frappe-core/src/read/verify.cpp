@@ -36,7 +36,15 @@ constexpr float kPaperWhite = 0.5f;
 
 /* A cell whose mean is at least this grey level clips: what lies under it
  * may be black ink under glare. */
-constexpr float kClipped = 250.0f;
+constexpr float kClipped = kClippedGrey;
+
+/* A plain codeword (plainCode(): a hollow square, a bar) must be read at
+ * least this clearly, on cells of at least this many pixels: letters and
+ * strokes of text make those shapes, and read them with margins up to 0.45
+ * on cells of 2 pixels or more, and up to 0.54 on smaller ones
+ * (tests/bench/frappe_text.cpp). */
+constexpr float kPlainMargin = 0.5f;
+constexpr float kPlainCellPx = 2.0f;
 
 /* A candidate's payload must span at least this many grey levels (the
  * detector's rule for every read). */
@@ -323,6 +331,11 @@ MarkerRead readMarker(const ImageView &image, const std::array<Point2f, 4> &corn
 	const QuietZone quiet = readQuietZone(image, corners, dict.bits, b, policy.tone);
 	if (!quietZoneIsLight(quiet, scrutiny) || !quietZoneIsPaper(quiet, b, policy.tone)) {
 		out.rejection = Rejection::NoQuietZone;
+		return out;
+	}
+	if (codes.plain(out.decoded.id) &&
+	    (cells.margin < kPlainMargin || !sidesAtLeast(corners, kPlainCellPx * static_cast<float>(dict.bits + 2)))) {
+		out.rejection = Rejection::PlainShape;
 		return out;
 	}
 	out.rejection = Rejection::None;

@@ -137,6 +137,7 @@ enum class Rejection {
 	CellsDisagree,
 	NoQuietZone,
 	WeakRead, ///< readCellCentres: too few cells read clearly to single out the code
+	PlainShape, ///< a plain codeword (plainCode()) read less clearly than kPlainMargin
 };
 
 /// A candidate read as a marker, or the reason it is not one.

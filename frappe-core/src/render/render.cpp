@@ -20,28 +20,26 @@ constexpr long long kMaxMarkerImageSide = 1 << 15;
 /* No quiet zone wider than the widest image: cells + 2 * quiet stays an int. */
 constexpr int kMaxQuietCells = 1 << 15;
 
-/* The cell a marker coordinate falls in, clamped to one past the widest
- * quiet zone: near the horizon a sample maps arbitrarily far, or to NaN,
- * which no cast to int may see. */
-int cellOf(float u, int cells)
+/* The cell a marker coordinate falls in (the square's first cell at u = 0),
+ * clamped to one past the widest quiet zone: near the horizon a sample
+ * maps arbitrarily far, or to NaN, which no cast to int may see. */
+int cellOf(float u, const MarkerLayout &l)
 {
-	const double c = std::floor(static_cast<double>(u) * cells);
+	const double c = std::floor(static_cast<double>(u) * l.square_cells);
 	constexpr double kFar = 4.0 * kMaxQuietCells;
-	return c >= -kFar && c <= kFar ? static_cast<int>(c) : static_cast<int>(-kFar);
+	return c >= -kFar && c <= kFar ? static_cast<int>(c) + l.square_start : static_cast<int>(-kFar);
 }
 
-/* 1 = white, 0 = black; -1 outside the marker and its quiet zone. */
-int cellValue(const Dictionary &dict, std::uint64_t code, int cx, int cy, int quiet)
+/* 1 = white, 0 = black; -1 outside the marker and its quiet zone. Cells of
+ * no matter are drawn black, as AprilTag draws them. */
+int cellValue(const MarkerLayout &l, std::uint64_t code, int cx, int cy, int quiet)
 {
-	const int n = dict.bits, cells = n + 2;
-	if (cx < -quiet || cy < -quiet || cx >= cells + quiet || cy >= cells + quiet)
+	if (cx < -quiet || cy < -quiet || cx >= l.size + quiet || cy >= l.size + quiet)
 		return -1;
-	if (cx < 0 || cy < 0 || cx >= cells || cy >= cells)
+	if (cx < 0 || cy < 0 || cx >= l.size || cy >= l.size)
 		return 1;
-	if (cx == 0 || cy == 0 || cx == cells - 1 || cy == cells - 1)
-		return 0;
-	const int bit = n * n - 1 - ((cy - 1) * n + (cx - 1));
-	return static_cast<int>((code >> bit) & 1u);
+	const int c = l.at(cx, cy);
+	return c >= 0 ? l.bit(code, c) : c == MarkerLayout::kWhite ? 1 : 0;
 }
 
 /* Appended piece by piece: GCC 12 warns falsely (-Wrestrict, its bug
@@ -117,11 +115,17 @@ void renderMarker(MutableImageView image, const Dictionary &dict, int id,
 	if (image.width == 0 || image.height == 0)
 		return;
 	const std::uint64_t code = dict.codes[id];
-	const int cells = dict.bits + 2;
+	const MarkerLayout classic = dict.layout ? MarkerLayout{} : MarkerLayout::classic(dict.bits);
+	const MarkerLayout &layout = dict.layout ? *dict.layout : classic;
 	const int q = opt.quiet_cells;
 
-	/* Bounding box of the marker with its quiet zone. */
-	const double lo = -static_cast<double>(q) / cells, hi = 1.0 + static_cast<double>(q) / cells;
+	/* Bounding box of the marker with its quiet zone: the unit square is
+	 * the layout's square, cells square_start .. + square_cells. */
+	const double cells = layout.square_cells;
+	const double lo = -static_cast<double>(q + layout.square_start) / cells,
+		     hi = layout.square_start == 0 && layout.size == layout.square_cells
+				  ? 1.0 + static_cast<double>(q) / cells
+				  : static_cast<double>(layout.size + q - layout.square_start) / cells;
 	double minX = 1e18, minY = 1e18, maxX = -1e18, maxY = -1e18;
 	bool beyondHorizon = false;
 	for (double u : { lo, hi }) {
@@ -162,9 +166,9 @@ void renderMarker(MutableImageView image, const Dictionary &dict, int id,
 					const double px = x - 0.5 + (sx + 0.5) * inv;
 					const double py = y - 0.5 + (sy + 0.5) * inv;
 					const Point2f uv = Hinv->map(px, py);
-					const int cx = cellOf(uv.x, cells);
-					const int cy = cellOf(uv.y, cells);
-					const int v = cellValue(dict, code, cx, cy, q);
+					const int cx = cellOf(uv.x, layout);
+					const int cy = cellOf(uv.y, layout);
+					const int v = cellValue(layout, code, cx, cy, q);
 					if (v < 0) {
 						sum += row[x];
 					} else {
@@ -206,18 +210,22 @@ std::vector<std::uint8_t> markerImage(const Dictionary &dict, int id, int cell_p
 	if (id < 0 || id >= dict.size())
 		throw std::out_of_range("markerImage: id " + std::to_string(id) + " not in " + std::string(dict.name) +
 					" (0.." + std::to_string(dict.size() - 1) + ")");
+	/* The whole layout, the detected square within it. */
+	const int size = dict.layout ? dict.layout->size : dict.bits + 2;
+	const int start = dict.layout ? dict.layout->square_start : 0;
+	const int square = dict.bits + 2;
 	/* In 64 bits: the side, then its square, must not overflow. */
-	const long long wide = (static_cast<long long>(dict.bits) + 2 + 2LL * quiet_cells) * cell_px;
+	const long long wide = (static_cast<long long>(size) + 2LL * quiet_cells) * cell_px;
 	if (wide > kMaxMarkerImageSide)
 		fail("the image would be " + std::to_string(wide) + " pixels a side, more than " +
 		     std::to_string(kMaxMarkerImageSide) + " (cell_px " + std::to_string(cell_px) + ", quiet_cells " +
 		     std::to_string(quiet_cells) + ")");
-	const int cells = dict.bits + 2 + 2 * quiet_cells;
+	const int cells = size + 2 * quiet_cells;
 	side = cells * cell_px;
 	std::vector<std::uint8_t> img(static_cast<std::size_t>(side) * side, 255);
 	MutableImageView view{ img.data(), side, side, side };
-	const float a = static_cast<float>(quiet_cells * cell_px) - 0.5f;
-	const float b = static_cast<float>((cells - quiet_cells) * cell_px) - 0.5f;
+	const float a = static_cast<float>((quiet_cells + start) * cell_px) - 0.5f;
+	const float b = static_cast<float>((quiet_cells + start + square) * cell_px) - 0.5f;
 	RenderOptions opt;
 	opt.quiet_cells = quiet_cells;
 	opt.supersample = 1;

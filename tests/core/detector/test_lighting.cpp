@@ -6,6 +6,7 @@
 // truth is exact; each is also run with Config::light_floor at 0.5, the
 // paper's absolute thresholds, to show what the light-following ones add.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <functional>
@@ -36,7 +37,7 @@ struct Scene {
  * blurred a little, with sensor noise of `noise` grey levels added after
  * the light (a dim frame is as noisy as a bright one). */
 Scene litScene(const Dictionary &dict, int id, float side, float roll, float tilt, const LightField &light,
-	       float noise, unsigned seed)
+	       float noise, unsigned seed, float sigma = 0.6f)
 {
 	const int size = static_cast<int>(side * 1.8f) + 40;
 	Scene s{ Image(size, size, 120), squarePose(size / 2.0f + 0.3f, size / 2.0f - 0.2f, side, roll, tilt), id };
@@ -44,7 +45,7 @@ Scene litScene(const Dictionary &dict, int id, float side, float roll, float til
 	opt.black = 25;
 	opt.white = 215;
 	renderMarker(s.img.mut(), dict, id, s.truth, opt);
-	blur(s.img, 0.6f);
+	blur(s.img, sigma);
 	std::mt19937 rng(seed);
 	std::normal_distribution<float> n(0.0f, noise);
 	for (int y = 0; y < size; ++y)
@@ -207,6 +208,35 @@ TEST(Lighting, OverexposedCornersStayInPlace)
 	}
 }
 
+/* Overexposed 2.5 times, small (22-31 px) and blurred: every white clips,
+ * and the blur lifts a black cell among white ones to near the ceiling,
+ * above the midpoint of black and the clipped white. The read on the
+ * exponential scale places the threshold near the ceiling: most are read,
+ * every one with its own id; without it (absolute thresholds: one read) 9
+ * of the 24. */
+TEST(Lighting, OverexposedBlurredSmallMarkersRead)
+{
+	int found = 0, foundAbsolute = 0, scenes = 0;
+	for (const char *name : { "aruco_mip_36h12", "apriltag_36h11" }) {
+		const Dictionary &dict = dictionary(name);
+		for (int k = 0; k < 12; ++k) {
+			const int id = (k * 37 + 11) % dict.size();
+			const float side = 22.0f + 3.0f * static_cast<float>(k % 4);
+			const Scene s = litScene(dict, id, side, 7.0f * static_cast<float>(k), 15.0f + 2.0f * static_cast<float>(k),
+						 [](float, float) { return 2.5f; }, 1.5f, static_cast<unsigned>(k), 1.2f);
+			const Outcome o = detectIn(s, dict, kDefault);
+			EXPECT_EQ(o.others, 0) << name << " id " << id;
+			found += o.marker != nullptr;
+			foundAbsolute += detectIn(s, dict, kAbsolute).marker != nullptr;
+			++scenes;
+		}
+	}
+	std::printf("overexposed, blurred: %d of %d found (%d with absolute thresholds, one read)\n", found, scenes,
+		    foundAbsolute);
+	EXPECT_GE(found, scenes * 3 / 4);
+	EXPECT_GE(found, foundAbsolute + scenes / 4);
+}
+
 /* Glare: a patch clipped to white over part of the code, at many places
  * and ids. The marker may be lost, or read with its own id and a margin
  * that says little is certain; never read as another id. */
@@ -250,4 +280,36 @@ TEST(Lighting, LogScaleTurnsLightIntoAShift)
 	EXPECT_GT(shaded, 0.7f * lit); /* grey levels: 0.3 of it */
 	EXPECT_TRUE(detail::Tone{}.linear());
 	EXPECT_FLOAT_EQ(detail::Tone{}.apply(77.0f), 77.0f);
+}
+
+/* The table the detector gives its second reads: whole grey levels read as
+ * the logs give them, any other level within 0.05 of a grey level of the
+ * curve, on either scale, and the order of samples kept. */
+TEST(Lighting, ToneTableFollowsTheCurve)
+{
+	for (detail::Tone exact : { detail::Tone{ 16.0f }, detail::Tone{ 0.0f, 48.0f } }) {
+		std::array<float, 256> table{};
+		exact.fillTable(table.data());
+		detail::Tone tabled = exact;
+		tabled.table = table.data();
+		detail::WarpedMarker a;
+		a.side = CandidateSamples::kMaxSide;
+		for (int i = 0; i < a.side * a.side; ++i)
+			a.samples[static_cast<std::size_t>(i)] = i % 2 ? static_cast<float>(i % 256) : 0.37f * static_cast<float>(i % 700);
+		detail::WarpedMarker b = a;
+		tabled.apply(b);
+		for (int i = 0; i < a.side * a.side; ++i) {
+			const float v = a.samples[static_cast<std::size_t>(i)], t = b.samples[static_cast<std::size_t>(i)];
+			if (i % 2)
+				EXPECT_EQ(t, table[static_cast<std::size_t>(v)]) << v;
+			EXPECT_NEAR(t, exact.apply(std::min(v, 255.0f)), 0.05f) << "sample " << v << " expScale " << exact.expScale;
+		}
+		detail::WarpedMarker ramp;
+		ramp.side = CandidateSamples::kMaxSide;
+		for (int i = 0; i < ramp.side * ramp.side; ++i)
+			ramp.samples[static_cast<std::size_t>(i)] = 255.0f * static_cast<float>(i) / static_cast<float>(ramp.side * ramp.side - 1);
+		tabled.apply(ramp);
+		for (int i = 1; i < ramp.side * ramp.side; ++i)
+			EXPECT_LT(ramp.samples[static_cast<std::size_t>(i - 1)], ramp.samples[static_cast<std::size_t>(i)]) << i;
+	}
 }

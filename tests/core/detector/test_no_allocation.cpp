@@ -158,3 +158,25 @@ TEST_P(NoAllocation, StagedPipelinePushAllocatesNothingOnceWarm)
 		EXPECT_EQ(after - before, 0) << "push() allocated on frames of a size it had seen, latency " << latency;
 	}
 }
+
+/* Mode::Track: the regions, the tracks and the band allocate nothing once a
+ * frame of the size was seen, whether a frame is read in regions or whole. */
+TEST(NoAllocationTrack, FramesReadInRegionsAllocateNothingOnceWarm)
+{
+	const std::vector<Image> s = scenes();
+	Config config;
+	config.mode = Mode::Track;
+	Detector det(config);
+	for (int k = 0; k < 12; ++k) /* a six times, b six times: scene changes and tracked frames */
+		det.detect(s[static_cast<std::size_t>(k / 6) % 2].view());
+	int regions = 0;
+	const long before = gAllocations.load();
+	for (int k = 12; k < 24; ++k) {
+		const Result &r = det.detect(s[static_cast<std::size_t>(k / 6) % 2].view());
+		EXPECT_EQ(r.markers.size(), 6u) << k;
+		regions += r.whole_frame ? 0 : 1;
+	}
+	const long after = gAllocations.load();
+	EXPECT_GE(regions, 6);
+	EXPECT_EQ(after - before, 0) << "detect() allocated in Mode::Track on frames of a size it had seen";
+}

@@ -65,7 +65,7 @@ TEST(Settings, RangesAreTheValidations)
 		Config c;
 		const bool dictionaryBound = s.name == "max_hamming"; /* the widest over the dictionaries */
 		if (dictionaryBound)
-			c.dictionary = "7x7_1000";
+			c.dictionary = "apriltag_standard52h13";
 		if (!s.min_open) {
 			s.setNumber(c, s.min);
 			EXPECT_TRUE(accepted(c)) << s.text(c);

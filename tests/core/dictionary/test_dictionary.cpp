@@ -22,6 +22,9 @@ TEST(Dictionary, AllSharedDictionariesAreBuiltIn)
 		"6x6_50", "6x6_100", "6x6_250", "6x6_1000", "7x7_50", "7x7_100", "7x7_250", "7x7_1000",
 		"apriltag_16h5", "apriltag_25h9", "apriltag_36h10", "apriltag_36h11", "aruco_mip_36h12",
 		"aruco_original",
+		/* AprilTag 3's layout families (issue 32) */
+		"apriltag_standard41h12", "apriltag_standard52h13", "apriltag_circle21h7", "apriltag_circle49h12",
+		"apriltag_custom48h12",
 	};
 	std::set<std::string_view> got;
 	for (const Dictionary &d : dictionaries())
@@ -87,8 +90,11 @@ TEST(Dictionary, RotateCodeTurnsTheGridClockwise)
 		for (int id = 0; id < d.size(); id += 7) {
 			std::uint64_t c = d.codes[id];
 			for (int r = 0; r < 4; ++r)
-				c = rotateCode(c, d.bits);
+				c = d.rotate(c);
 			ASSERT_EQ(c, d.codes[id]) << d.name << " id " << id;
+			if (!d.layout) {
+				ASSERT_EQ(d.rotate(c), rotateCode(c, d.bits)) << d.name;
+			}
 		}
 	}
 }
@@ -114,9 +120,10 @@ TEST(Dictionary, RotateCodeRefusesGridsBeyondSixtyFourBits)
 
 namespace {
 
-std::uint64_t flipBits(std::uint64_t code, int bits, int flips, std::mt19937 &rng)
+/* `width`: the code's bits (Dictionary::codeBits()). */
+std::uint64_t flipBits(std::uint64_t code, int width, int flips, std::mt19937 &rng)
 {
-	std::uniform_int_distribution<int> pick(0, bits * bits - 1);
+	std::uniform_int_distribution<int> pick(0, width - 1);
 	std::uint64_t mask = 0;
 	while (std::popcount(mask) < flips)
 		mask |= 1ull << pick(rng);
@@ -132,17 +139,18 @@ TEST_P(DictionaryDecode, EveryCodeEveryRotationUpToMaxHamming)
 	const Dictionary &d = dictionaries()[GetParam()];
 	const int h = d.defaultMaxHamming();
 	std::mt19937 rng(1234 + GetParam());
-	/* The 1000-code dictionaries take every 3rd id to bound the run time. */
-	const int step = d.size() > 600 ? 3 : 1;
+	/* The 1000-code dictionaries take every 3rd id to bound the run time;
+	 * AprilTag 3's large families (up to 65535 codes, each read a scan) every 500th. */
+	const int step = d.size() > 4096 ? 500 : d.size() > 600 ? 3 : 1;
 	for (int id = 0; id < d.size(); id += step) {
 		/* Seen with the marker turned r quarter turns clockwise, the marker's
 		 * top-left corner sits at quad corner r. */
 		for (int r = 0; r < 4; ++r) {
 			std::uint64_t grid = d.codes[id];
 			for (int t = 0; t < r; ++t)
-				grid = rotateCode(grid, d.bits);
+				grid = d.rotate(grid);
 			const int flips = (id + r) % (h + 1);
-			const std::uint64_t seen = flipBits(grid, d.bits, flips, rng);
+			const std::uint64_t seen = flipBits(grid, d.codeBits(), flips, rng);
 			const detail::Decoded got = detail::decode(d, seen, h);
 			if (got.id != id && d.min_hamming == 0) {
 				/* aruco_original has rotation-symmetric and duplicate
@@ -167,7 +175,7 @@ TEST_P(DictionaryDecode, OneMoreFlipThanMaxHammingIsRejected)
 		GTEST_SKIP() << d.name << ": h_thr + 1 flips may land within h_thr of another code";
 	std::mt19937 rng(99 + GetParam());
 	for (int id = 0; id < d.size(); id += 5) {
-		const std::uint64_t seen = flipBits(d.codes[id], d.bits, h + 1, rng);
+		const std::uint64_t seen = flipBits(d.codes[id], d.codeBits(), h + 1, rng);
 		const detail::Decoded got = detail::decode(d, seen, h);
 		ASSERT_EQ(got.id, -1) << d.name << " id " << id << " decoded as " << got.id;
 	}
@@ -190,19 +198,19 @@ TEST_P(DictionaryDecode, CodeBookAnswersAsTheScan)
 		ASSERT_EQ(b.hamming, a.hamming) << d.name << " code " << seen;
 		ASSERT_EQ(b.rotation, a.rotation) << d.name << " code " << seen;
 	};
-	const int step = d.size() > 600 ? 7 : 1;
+	const int step = d.size() > 4096 ? 500 : d.size() > 600 ? 7 : 1;
 	int exact = 0;
 	for (int id = 0; id < d.size(); id += step) {
 		std::uint64_t grid = d.codes[id];
-		for (int r = 0; r < 4; ++r, grid = rotateCode(grid, d.bits)) {
+		for (int r = 0; r < 4; ++r, grid = d.rotate(grid)) {
 			expectSame(grid, h);
 			expectSame(grid, 0);
 			exact += detail::decode(d, grid, 0).id >= 0;
-			expectSame(flipBits(grid, d.bits, 1 + (id + r) % (h + 1), rng), h);
+			expectSame(flipBits(grid, d.codeBits(), 1 + (id + r) % (h + 1), rng), h);
 		}
 	}
 	EXPECT_GT(exact, d.size() / step);
-	const std::uint64_t all = d.bits * d.bits == 64 ? ~std::uint64_t{ 0 } : (std::uint64_t{ 1 } << (d.bits * d.bits)) - 1;
+	const std::uint64_t all = d.codeBits() == 64 ? ~std::uint64_t{ 0 } : (std::uint64_t{ 1 } << d.codeBits()) - 1;
 	for (int k = 0; k < 200; ++k)
 		expectSame((static_cast<std::uint64_t>(rng()) << 32 | rng()) & all, h);
 	expectSame(d.codes[0], -1);

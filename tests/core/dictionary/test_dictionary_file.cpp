@@ -31,6 +31,10 @@ void expectSame(const Dictionary &got, const Dictionary &want)
 	EXPECT_EQ(got.bits, want.bits) << want.name;
 	EXPECT_EQ(got.min_hamming, want.min_hamming) << want.name;
 	EXPECT_EQ(got.opencv_max_correction, want.opencv_max_correction) << want.name;
+	ASSERT_EQ(got.layout != nullptr, want.layout != nullptr) << want.name;
+	if (want.layout) {
+		EXPECT_EQ(got.layout->cells, want.layout->cells) << want.name;
+	}
 	ASSERT_EQ(got.size(), want.size()) << want.name;
 	for (int id = 0; id < want.size(); ++id)
 		ASSERT_EQ(got.codes[id], want.codes[id]) << want.name << " id " << id;

@@ -612,3 +612,72 @@ TEST(ReadCellCentres, AnotherFamilyOnTheWrongGrid)
 	}
 	EXPECT_LE(read, 2);
 }
+
+/* ---- plain codewords (the shapes of letters) ---- */
+
+/* The plain codes of each built-in dictionary, counted by hand from the
+ * rule (at most 0.6 n (n + 1) black-white changes, border included): ArUco's
+ * original dictionary's hollow rectangle (id 1023, every row 01110) is one,
+ * a code of changes everywhere is not; AprilTag's families, made to avoid
+ * simple shapes, have none. */
+TEST(PlainCode, HollowShapesAndBarsArePlain)
+{
+	const Dictionary &original = *findDictionary("aruco_original");
+	const detail::CodeBook book(original);
+	EXPECT_TRUE(book.plain(1023));
+	EXPECT_TRUE(detail::plainCode(0, 4));                   /* all black: no change at all */
+	EXPECT_FALSE(detail::plainCode(0b1010'0101'1010'0101u, 4)); /* a checkerboard: 32 changes */
+	EXPECT_TRUE(detail::plainCode(0b0110'0110'0110'0110u, 4));  /* a bar, 2 wide: 12 of 20 */
+	EXPECT_FALSE(detail::plainCode(0b0110'1111'0110'0000u, 4)); /* a plus, 13 changes */
+	auto count = [](const char *name) {
+		const Dictionary &d = *findDictionary(name);
+		const detail::CodeBook b(d);
+		int n = 0;
+		for (int id = 0; id < d.size(); ++id)
+			n += b.plain(id);
+		return n;
+	};
+	EXPECT_EQ(count("aruco_original"), 12);
+	EXPECT_EQ(count("4x4_1000"), 29);
+	EXPECT_EQ(count("4x4_50"), 1);
+	EXPECT_EQ(count("5x5_1000"), 3);
+	for (const char *name : { "apriltag_16h5", "apriltag_25h9", "apriltag_36h10", "apriltag_36h11", "aruco_mip_36h12",
+				  "6x6_250", "7x7_1000" })
+		EXPECT_EQ(count(name), 0) << name;
+}
+
+/* A plain code must be read clearly: with one code cell read at margin 0.2
+ * the plain id 17 of 4x4_50 is refused as a plain shape, a code of many
+ * changes read the same way is not; read clearly, both are markers. */
+TEST(PlainCode, ReadOnlyClearly)
+{
+	const Dictionary &d = *findDictionary("4x4_50");
+	const detail::CodeBook book(d);
+	ASSERT_TRUE(book.plain(17));
+	int busy = -1;
+	for (int id = 0; id < d.size() && busy < 0; ++id)
+		if (!book.plain(id))
+			busy = id;
+	/* Corners far outside the 1 x 1 image: the quiet zone is unknown, so it
+	 * passes; every other check is the grid's. */
+	const Image img(1, 1, 0);
+	const Quad far = square(1000.0f, 1000.0f, 60.0f);
+	detail::DecodePolicy policy;
+	policy.maxHamming = policy.maxTotal = 0;
+	for (int id : { 17, busy }) {
+		detail::WarpedMarker w = gridOf(d.codes[static_cast<std::size_t>(id)], d.bits);
+		detail::Binarised b = detail::binarise(w, d.bits);
+		EXPECT_TRUE(detail::readMarker(img.view(), far, book, policy, w, b).ok()) << id;
+		/* A white code cell at 120: 20 above the threshold of 100. */
+		int white = -1;
+		for (int bit = 0; bit < d.bits * d.bits && white < 0; ++bit)
+			if ((d.codes[static_cast<std::size_t>(id)] >> (d.bits * d.bits - 1 - bit)) & 1u)
+				white = bit;
+		ASSERT_GE(white, 0);
+		setCell(w, 1 + white % d.bits, 1 + white / d.bits, 120, 120, 120, 120);
+		b = detail::binarise(w, d.bits);
+		const detail::MarkerRead r = detail::readMarker(img.view(), far, book, policy, w, b);
+		EXPECT_NEAR(r.margin, 0.2f, 1e-5f) << id;
+		EXPECT_EQ(r.rejection, id == 17 ? detail::Rejection::PlainShape : detail::Rejection::None) << id;
+	}
+}

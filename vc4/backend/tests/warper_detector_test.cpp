@@ -110,21 +110,41 @@ std::vector<std::uint8_t> renderScene(const Dictionary &dict, unsigned seed, int
 
 } // namespace
 
-TEST(Vc4WarperDetector, RenderedScenesGiveTheCpuMarkersToTheBit)
+// Scenes of each dictionary at each blur, seeds from `seed` on, compared.
+Comparison compareScenes(std::initializer_list<const char *> names, std::initializer_list<int> blurs, unsigned seed)
 {
 	Comparison c;
-	unsigned seed = 1;
-	for (const char *name : { "aruco_mip_36h12", "4x4_50", "5x5_100", "apriltag_36h11", "apriltag_16h5", "7x7_50" }) {
+	for (const char *name : names) {
 		const Dictionary &dict = *findDictionary(name);
-		for (int blur : { 0, 2, 4 }) {
+		for (int blur : blurs) {
 			const auto px = renderScene(dict, seed++, blur);
 			expectSameMarkers(ImageView(px.data(), 640, 480, 640), name,
 					  std::string(name) + " blur " + std::to_string(blur), c);
 		}
 	}
+	return c;
+}
+
+TEST(Vc4WarperDetector, RenderedScenesGiveTheCpuMarkersToTheBit)
+{
+	const Comparison c = compareScenes(
+		{ "aruco_mip_36h12", "4x4_50", "5x5_100", "apriltag_36h11", "apriltag_16h5", "7x7_50" }, { 0, 2, 4 }, 1);
 	std::printf("rendered scenes: %zu markers, %u candidates warped on the QPUs\n", c.markers, c.onQpus);
 	EXPECT_GT(c.markers, 150u);
 	EXPECT_GT(c.onQpus, 200u);
+}
+
+// AprilTag 3's layout families (issue 32): each candidate's sample grid is the layout's
+// whole grid, one sample a cell (11 to 13 a side), warped from the detected square: one
+// more quad for the QPUs, and the same markers to the bit.
+TEST(Vc4WarperDetector, LayoutFamiliesGiveTheCpuMarkersToTheBit)
+{
+	const Comparison c = compareScenes({ "apriltag_standard41h12", "apriltag_standard52h13", "apriltag_circle21h7",
+					     "apriltag_circle49h12", "apriltag_custom48h12" },
+					   { 0, 2 }, 100);
+	std::printf("layout scenes: %zu markers, %u candidates warped on the QPUs\n", c.markers, c.onQpus);
+	EXPECT_GT(c.markers, 60u);
+	EXPECT_GT(c.onQpus, 100u);
 }
 
 #if FRAPPE_VC4_TEST_OPENCV

@@ -1,0 +1,157 @@
+// SPDX-License-Identifier: MIT
+// CandidateReader::finish() for a dictionary with a layout (frappe/layout.h): a candidate is
+// the detected square, where a black ring meets a white one (or today's
+// border against its quiet zone); its corners are refined with the edge's
+// own polarity, the layout's whole grid is warped from them (on the QPUs in
+// a batch: the grid is one more quad), and the cells are read against the
+// two rings beside the edge.
+#include <algorithm>
+#include <cmath>
+
+#include "candidate_reader.h"
+#include "corner_refine.h"
+#include "layout_reader.h"
+#include "marker_set.h"
+#include "quad_geometry.h"
+
+namespace frappe {
+
+namespace {
+
+using detail::bigEnough;
+using detail::cellSide;
+using detail::StageTimer;
+using detail::toFullResolution;
+
+std::array<Point2f, 4> reversedOrder(const std::array<Point2f, 4> &q)
+{
+	return { q[0], q[3], q[2], q[1] };
+}
+
+} // namespace
+
+/* refineCorners() finds a light-to-dark step going inwards; a reversed
+ * layout's square is dark outside: the quad is handed over anticlockwise,
+ * which turns its normals outwards. */
+bool detail::CandidateReader::refineLayoutQuad(const ImageView &image, detail::Quad &q, float search) const
+{
+	if (!dict->layout->reversed)
+		return detail::refineCorners(image, q.corners, search);
+	std::array<Point2f, 4> turned = reversedOrder(q.corners);
+	if (!detail::refineCorners(image, turned, search))
+		return false;
+	q.corners = reversedOrder(turned);
+	return true;
+}
+
+/* Batch mode: the candidates read on the frame refined, then their grids
+ * warped in one call. */
+void detail::CandidateReader::refineAndWarpLayouts(const ImageView &image, Slot &slot, float search)
+{
+	const MarkerLayout &layout = *dict->layout;
+	const std::size_t n = slot.quads.size();
+	batch.outlines.resize(n);
+	batch.refined.resize(n);
+	batch.place.resize(n);
+	batch.quads.clear();
+	StageTimer timer(slot.result.times, Stage::Refine);
+	std::array<Point2f, 4> grid;
+	for (std::size_t k = 0; k < n; ++k) {
+		std::array<Point2f, 4> &corners = slot.quads[k].corners;
+		batch.outlines[k] = corners;
+		batch.place[k] = -1;
+		batch.refined[k] = 0;
+		if (detail::readBlock(cellSide(corners, dict->bits)) > 1)
+			continue;
+		batch.refined[k] = refineLayoutQuad(image, slot.quads[k], std::max(search, 2.5f));
+		if (bigEnough(corners, config.min_marker_side) && detail::layoutGrid(corners, layout, grid)) {
+			batch.place[k] = static_cast<int>(batch.quads.size());
+			batch.quads.push_back(grid);
+		}
+	}
+	timer.lap(Stage::Warp);
+	const std::size_t m = batch.quads.size();
+	batch.warpedOk.assign(m, 0);
+	batch.samples.resize(std::max(batch.samples.size(), m));
+	warper->warp(image, batch.quads, detail::layoutGridSide(layout), std::span(batch.samples).first(m),
+		     batch.warpedOk);
+}
+
+bool detail::CandidateReader::readLayoutCandidate(const ImageView &image, Slot &slot, std::size_t k, float search,
+						  StageTimer &timer, Marker &m)
+{
+	const MarkerLayout &layout = *dict->layout;
+	detail::Quad &q = slot.quads[k];
+	const std::array<Point2f, 4> traced = warper ? batch.outlines[k] : q.corners;
+	if (detail::surroundsMarker(traced, detail::quadArea(traced), -1, dict->bits, slot.result.markers,
+				    markerCentres))
+		return false;
+	/* Large cells on the frame halved f times: a patch that holds the
+	 * layout's grid around the square and refinement's reach. */
+	const float cellPx = cellSide(traced, dict->bits);
+	const int f = detail::readBlock(cellPx);
+	const bool inBatch = warper != nullptr && f == 1;
+	const float ff = static_cast<float>(f);
+	const BlockView block =
+		f == 1 ? BlockView{ image }
+		       : blockView(image, f, traced, static_cast<float>(layout.square_start + 2) * cellPx + 14.0f * ff);
+	const Point2f origin{ static_cast<float>(block.ox), static_cast<float>(block.oy) };
+	std::array<Point2f, 4> outline = traced;
+	if (f > 1) {
+		for (int i = 0; i < 4; ++i) {
+			outline[i] = toFullResolution({ outline[i].x - origin.x, outline[i].y - origin.y }, ff);
+			q.corners[i] = outline[i];
+		}
+	}
+	const float minSide = config.min_marker_side / ff;
+	const bool refined = inBatch ? batch.refined[k] != 0
+				     : refineLayoutQuad(block.view, q, std::max(search / ff, 2.5f));
+	/* The refined square first, then the traced one (refinement can
+	 * slide onto a code cell's edge), each on grey levels, then on the
+	 * log scale. */
+	detail::MarkerRead read;
+	bool counted = false;
+	std::array<Point2f, 4> grid;
+	for (const detail::DecodePolicy *pol : { &policy, &logPolicy }) {
+		if (pol == &logPolicy && logPolicy.tone.linear())
+			break;
+		for (int attempt = 0; attempt < 2 && !read.ok(); ++attempt) {
+			if (attempt == 1 && !refined)
+				break;
+			const std::array<Point2f, 4> square = attempt == 0 ? q.corners : outline;
+			if (!bigEnough(square, minSide))
+				continue;
+			timer.lap(Stage::Warp);
+			const detail::WarpedMarker *samples = nullptr;
+			if (attempt == 0 && inBatch && batch.place[k] >= 0 &&
+			    batch.warpedOk[static_cast<std::size_t>(batch.place[k])]) {
+				samples = &batch.samples[static_cast<std::size_t>(batch.place[k])];
+				if (!pol->tone.linear()) {
+					warped = *samples;
+					pol->tone.apply(warped);
+					samples = &warped;
+				}
+			} else if (detail::layoutGrid(square, layout, grid) &&
+				   detail::warpToGrid(block.view, grid, detail::layoutGridSide(layout), warped)) {
+				pol->tone.apply(warped);
+				samples = &warped;
+			}
+			if (!samples)
+				continue;
+			counted = true;
+			timer.lap(Stage::Decode);
+			read = detail::decodeLayout(detail::readLayoutCells(*samples, layout, pol->weakMargin), *codes, *pol);
+			if (read.ok())
+				q.corners = square;
+		}
+		if (read.ok())
+			break;
+	}
+	slot.result.candidates += counted;
+	if (!read.ok())
+		return false;
+	toMarker(q, f, block, read, m);
+	return true;
+}
+
+} // namespace frappe
