@@ -6,6 +6,7 @@
 #include "frappe_backend.h"
 
 #include <algorithm>
+#include <iterator>
 #include <utility>
 #include <vector>
 
@@ -15,8 +16,35 @@
 
 namespace frappe {
 
+namespace {
+
+constexpr BackendName kBackends[] = {
+	{ "auto", "The Raspberry Pi's QPUs when they can be used, else the CPU (with one warning on a Pi)" },
+	{ "cpu", "The reference CPU front end" },
+	{ "vc4", "The QPU kernels on the VideoCore IV GPU (Pi Zero, 1, 2, 3)" },
+	{ "vc4-emu", "The QPU kernels on an emulator: bit-exact with vc4, slow; for testing" },
+};
+
+} // namespace
+
+std::span<const BackendName> backendNames()
+{
+	return kBackends;
+}
+
+std::string backendNameList(std::string_view separator)
+{
+	std::string out;
+	for (const BackendName &b : kBackends)
+		out += (out.empty() ? "" : std::string(separator)) + std::string(b.name);
+	return out;
+}
+
 std::string selectBackend(Pipeline &pipeline, std::string_view name)
 {
+	if (std::none_of(std::begin(kBackends), std::end(kBackends),
+			 [&](const BackendName &b) { return b.name == name; }))
+		throw std::invalid_argument("unknown backend '" + std::string(name) + "' (" + backendNameList() + ")");
 	/* The detectors' own front end already is the CPU one. */
 	if (name == "cpu")
 		return {};
@@ -35,9 +63,7 @@ std::string selectBackend(Pipeline &pipeline, std::string_view name)
 	(void)pipeline;
 	if (name == "auto")
 		return {};
-	if (name == "vc4" || name == "vc4-emu")
-		throw BackendNotBuilt("backend " + std::string(name) + " needs vc4/, which this build lacks");
-	throw std::invalid_argument("unknown backend '" + std::string(name) + "' (auto, cpu, vc4, vc4-emu)");
+	throw BackendNotBuilt("backend " + std::string(name) + " needs vc4/, which this build lacks");
 #endif
 }
 

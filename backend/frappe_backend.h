@@ -10,6 +10,7 @@
 #include <cstddef>
 #include <stdexcept>
 #include <string>
+#include <span>
 #include <string_view>
 
 #include <frappe/pipeline.h>
@@ -22,6 +23,16 @@ class BackendNotBuilt : public std::runtime_error
 public:
 	using std::runtime_error::runtime_error;
 };
+
+/* A front end a user may name: the one list the element's backend enum,
+ * the CLI's --backend and its --help are made from. */
+struct BackendName {
+	std::string_view name; /* "auto", "cpu", "vc4", "vc4-emu" */
+	std::string_view doc;  /* one line */
+};
+std::span<const BackendName> backendNames();
+/* "auto, cpu, vc4, vc4-emu". */
+std::string backendNameList(std::string_view separator = ", ");
 
 /*
  * Puts the front end named `name` into every detector of `pipeline`: "cpu"

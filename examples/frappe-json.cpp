@@ -10,11 +10,12 @@
 //   frappe-json -p 'PIPELINE'        a pipeline with an appsink named "sink"
 //
 // Lines look like
-//   {"source":"meta","pts":33333333,"markers":[{"id":7,"dictionary":"aruco_mip_36h12",
-//    "corners":[[x0,y0],[x1,y1],[x2,y2],[x3,y3]],"hamming":0}]}
-// with "rvec", "tvec" (metres) and "reprojection_error" added when the
-// element knows the marker size and the camera matrix.
-#include <cmath>
+//   {"source": "meta", "pts": 33333333, "markers": [{"id": 7, "dictionary": "aruco_mip_36h12",
+//    "corners": [[x0, y0], [x1, y1], [x2, y2], [x3, y3]], "hamming": 0, "margin": 0.93}]}
+// with "rvec", "tvec" (metres) and the reprojection errors added when the
+// element knows the marker size and the camera matrix: each marker as the
+// library's one writer makes it (frappe/marker_record.h), as frappejson and
+// frappe-detect write theirs.
 #include <cstdio>
 #include <cstring>
 #include <string>
@@ -23,76 +24,68 @@
 #include <gst/gst.h>
 
 #include <gstfrappemeta.h>
+#include <gstfrappemeta-record.h>
 
 namespace {
 
-std::string number(double v)
+/* The meta's marker in the library's record (gstfrappemeta-record.h),
+ * written by the one JSON writer frappejson and frappe-detect use too. */
+void appendMeta(std::string &out, const GstFrappeMarkerMeta &m)
 {
-	if (!std::isfinite(v))
-		return "null";
-	char buf[32];
-	std::snprintf(buf, sizeof(buf), "%.4f", v);
-	return buf;
+	frappe::appendMarkerJson(out, frappe::gst::MetaRecord(m).record(), frappe::JsonNumbers::Exact);
 }
 
-std::string vec3(const double *v)
+std::string timeOrNull(guint64 t)
 {
-	std::string out = "[";
-	for (int i = 0; i < 3; ++i) {
-		if (i)
-			out += ',';
-		out += number(v[i]);
-	}
-	out += ']';
-	return out;
+	return GST_CLOCK_TIME_IS_VALID(t) ? std::to_string(t) : "null";
 }
 
 std::string fromMeta(GstBuffer *buf)
 {
-	std::string out = "{\"source\":\"meta\",\"pts\":" +
-			  (GST_BUFFER_PTS_IS_VALID(buf) ? std::to_string(GST_BUFFER_PTS(buf)) : "null") +
-			  ",\"markers\":[";
+	std::string out = "{\"source\": \"meta\", \"pts\": " + timeOrNull(GST_BUFFER_PTS(buf)) + ", \"markers\": [";
 	gpointer state = nullptr;
-	GstMeta *meta;
 	bool first = true;
-	while ((meta = gst_buffer_iterate_meta_filtered(buf, &state, GST_FRAPPE_MARKER_META_API_TYPE))) {
-		const auto *m = reinterpret_cast<const GstFrappeMarkerMeta *>(meta);
-		out += first ? "" : ",";
+	while (GstMeta *meta = gst_buffer_iterate_meta_filtered(buf, &state, GST_FRAPPE_MARKER_META_API_TYPE)) {
+		out += first ? "" : ", ";
 		first = false;
-		out += "{\"id\":" + std::to_string(m->id) + ",\"dictionary\":\"" +
-		       (m->dictionary ? m->dictionary : "") + "\",\"corners\":[";
-		for (int k = 0; k < 4; ++k)
-		{
-			out += k ? ",[" : "[";
-			out += number(m->corners[2 * k]);
-			out += ',';
-			out += number(m->corners[2 * k + 1]);
-			out += ']';
-		}
-		out += "],\"hamming\":" + std::to_string(m->hamming);
-		if (m->has_pose)
-			out += ",\"rvec\":" + vec3(m->rvec) + ",\"tvec\":" + vec3(m->tvec) +
-			       ",\"reprojection_error\":" + number(m->reprojection_error) +
-			       ",\"alternative_reprojection_error\":" + number(m->alternative_reprojection_error);
-		out += "}";
+		appendMeta(out, *reinterpret_cast<const GstFrappeMarkerMeta *>(meta));
 	}
 	return out + "]}";
 }
 
-std::string doubles(const GValue *array, int group)
+double arrayValue(const GstStructure *s, const char *field, guint i)
 {
-	std::string out = "[";
-	const guint n = gst_value_array_get_size(array);
-	for (guint i = 0; i < n; ++i) {
-		if (group > 1 && i % static_cast<guint>(group) == 0)
-			out += i ? ",[" : "[";
-		else if (i)
-			out += ",";
-		out += number(g_value_get_double(gst_value_array_get_value(array, i)));
-		if (group > 1 && i % static_cast<guint>(group) == static_cast<guint>(group - 1))
-			out += "]";
+	const GValue *array = gst_structure_get_value(s, field);
+	return array && i < gst_value_array_get_size(array) ? g_value_get_double(gst_value_array_get_value(array, i))
+							    : 0.0;
+}
+
+/* The message's marker: the same record, from the structure's fields
+ * (the list's names in kebab-case). */
+void appendMessageMarker(std::string &out, const GstStructure *m)
+{
+	frappe::Marker marker;
+	guint hamming = 0;
+	gdouble margin = 0.0;
+	gst_structure_get_int(m, "id", &marker.id);
+	gst_structure_get_uint(m, "hamming", &hamming);
+	gst_structure_get_double(m, "margin", &margin);
+	marker.hamming = static_cast<int>(hamming);
+	marker.margin = static_cast<float>(margin);
+	for (guint k = 0; k < 4; ++k)
+		marker.corners[k] = { static_cast<float>(arrayValue(m, "corners", 2 * k)),
+				      static_cast<float>(arrayValue(m, "corners", 2 * k + 1)) };
+	frappe::MarkerPose pose;
+	const bool hasPose = gst_structure_has_field(m, "tvec");
+	for (guint k = 0; k < 3; ++k) {
+		pose.pose.rvec[k] = arrayValue(m, "rvec", k);
+		pose.pose.tvec[k] = arrayValue(m, "tvec", k);
 	}
-	return out + "]";
+	gst_structure_get_double(m, "reprojection-error", &pose.pose.error);
+	gst_structure_get_double(m, "alternative-reprojection-error", &pose.alternative.error);
+	const char *dict = gst_structure_get_string(m, "dictionary");
+	frappe::appendMarkerJson(out, { &marker, dict ? dict : "", hasPose ? &pose : nullptr },
+				 frappe::JsonNumbers::Exact);
 }
 
 std::string fromMessage(const GstStructure *s)
@@ -100,31 +93,13 @@ std::string fromMessage(const GstStructure *s)
 	guint64 ts = GST_CLOCK_TIME_NONE, rt = GST_CLOCK_TIME_NONE;
 	gst_structure_get_uint64(s, "timestamp", &ts);
 	gst_structure_get_uint64(s, "running-time", &rt);
-	std::string out = "{\"source\":\"message\",\"timestamp\":" +
-			  (GST_CLOCK_TIME_IS_VALID(ts) ? std::to_string(ts) : "null") + ",\"running_time\":" +
-			  (GST_CLOCK_TIME_IS_VALID(rt) ? std::to_string(rt) : "null") + ",\"markers\":[";
+	std::string out = "{\"source\": \"message\", \"timestamp\": " + timeOrNull(ts) +
+			  ", \"running_time\": " + timeOrNull(rt) + ", \"markers\": [";
 	const GValue *markers = gst_structure_get_value(s, "markers");
 	const guint n = markers ? gst_value_list_get_size(markers) : 0;
 	for (guint i = 0; i < n; ++i) {
-		const GstStructure *m = gst_value_get_structure(gst_value_list_get_value(markers, i));
-		int id = -1;
-		guint hamming = 0;
-		gst_structure_get_int(m, "id", &id);
-		gst_structure_get_uint(m, "hamming", &hamming);
-		const char *dict = gst_structure_get_string(m, "dictionary");
-		out += i ? ",{" : "{";
-		out += "\"id\":" + std::to_string(id) + ",\"dictionary\":\"" +
-		       (dict ? dict : "") + "\",\"corners\":" + doubles(gst_structure_get_value(m, "corners"), 2) +
-		       ",\"hamming\":" + std::to_string(hamming);
-		if (gst_structure_has_field(m, "tvec")) {
-			double err = 0, alt = 0;
-			gst_structure_get_double(m, "reprojection-error", &err);
-			gst_structure_get_double(m, "alternative-reprojection-error", &alt);
-			out += ",\"rvec\":" + doubles(gst_structure_get_value(m, "rvec"), 1) +
-			       ",\"tvec\":" + doubles(gst_structure_get_value(m, "tvec"), 1) +
-			       ",\"reprojection_error\":" + number(err) + ",\"alternative_reprojection_error\":" + number(alt);
-		}
-		out += "}";
+		out += i ? ", " : "";
+		appendMessageMarker(out, gst_value_get_structure(gst_value_list_get_value(markers, i)));
 	}
 	return out + "]}";
 }

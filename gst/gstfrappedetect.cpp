@@ -46,8 +46,13 @@
  *   `alternative-reprojection-error` (double: the error of the other planar
  *   solution; close to `reprojection-error` when the pose is ambiguous).
  *
- * #GstFrappeDetect:dictionary takes the library's names (`apriltag_36h11`)
- * or the same with dashes (`apriltag-36h11`); #GstFrappeDetect:dictionary-file
+ * The detector's properties are the library's settings table
+ * (frappe/settings.h, docs/settings.md): one per frappe::Config field, named
+ * in kebab-case, with its default and range. #GstFrappeDetect:dictionary
+ * takes every spelling the library does: its names (`apriltag_36h11`), the
+ * same with dashes (`apriltag-36h11`), OpenCV's (`DICT_APRILTAG_36h11`) and
+ * AprilTag's (`tag36h11`), and reads back as the library's; an unknown name
+ * is a warning listing the known ones. #GstFrappeDetect:dictionary-file
  * a dictionary of one's own (frappe::loadDictionary), used instead; metas
  * and messages carry the dictionary's name.
  *
@@ -231,8 +236,8 @@ static const char *overlap_name(Overlap o)
 /* A pipeline of the active settings with its front end, or nullptr after
  * an element error. Not pipelined: frames one at a time on one thread.
  * Pipelined, one frame held either way: whole frames on two detectors and
- * threads (frappe::Pipeline::Mode::Frames, latency 1), or one detector's
- * stages (Mode::Stages, latency 1: the next frame's front end beside this
+ * threads (frappe::Pipeline::Overlap::Frames, latency 1), or one detector's
+ * stages (Overlap::Stages, latency 1: the next frame's front end beside this
  * frame's trace). */
 static std::unique_ptr<frappe::Pipeline> make_pipeline(GstFrappeDetect *self, Overlap overlap,
 						       GstFrappeBackend backend)
@@ -241,9 +246,10 @@ static std::unique_ptr<frappe::Pipeline> make_pipeline(GstFrappeDetect *self, Ov
 	const bool staged = overlap == Overlap::Stages;
 	std::unique_ptr<frappe::Pipeline> pipeline;
 	try {
-		pipeline = std::make_unique<frappe::Pipeline>(
-			priv->active.config(staged), staged ? frappe::Pipeline::Mode::Stages : frappe::Pipeline::Mode::Frames,
-			overlap == Overlap::None ? 0 : 1);
+		pipeline = std::make_unique<frappe::Pipeline>(priv->active.config(staged),
+							      staged ? frappe::Pipeline::Overlap::Stages
+								     : frappe::Pipeline::Overlap::Frames,
+							      overlap == Overlap::None ? 0 : 1);
 	} catch (const std::exception &e) {
 		GST_ELEMENT_ERROR(self, LIBRARY, SETTINGS, ("Invalid detector settings"), ("%s", e.what()));
 		return nullptr;
@@ -289,8 +295,7 @@ static bool ensure_pipeline(GstFrappeDetect *self)
 	GST_DEBUG_OBJECT(self,
 			 "pipeline for %s, mode %s, max-hamming %d, front end %s, overlap %s, %d thread(s), "
 			 "%u QPU context(s) opened",
-			 priv->dictionary.c_str(),
-			 s.mode == GST_FRAPPE_MODE_ASCALE ? "ascale" : s.mode == GST_FRAPPE_MODE_TRACK ? "track" : "normal",
+			 priv->dictionary.c_str(), std::string(frappe::modeName(s.library.mode)).c_str(),
 			 priv->pipeline->detector().maxHamming(), priv->pipeline->detector().frontEnd().name(),
 			 overlap_name(overlap), priv->pipeline->threads(), priv->qpuContexts);
 	return true;
@@ -767,7 +772,5 @@ static void gst_frappe_detect_class_init(GstFrappeDetectClass *klass)
 	trans_class->stop = GST_DEBUG_FUNCPTR(gst_frappe_detect_stop);
 	filter_class->set_info = GST_DEBUG_FUNCPTR(gst_frappe_detect_set_info);
 
-	gst_type_mark_as_plugin_api(GST_TYPE_FRAPPE_MODE, static_cast<GstPluginAPIFlags>(0));
 	gst_type_mark_as_plugin_api(GST_TYPE_FRAPPE_BACKEND, static_cast<GstPluginAPIFlags>(0));
-	gst_type_mark_as_plugin_api(GST_TYPE_FRAPPE_DICTIONARY, static_cast<GstPluginAPIFlags>(0));
 }

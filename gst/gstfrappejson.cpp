@@ -53,11 +53,11 @@
 #include "gstfrappejson.h"
 
 #include <charconv>
-#include <cmath>
 #include <string>
 
 #include <gst/video/video.h>
 
+#include "gstfrappemeta-record.h"
 #include "gstfrappemeta.h"
 
 GST_DEBUG_CATEGORY_STATIC(gst_frappe_json_debug);
@@ -92,93 +92,11 @@ static GstStaticPadTemplate src_template =
 
 namespace {
 
-/* Numbers in their shortest exact form (std::to_chars allocates nothing);
- * NaN and infinities, which JSON cannot hold, as null. */
-template<typename T>
-void appendNumber(std::string &out, T v)
-{
-	if constexpr (std::is_floating_point_v<T>) {
-		if (!std::isfinite(v)) {
-			out += "null";
-			return;
-		}
-	}
-	char text[32];
-	const auto r = std::to_chars(text, text + sizeof(text), v);
-	out.append(text, r.ptr);
-}
-
-/* A JSON string, valid UTF-8 whatever the meta holds (any application may
- * attach one): a byte that is not part of valid UTF-8 is written \\u00XX,
- * as frappe-detect writes file names. */
-void appendString(std::string &out, const char *s)
-{
-	static const char hex[] = "0123456789abcdef";
-	out += '"';
-	while (s && *s) {
-		const unsigned char c = static_cast<unsigned char>(*s);
-		if (c >= 0x80) {
-			if (static_cast<gint32>(g_utf8_get_char_validated(s, -1)) >= 0) {
-				const char *next = g_utf8_next_char(s);
-				out.append(s, next);
-				s = next;
-				continue;
-			}
-		}
-		if (c == '"' || c == '\\') {
-			out += '\\';
-			out += static_cast<char>(c);
-		} else if (c < 0x20 || c >= 0x80) {
-			out += "\\u00";
-			out += hex[c >> 4];
-			out += hex[c & 15];
-		} else {
-			out += static_cast<char>(c);
-		}
-		++s;
-	}
-	out += '"';
-}
-
-template<typename T>
-void appendArray(std::string &out, const T *v, int n)
-{
-	out += '[';
-	for (int i = 0; i < n; ++i) {
-		if (i)
-			out += ", ";
-		appendNumber(out, v[i]);
-	}
-	out += ']';
-}
-
+/* A meta as the library's marker record, written by its one JSON writer
+ * (frappe/marker_record.h): the fields every output has, in one order. */
 void appendMarker(std::string &out, const GstFrappeMarkerMeta &m)
 {
-	out += "{\"id\": ";
-	appendNumber(out, m.id);
-	out += ", \"dictionary\": ";
-	appendString(out, m.dictionary);
-	out += ", \"corners\": [";
-	for (int k = 0; k < 4; ++k) {
-		if (k)
-			out += ", ";
-		appendArray(out, m.corners + 2 * k, 2);
-	}
-	out += "], \"hamming\": ";
-	appendNumber(out, m.hamming);
-	out += ", \"margin\": ";
-	appendNumber(out, m.margin);
-	if (m.has_pose) {
-		out += ", \"rvec\": ";
-		appendArray(out, m.rvec, 3);
-		out += ", \"tvec\": ";
-		appendArray(out, m.tvec, 3);
-		out += ", \"reprojection_error\": ";
-		appendNumber(out, m.reprojection_error);
-		out += ", \"alternative_reprojection_error\": ";
-		appendNumber(out, m.alternative_reprojection_error);
-	}
-	out += '}';
+	frappe::appendMarkerJson(out, frappe::gst::MetaRecord(m).record(), frappe::JsonNumbers::Exact);
 }
 
 /* The buffer's line, into `out`. */
@@ -186,9 +104,11 @@ void formatLine(std::string &out, GstBuffer *buffer)
 {
 	out.clear();
 	out += "{\"pts\": ";
-	if (GST_BUFFER_PTS_IS_VALID(buffer))
-		appendNumber(out, static_cast<guint64>(GST_BUFFER_PTS(buffer)));
-	else
+	if (GST_BUFFER_PTS_IS_VALID(buffer)) {
+		char text[24];
+		const auto r = std::to_chars(text, text + sizeof(text), static_cast<guint64>(GST_BUFFER_PTS(buffer)));
+		out.append(text, r.ptr);
+	} else
 		out += "null";
 	out += ", \"markers\": [";
 	gpointer state = nullptr;

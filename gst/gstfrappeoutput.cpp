@@ -9,9 +9,12 @@
 #include <cstddef>
 #include <cstdio>
 #include <string>
+#include <type_traits>
 #include <utility>
 
 #include <gst/video/video.h>
+
+#include <frappe/marker_record.h>
 
 #include "gstfrappemeta.h"
 
@@ -35,25 +38,54 @@ void addDoubleArray(GstStructure *s, const char *field, const double *v, int n)
 	gst_structure_take_value(s, field, &array);
 }
 
+/* A field name of the library's list in GStreamer's kebab-case. */
+const char *kebab(std::string_view name)
+{
+	std::string k(name);
+	std::replace(k.begin(), k.end(), '_', '-');
+	return g_intern_string(k.c_str());
+}
+
+/* Adds the fields of frappe::forEachMarkerField() to `s`, the arrays only
+ * when `arrays` (an ROI's parameters are the scalars). */
+void addMarkerFields(GstStructure *s, const frappe::MarkerRecord &r, bool arrays)
+{
+	frappe::forEachMarkerField(r, [&](std::string_view name, const auto &value) {
+		using T = std::remove_cvref_t<decltype(value)>;
+		const char *field = kebab(name);
+		if constexpr (std::is_same_v<T, std::string_view>) {
+			const std::string text(value);
+			gst_structure_set(s, field, G_TYPE_STRING, text.c_str(), nullptr);
+		} else if constexpr (std::is_same_v<T, frappe::Count>) {
+			gst_structure_set(s, field, G_TYPE_UINT, static_cast<guint>(value.value), nullptr);
+		} else if constexpr (std::is_same_v<T, bool>) {
+			gst_structure_set(s, field, G_TYPE_BOOLEAN, value ? TRUE : FALSE, nullptr);
+		} else if constexpr (std::is_same_v<T, int>) {
+			gst_structure_set(s, field, G_TYPE_INT, value, nullptr);
+		} else if constexpr (std::is_floating_point_v<T>) {
+			gst_structure_set(s, field, G_TYPE_DOUBLE, static_cast<gdouble>(value), nullptr);
+		} else if constexpr (std::is_same_v<T, std::array<Point2f, 4>>) {
+			if (!arrays)
+				return;
+			double corners[8];
+			for (std::size_t k = 0; k < 4; ++k) {
+				corners[2 * k] = value[k].x;
+				corners[2 * k + 1] = value[k].y;
+			}
+			addDoubleArray(s, field, corners, 8);
+		} else {
+			if (arrays)
+				addDoubleArray(s, field, value.data(), static_cast<int>(value.size()));
+		}
+	});
+}
+
+/* The message's marker: every field of the library's list. */
 GstStructure *markerStructure(const Marker &m, const std::optional<frappe::MarkerPose> &pose,
 			      const char *dictionary)
 {
-	GstStructure *ms = gst_structure_new("marker", "id", G_TYPE_INT, m.id, "dictionary", G_TYPE_STRING,
-					     dictionary, nullptr);
-	double corners[8];
-	for (int k = 0; k < 4; ++k) {
-		corners[2 * k] = m.corners[static_cast<std::size_t>(k)].x;
-		corners[2 * k + 1] = m.corners[static_cast<std::size_t>(k)].y;
-	}
-	addDoubleArray(ms, "corners", corners, 8);
-	gst_structure_set(ms, "hamming", G_TYPE_UINT, static_cast<guint>(m.hamming), "margin", G_TYPE_DOUBLE,
-			  static_cast<gdouble>(m.margin), "tracked", G_TYPE_BOOLEAN, m.tracked ? TRUE : FALSE, nullptr);
-	if (pose) {
-		addDoubleArray(ms, "rvec", pose->pose.rvec.data(), 3);
-		addDoubleArray(ms, "tvec", pose->pose.tvec.data(), 3);
-		gst_structure_set(ms, "reprojection-error", G_TYPE_DOUBLE, pose->pose.error,
-				  "alternative-reprojection-error", G_TYPE_DOUBLE, pose->alternative.error, nullptr);
-	}
+	GstStructure *ms = gst_structure_new_empty("marker");
+	addMarkerFields(ms, { &m, dictionary, pose ? &*pose : nullptr, true }, true);
 	return ms;
 }
 
@@ -99,11 +131,9 @@ void attachMarkerMetas(GstBuffer *buffer, gint width, gint height, const Result 
 			static_cast<guint>(x1 - x0), static_cast<guint>(y1 - y0));
 		if (roi) {
 			roi->id = static_cast<gint>(i);
-			gst_video_region_of_interest_meta_add_param(
-				roi, gst_structure_new(GST_FRAPPE_ROI_TYPE, "id", G_TYPE_INT, m.id, "dictionary",
-						       G_TYPE_STRING, dictionary, "hamming", G_TYPE_UINT,
-						       static_cast<guint>(m.hamming), "margin", G_TYPE_DOUBLE,
-						       static_cast<gdouble>(m.margin), nullptr));
+			GstStructure *param = gst_structure_new_empty(GST_FRAPPE_ROI_TYPE);
+			addMarkerFields(param, { &m, dictionary, nullptr }, false);
+			gst_video_region_of_interest_meta_add_param(roi, param);
 		}
 	}
 }

@@ -5,6 +5,9 @@
 #include "gstfrappesettings.h"
 
 #include <algorithm>
+#include <cmath>
+#include <type_traits>
+#include <variant>
 #include <cstddef>
 #include <exception>
 #include <string>
@@ -21,30 +24,62 @@ namespace frappe::gst {
 
 namespace {
 
-/*
- * The ranges frappe::Config's validation (the Detector constructor)
- * accepts. The library does not export them; test-gst-settings builds a
- * Detector at both ends of every range to keep the two in step. A
- * GParamSpec range is closed, so edge_threshold's (0, 4] starts at 0.001.
- */
-constexpr gfloat kEdgeThresholdMin = 0.001f, kEdgeThresholdMax = 4.0f;
-constexpr gfloat kCornerThresholdMin = 0.0f, kCornerThresholdMax = 100.0f;
-constexpr gfloat kRegionContrastMin = 0.0f, kRegionContrastMax = 1.0f;
-constexpr gfloat kLightFloorMin = 0.0f, kLightFloorMax = 1.0f;
-constexpr gfloat kScaledSizeMin = 8.0f, kScaledSizeMax = 1000.0f;
-constexpr gint kMaxScaledFramesMax = 1000;
-constexpr gint kTrackCoverFramesMax = 1000;
 /* The element's own: the pose's marker side in metres. */
 constexpr gdouble kMarkerSizeMax = 1000.0;
 
-/* max_hamming goes up to half the bits of the dictionary: the largest any
- * built-in dictionary accepts (24 for 7x7). */
-gint maxMaxHamming()
+/* The detector's settings the element offers, in the table's order: the
+ * property id of settingsOnElement()[i] is PROP_SETTING_0 + i. */
+const std::vector<const frappe::Setting *> &settingsOnElement()
 {
-	gint most = 0;
-	for (const auto &d : frappe::dictionaries())
-		most = std::max(most, d.codeBits() / 2);
-	return most;
+	static const std::vector<const frappe::Setting *> list = [] {
+		std::vector<const frappe::Setting *> out;
+		for (const frappe::Setting &s : frappe::settings())
+			if (s.surfaces & frappe::kOnElement)
+				out.push_back(&s);
+		return out;
+	}();
+	return list;
+}
+
+const frappe::Setting *settingOf(guint propId)
+{
+	const auto &list = settingsOnElement();
+	if (propId < PROP_SETTING_0 || propId - PROP_SETTING_0 >= list.size())
+		return nullptr;
+	return list[propId - PROP_SETTING_0];
+}
+
+/* A property's spec from its entry: a choice (dictionary, mode) is a
+ * string that takes every spelling the library does; a number has the
+ * table's range (a GParamSpec range is closed: an open end starts at the
+ * next float). */
+GParamSpec *settingSpec(const frappe::Setting &s, GParamFlags flags)
+{
+	const char *name = g_intern_string(s.kebabName().c_str());
+	std::string blurb(s.doc);
+	if (s.isChoice())
+		blurb += " (" + s.rangeText() + ")";
+	const char *nick = g_intern_string(std::string(s.name).c_str());
+	const char *text = g_intern_string(blurb.c_str());
+	const frappe::Config defaults;
+	return std::visit(
+		[&](auto m) -> GParamSpec * {
+			using T = std::remove_cvref_t<decltype(defaults.*m)>;
+			if constexpr (std::is_same_v<T, float>) {
+				const float lo = static_cast<float>(s.min), hi = static_cast<float>(s.max);
+				return g_param_spec_float(name, nick, text, s.min_open ? std::nextafter(lo, hi) : lo,
+							  std::isinf(s.max) ? G_MAXFLOAT : hi, defaults.*m, flags);
+			} else if constexpr (std::is_same_v<T, int>) {
+				return g_param_spec_int(name, nick, text, static_cast<gint>(s.min) + s.min_open,
+							static_cast<gint>(s.max), defaults.*m, flags);
+			} else if constexpr (std::is_same_v<T, long long>) {
+				return g_param_spec_int64(name, nick, text, static_cast<gint64>(s.min) + s.min_open,
+							  static_cast<gint64>(s.max), defaults.*m, flags);
+			} else {
+				return g_param_spec_string(name, nick, text, s.text(defaults).c_str(), flags);
+			}
+		},
+		s.member);
 }
 
 void setDoubleArray(const GValue *value, std::vector<double> &out)
@@ -125,32 +160,20 @@ bool readFileProperty(guint propId, const GValue *value, bool running, FileValue
 
 bool Settings::samePipeline(const Settings &o) const
 {
-	return dictionary == o.dictionary && mode == o.mode && edgeThreshold == o.edgeThreshold &&
-	       cornerThreshold == o.cornerThreshold && regionContrast == o.regionContrast &&
-	       lightFloor == o.lightFloor &&
-	       maxHamming == o.maxHamming &&
-	       scaledSize == o.scaledSize && maxScaledFrames == o.maxScaledFrames &&
-	       backend == o.backend && pipelined == o.pipelined &&
+	for (const frappe::Setting &s : frappe::settings())
+		if (!s.same(library, o.library))
+			return false;
+	return backend == o.backend && pipelined == o.pipelined &&
 	       (overlap == o.overlap || !pipelined) && /* overlap means nothing unpipelined */
 	       customDictionary == o.customDictionary;
 }
 
 frappe::Config Settings::config(bool staged) const
 {
-	frappe::Config config;
-	const auto dicts = frappe::dictionaries();
-	const auto &dict = customDictionary ? *customDictionary : dicts[static_cast<std::size_t>(dictionary)];
-	config.dictionary = std::string(dicts[static_cast<std::size_t>(dictionary)].name);
+	frappe::Config config = library;
+	const auto &dict = customDictionary ? *customDictionary : *frappe::findDictionary(library.dictionary);
 	config.custom_dictionary = customDictionary;
-	config.mode = gst_frappe_mode_to_library(mode);
-	config.edge_threshold = edgeThreshold;
-	config.corner_threshold = cornerThreshold;
-	config.region_contrast = regionContrast;
-	config.light_floor = lightFloor;
-	config.max_hamming = std::min(maxHamming, dict.codeBits() / 2);
-	config.scaled_size = scaledSize;
-	config.max_scaled_frames = maxScaledFrames;
-	config.track_cover_frames = trackCoverFrames;
+	config.max_hamming = std::min(library.max_hamming, dict.codeBits() / 2);
 	/* Whole frames on two threads; track follows the video on one. */
 	config.threads = pipelined && !staged && config.mode != frappe::Mode::Track ? 2 : 1;
 	return config;
@@ -170,79 +193,11 @@ void installProperties(GObjectClass *gobject_class)
 	const auto live = static_cast<GParamFlags>(G_PARAM_READWRITE | G_PARAM_STATIC_STRINGS |
 						   GST_PARAM_MUTABLE_PLAYING);
 
-	/**
-	 * GstFrappeDetect:dictionary:
-	 *
-	 * The marker family to look for.
-	 */
-	g_object_class_install_property(
-		gobject_class, PROP_DICTIONARY,
-		g_param_spec_enum("dictionary", "Dictionary", "Marker family to detect", GST_TYPE_FRAPPE_DICTIONARY,
-				  defaults.dictionary, live));
-	g_object_class_install_property(
-		gobject_class, PROP_MODE,
-		g_param_spec_enum("mode", "Mode",
-				  "normal: every frame at full resolution; ascale: scale frames down from the "
-				  "size of the smallest marker of the previous frame (faster on video)",
-				  GST_TYPE_FRAPPE_MODE, defaults.mode, live));
-	g_object_class_install_property(
-		gobject_class, PROP_EDGE_THRESHOLD,
-		g_param_spec_float("edge-threshold", "Edge threshold",
-				   "Sobel gradient magnitude (intensities in [0, 1]) an edge pixel must exceed; "
-				   "lower finds fainter markers but costs more contour tracing",
-				   kEdgeThresholdMin, kEdgeThresholdMax, defaults.edgeThreshold, live));
-	g_object_class_install_property(
-		gobject_class, PROP_CORNER_THRESHOLD,
-		g_param_spec_float("corner-threshold", "Corner threshold",
-				   "Shi-Tomasi minimum eigenvalue that marks an edge pixel as a corner; too high "
-				   "loses low-contrast markers, too low splits corners",
-				   kCornerThresholdMin, kCornerThresholdMax, defaults.cornerThreshold, live));
-	g_object_class_install_property(
-		gobject_class, PROP_REGION_CONTRAST,
-		g_param_spec_float("region-contrast", "Region contrast",
-				   "Contrast (intensities in [0, 1]) around a pixel for the dark-region candidates "
-				   "that find blurred markers; lower finds fainter blurred markers but traces more "
-				   "clutter; 0 turns them off (edge candidates only, faster)",
-				   kRegionContrastMin, kRegionContrastMax, defaults.regionContrast, live));
-	/**
-	 * GstFrappeDetect:light-floor:
-	 *
-	 * Below mid-grey the edge, corner and region thresholds follow the local
-	 * brightness plus this floor, so that markers in a dim room or under
-	 * shadows keep their edges; 0.5 or more keeps them absolute.
-	 *
-	 * Since: 0.3
-	 */
-	g_object_class_install_property(
-		gobject_class, PROP_LIGHT_FLOOR,
-		g_param_spec_float("light-floor", "Light floor",
-				   "Below mid-grey the edge, corner and region thresholds follow the local "
-				   "brightness plus this floor (intensities in [0, 1]): markers in dim light and "
-				   "shadows; lower finds darker markers but lets sensor noise make edges; 0.5 or "
-				   "more keeps the thresholds absolute (the paper's)",
-				   kLightFloorMin, kLightFloorMax, defaults.lightFloor, live));
-	g_object_class_install_property(
-		gobject_class, PROP_MAX_HAMMING,
-		g_param_spec_int("max-hamming", "Max Hamming",
-				 "Most bit errors corrected among cells read clearly (-1 = the dictionary's "
-				 "careful default; clamped to half the bits of the dictionary)",
-				 -1, maxMaxHamming(), defaults.maxHamming, live));
-	g_object_class_install_property(
-		gobject_class, PROP_SCALED_SIZE,
-		g_param_spec_float("scaled-size", "Scaled size",
-				   "ascale: target side in pixels of the smallest marker after scaling",
-				   kScaledSizeMin, kScaledSizeMax, defaults.scaledSize, live));
-	g_object_class_install_property(
-		gobject_class, PROP_MAX_SCALED_FRAMES,
-		g_param_spec_int("max-scaled-frames", "Max scaled frames",
-				 "ascale: at most this many scaled frames in a row before one at full resolution",
-				 0, kMaxScaledFramesMax, defaults.maxScaledFrames, live));
-	g_object_class_install_property(
-		gobject_class, PROP_TRACK_COVER_FRAMES,
-		g_param_spec_int("track-cover-frames", "Track cover frames",
-				 "track: every part of the frame is searched for new markers at least every this "
-				 "many frames",
-				 1, kTrackCoverFramesMax, defaults.trackCoverFrames, live));
+	/* The detector's: one per entry of the library's table. */
+	const auto &list = settingsOnElement();
+	for (std::size_t i = 0; i < list.size(); ++i)
+		g_object_class_install_property(gobject_class, static_cast<guint>(PROP_SETTING_0 + i),
+						settingSpec(*list[i], live));
 	g_object_class_install_property(
 		gobject_class, PROP_ANNOTATE,
 		g_param_spec_boolean("annotate", "Annotate",
@@ -338,37 +293,24 @@ namespace {
  * previous one kept). */
 bool setValue(Settings &p, guint propId, const GValue *value, std::string &warning)
 {
+	if (const frappe::Setting *s = settingOf(propId)) {
+		if (s->isChoice()) {
+			const gchar *text = g_value_get_string(value);
+			try {
+				s->parse(p.library, text ? text : "");
+			} catch (const std::exception &e) {
+				warning = s->kebabName() + " " + e.what() + "; keeping " + s->text(p.library);
+			}
+		} else if (G_VALUE_HOLDS_FLOAT(value)) {
+			s->setNumber(p.library, g_value_get_float(value));
+		} else if (G_VALUE_HOLDS_INT(value)) {
+			s->setNumber(p.library, g_value_get_int(value));
+		} else {
+			s->setNumber(p.library, static_cast<double>(g_value_get_int64(value)));
+		}
+		return true;
+	}
 	switch (propId) {
-	case PROP_DICTIONARY:
-		p.dictionary = g_value_get_enum(value);
-		break;
-	case PROP_MODE:
-		p.mode = static_cast<GstFrappeMode>(g_value_get_enum(value));
-		break;
-	case PROP_EDGE_THRESHOLD:
-		p.edgeThreshold = g_value_get_float(value);
-		break;
-	case PROP_CORNER_THRESHOLD:
-		p.cornerThreshold = g_value_get_float(value);
-		break;
-	case PROP_REGION_CONTRAST:
-		p.regionContrast = g_value_get_float(value);
-		break;
-	case PROP_LIGHT_FLOOR:
-		p.lightFloor = g_value_get_float(value);
-		break;
-	case PROP_MAX_HAMMING:
-		p.maxHamming = g_value_get_int(value);
-		break;
-	case PROP_SCALED_SIZE:
-		p.scaledSize = g_value_get_float(value);
-		break;
-	case PROP_MAX_SCALED_FRAMES:
-		p.maxScaledFrames = g_value_get_int(value);
-		break;
-	case PROP_TRACK_COVER_FRAMES:
-		p.trackCoverFrames = g_value_get_int(value);
-		break;
 	case PROP_ANNOTATE:
 		p.annotate = g_value_get_boolean(value);
 		break;
@@ -590,37 +532,18 @@ const char *frameMemoryBackend(GstFrappeBackend backend, frappe::Pipeline *pipel
 
 bool getProperty(const Settings &p, guint propId, GValue *value)
 {
+	if (const frappe::Setting *s = settingOf(propId)) {
+		if (s->isChoice())
+			g_value_set_string(value, s->text(p.library).c_str());
+		else if (G_VALUE_HOLDS_FLOAT(value))
+			g_value_set_float(value, static_cast<gfloat>(s->number(p.library)));
+		else if (G_VALUE_HOLDS_INT(value))
+			g_value_set_int(value, static_cast<gint>(s->number(p.library)));
+		else
+			g_value_set_int64(value, static_cast<gint64>(s->number(p.library)));
+		return true;
+	}
 	switch (propId) {
-	case PROP_DICTIONARY:
-		g_value_set_enum(value, p.dictionary);
-		break;
-	case PROP_MODE:
-		g_value_set_enum(value, p.mode);
-		break;
-	case PROP_EDGE_THRESHOLD:
-		g_value_set_float(value, p.edgeThreshold);
-		break;
-	case PROP_CORNER_THRESHOLD:
-		g_value_set_float(value, p.cornerThreshold);
-		break;
-	case PROP_REGION_CONTRAST:
-		g_value_set_float(value, p.regionContrast);
-		break;
-	case PROP_LIGHT_FLOOR:
-		g_value_set_float(value, p.lightFloor);
-		break;
-	case PROP_MAX_HAMMING:
-		g_value_set_int(value, p.maxHamming);
-		break;
-	case PROP_SCALED_SIZE:
-		g_value_set_float(value, p.scaledSize);
-		break;
-	case PROP_MAX_SCALED_FRAMES:
-		g_value_set_int(value, p.maxScaledFrames);
-		break;
-	case PROP_TRACK_COVER_FRAMES:
-		g_value_set_int(value, p.trackCoverFrames);
-		break;
 	case PROP_ANNOTATE:
 		g_value_set_boolean(value, p.annotate);
 		break;

@@ -1,9 +1,9 @@
 /* SPDX-License-Identifier: MIT
  *
- * gstfrappesettings.h: frappedetect's properties. The detector's take their
- * defaults from frappe::Config{} and their ranges from the library's
- * validation; the element's own (annotate, pose, files, ...) are defined
- * here, with what setting them checks and reads.
+ * gstfrappesettings.h: frappedetect's properties. The detector's are made
+ * from the library's settings table (frappe/settings.h): name, type,
+ * default, range and text; the element's own (annotate, pose, files, ...)
+ * are defined here, with what setting them checks and reads.
  */
 #pragma once
 
@@ -17,23 +17,16 @@
 #include <frappe/config.h>
 #include <frappe/pipeline.h>
 #include <frappe/pose.h>
+#include <frappe/settings.h>
 
 #include "gstfrappeenums.h"
 
 namespace frappe::gst {
 
+/* The element's own properties; the detector's (frappe::settings() with
+ * kOnElement) follow from PROP_SETTING_0, one per entry of the table. */
 enum Property {
 	PROP_0,
-	PROP_DICTIONARY,
-	PROP_MODE,
-	PROP_EDGE_THRESHOLD,
-	PROP_CORNER_THRESHOLD,
-	PROP_REGION_CONTRAST,
-	PROP_LIGHT_FLOOR,
-	PROP_MAX_HAMMING,
-	PROP_SCALED_SIZE,
-	PROP_MAX_SCALED_FRAMES,
-	PROP_TRACK_COVER_FRAMES,
 	PROP_ANNOTATE,
 	PROP_POST_MESSAGES,
 	PROP_PIPELINED,
@@ -46,24 +39,15 @@ enum Property {
 	PROP_DICTIONARY_FILE,
 	PROP_STATS,
 	PROP_OVERLAP,
+	PROP_SETTING_0,
 };
-
-/* The library's defaults: the detector's properties start from these. */
-inline const frappe::Config kLibraryDefaults{};
 
 /* Everything the properties set. The element copies it under the object
  * lock at the start of a frame when its generation changed. */
 struct Settings {
-	gint dictionary = gst_frappe_dictionary_index(kLibraryDefaults.dictionary.c_str());
-	GstFrappeMode mode = gst_frappe_mode_from_library(kLibraryDefaults.mode);
-	gfloat edgeThreshold = kLibraryDefaults.edge_threshold;
-	gfloat cornerThreshold = kLibraryDefaults.corner_threshold;
-	gfloat regionContrast = kLibraryDefaults.region_contrast;
-	gfloat lightFloor = kLibraryDefaults.light_floor;
-	gint maxHamming = kLibraryDefaults.max_hamming;
-	gfloat scaledSize = kLibraryDefaults.scaled_size;
-	gint maxScaledFrames = kLibraryDefaults.max_scaled_frames;
-	gint trackCoverFrames = kLibraryDefaults.track_cover_frames;
+	/* The detector's properties: frappe::Config{}'s defaults, set through
+	 * the table (frappe/settings.h). */
+	frappe::Config library;
 	gboolean annotate = FALSE;
 	gboolean postMessages = TRUE;
 	gboolean pipelined = FALSE;

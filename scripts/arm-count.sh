@@ -246,7 +246,9 @@ ninja -C "$BUILD" -j"$JOBS" "$LIB" >&2 || die "cross build of frappe-core failed
 
 step "driver tests/bench/frappe_count.cpp"
 mkdir -p "$OUT"
-CXXFLAGS=(-std=c++20 -O3 -pthread -I"$SRC/frappe-core/include" -I"$BUILD/frappe-core/include" -I"$SRC/frappe-core/src")
+CXXFLAGS=(-std=c++20 -O3 -pthread -I"$SRC/frappe-core/include" -I"$BUILD/frappe-core/include")
+# frappe-core/src's rooms (front_end, trace, read, ...): headers by file name
+for room in "$SRC"/frappe-core/src/*/; do CXXFLAGS+=(-I"$room"); done
 LIBS=("$BUILD/$LIB")
 if [ "$ARCH" = armv6 ]; then
 	CXXFLAGS+=(-march=armv6kz -mtune=arm1176jzf-s -mfpu=vfp -mfloat-abi=softfp

@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
 # Builds Frappe's Debian packages with plain dpkg-deb:
 #
-#   libfrappe-core0      libfrappe-core.so.0
+#   libfrappe-coreS      libfrappe-core.so.S, S the soversion: major.minor until 1.0
+#                        (libfrappe-core0.2), the major from then (docs/install.md)
 #   libfrappe-dev        headers, .pc files, the CMake package, .so links, .gir
-#   gstreamer1.0-frappe  the plugin (frappedetect, frappejson), libgstfrappemeta-1.0.so.0 and
+#   gstreamer1.0-frappe  the plugin (frappedetect, frappejson), libgstfrappemeta-1.0.so.S and
 #                        its typelib GstFrappe-1.0 (Python apps)
 #   frappe-tools         frappe-detect, frappe-render, vc4-dis, vc4-run, vc4-probe
 #
@@ -15,7 +16,7 @@
 # with scripts/arm/armv8-arm64.ini; GStreamer's and OpenCV's arm64
 # development packages are not co-installable with the amd64 ones on Debian
 # 12 (apt would remove libopencv-dev), so that set has no element and no
-# CLI: libfrappe-core0, libfrappe-dev and frappe-tools with the vc4 tools
+# CLI: libfrappe-coreS, libfrappe-dev and frappe-tools with the vc4 tools
 # only. On an arm64 machine (a Pi) it is a native build with everything.
 #
 # --builddir packages an existing build instead (tests/install does so with
@@ -88,6 +89,10 @@ print(info("projectinfo")["version"], opts["prefix"], opts["libdir"],
 EOF
 ) || true
 [ -n "$relocatable" ] || die "cannot read $builddir/meson-info"
+# The soversion, as frappe-core/meson.build makes it: major.minor until 1.0.
+IFS=. read -r major minor _ <<<"$version"
+if [ "$major" = 0 ]; then soversion=$major.$minor; else soversion=$major; fi
+corepkg=libfrappe-core$soversion
 [ "$libdir" = "lib/$triplet" ] || die "$builddir has libdir $libdir: configure it with --libdir=lib/$triplet"
 if [ "$prefix" != /usr ] && [ "$relocatable" != true ]; then
 	die "$builddir has prefix $prefix: configure it with --prefix=/usr (or -Dpkgconfig.relocatable=true)"
@@ -119,7 +124,7 @@ take() {
 		done
 	done
 }
-take libfrappe-core0 "$lib/libfrappe-core.so.*"
+take $corepkg "$lib/libfrappe-core.so.*"
 take gstreamer1.0-frappe "$lib/gstreamer-1.0/libgstfrappe.so" "$lib/libgstfrappemeta-1.0.so.*" \
 	"$lib/girepository-1.0/GstFrappe-1.0.typelib"
 take libfrappe-dev usr/include/frappe usr/include/gstreamer-1.0 "$lib/libfrappe-core.so" \
@@ -128,10 +133,10 @@ take frappe-tools "usr/bin/*"
 # A file no package took is a new install() that needs a home here.
 left=$(find "$root" ! -type d)
 [ -z "$left" ] || die "installed but in no package: $left"
-[ -d "$work/pkg/libfrappe-core0" ] || die "no libfrappe-core.so.N installed (a static build?)"
+[ -d "$work/pkg/$corepkg" ] || die "no libfrappe-core.so.N installed (a static build?)"
 # The build's CPU, from the library's ELF header (e_machine).
 machine=$(python3 -c 'import sys; print(int.from_bytes(open(sys.argv[1], "rb").read(20)[18:20], "little"))' \
-	"$(find "$work/pkg/libfrappe-core0" -type f | head -n1)")
+	"$(find "$work/pkg/$corepkg" -type f | head -n1)")
 case $arch:$machine in
 amd64:62 | arm64:183) ;;
 *) die "$builddir builds for ELF machine $machine, not $arch" ;;
@@ -144,8 +149,8 @@ esac
 # Our own libraries, for dpkg-shlibdeps: the packages that provide them.
 mkdir -p "$work/debian"
 cat >"$work/debian/shlibs.local" <<EOF
-libfrappe-core 0 libfrappe-core0 (= $version)
-libgstfrappemeta-1.0 0 gstreamer1.0-frappe (= $version)
+libfrappe-core $soversion $corepkg (= $version)
+libgstfrappemeta-1.0 $soversion gstreamer1.0-frappe (= $version)
 EOF
 # dpkg-shlibdeps reads the source package's control file.
 printf 'Source: frappe\n\nPackage: frappe\nArchitecture: any\n' >"$work/debian/control"
@@ -158,7 +163,7 @@ shlibs_depends() {
 	if command -v dpkg-shlibdeps >/dev/null; then
 		local out
 		out=$(cd "$work" && DEB_HOST_ARCH=$arch DEB_HOST_MULTIARCH=$triplet \
-			dpkg-shlibdeps -O -x"$1" -l"$work/pkg/libfrappe-core0/$lib" \
+			dpkg-shlibdeps -O -x"$1" -l"$work/pkg/$corepkg/$lib" \
 			-l"$work/pkg/gstreamer1.0-frappe/$lib" "${elves[@]}" 2>"$work/shlibdeps.err") ||
 			{ cat "$work/shlibdeps.err" >&2; return 1; }
 		sed -n 's/^shlibs:Depends=//p' <<<"$out"
@@ -168,7 +173,7 @@ shlibs_depends() {
 	local so f deps=()
 	for so in $(for f in "${elves[@]}"; do objdump -p "$f" | awk '$1 == "NEEDED" { print $2 }'; done | sort -u); do
 		case $1:$so in
-		*:libfrappe-core.so.*) deps+=("libfrappe-core0 (= $version)"); continue ;;
+		*:libfrappe-core.so.*) deps+=("$corepkg (= $version)"); continue ;;
 		gstreamer1.0-frappe:libgstfrappemeta-1.0.so.*) continue ;;
 		*:libgstfrappemeta-1.0.so.*) deps+=("gstreamer1.0-frappe (= $version)"); continue ;;
 		esac
@@ -220,8 +225,8 @@ control() {
 	} >"$dir/DEBIAN/control"
 }
 
-control libfrappe-core0 libs same "Frappe fiducial marker detector - shared library"
-dev_fields=("Depends: libfrappe-core0 (= $version)")
+control $corepkg libs same "Frappe fiducial marker detector - shared library"
+dev_fields=("Depends: $corepkg (= $version)")
 # gstfrappemeta.pc requires GStreamer's .pc files; the library itself comes
 # with the element.
 if [ -d "$work/pkg/gstreamer1.0-frappe" ]; then

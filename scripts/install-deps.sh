@@ -13,6 +13,8 @@ packages=(
 	# the fuzzers (tests/fuzz: libFuzzer is clang's, its runtime in
 	# libclang-rt) and the ThreadSanitizer build of CI
 	clang libclang-rt-14-dev
+	# the style of changed C++ files (.clang-format, the test clang-format)
+	clang-format
 	# the data tests' scorer (../shared/tools/eval.py) and scripts/quality.py
 	python3-numpy
 	# the Python module (python/: pip install --no-build-isolation ., its

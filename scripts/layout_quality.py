@@ -2,7 +2,7 @@
 """Issue 32's measure of the AprilTag 3 layout families: scenes rendered by
 `frappe-render --scene` (corner truth from the renderer), read by frappe and
 by AprilTag 3.3 (`apriltag-peer`, decimate 1) and scored by
-shared/tools/eval.py; then every layout family's detector over the other
+../shared/tools/eval.py; then every layout family's detector over the other
 families' scenes and ../shared's synth subsets, where any marker is a wrong id.
 
 usage: scripts/layout_quality.py BUILD_DIR OUT_DIR [--images 60] [--synth]

@@ -13,7 +13,7 @@ Runs, all at defaults and single-threaded:
   * frappe-sweep over every synthetic subset: every built-in dictionary (the
     wrong-id matrix) and the subset upsampled 2x and 3x, bilinear and nearest
     (made in memory, truth corners scaled as x' = (x + 0.5) s - 0.5);
-scores everything with shared/tools/eval.py and prints Markdown tables, then
+scores everything with ../shared/tools/eval.py and prints Markdown tables, then
 the checks of tests/data/floors.py (measured, enforced floor, issue target).
 See docs/quality.md. Needs python3-numpy (the scorer) and a build with
 OpenCV (frappe-sweep, frappe-bench). About a minute on two quiet cores.

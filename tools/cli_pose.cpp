@@ -61,17 +61,17 @@ const Camera *CameraFitter::fit(int width, int height, std::string &note, std::s
 	return &scaled_;
 }
 
-std::vector<std::optional<Pose>> markerPoses(const std::vector<Marker> &markers, const MarkerSizes &sizes,
-					     const Camera &camera)
+std::vector<std::optional<MarkerPose>> markerPoses(const std::vector<Marker> &markers, const MarkerSizes &sizes,
+						   const Camera &camera)
 {
-	std::vector<std::optional<Pose>> poses;
+	std::vector<std::optional<MarkerPose>> poses;
 	poses.reserve(markers.size());
 	for (const Marker &m : markers) {
 		const double side = sizes(m.id);
 		std::optional<MarkerPose> p;
 		if (side > 0.0)
 			p = estimatePose(m.corners, side, camera);
-		poses.push_back(p ? std::optional<Pose>(p->pose) : std::nullopt);
+		poses.push_back(p);
 	}
 	return poses;
 }

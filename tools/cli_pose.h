@@ -39,11 +39,12 @@ private:
 
 /// Each marker's pose (nullopt for a marker without a size or whose
 /// corners give none).
-std::vector<std::optional<Pose>> markerPoses(const std::vector<Marker> &markers, const MarkerSizes &sizes,
-					     const Camera &camera);
+std::vector<std::optional<MarkerPose>> markerPoses(const std::vector<Marker> &markers, const MarkerSizes &sizes,
+						   const Camera &camera);
 
-/// `, "rvec": [..], "tvec": [..], "pose_error": e` to add to a marker's
-/// JSON object.
+/// A bundle's pose as JSON members (frappe-detect --bundle): `, "rvec":
+/// [...], "tvec": [...], "pose_error": e`. A marker's pose is the marker
+/// record's (frappe/marker_record.h).
 std::string poseJson(const Pose &pose);
 
 /// A readable line: the distance, the position and the rotation.

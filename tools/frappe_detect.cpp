@@ -2,7 +2,7 @@
 // frappe-detect: the command-line detector.
 //
 //   frappe-detect photo.jpg [--annotate out.png]      people
-//   frappe-detect --list L --out D.jsonl --repeat N   benchmarks (DETECTOR-CONTRACT.md)
+//   frappe-detect --list L --out D.jsonl --repeat N   benchmarks (JSON lines: README.md)
 //   frappe-detect --calibration C --marker-size M -   robots: pose, an image on stdin
 #include <algorithm>
 #include <cerrno>
@@ -41,39 +41,22 @@ using frappe::Config;
 using frappe::Detector;
 using frappe::Marker;
 
-const char kUsage[] =
+const char kUsageHead[] =
 	"usage: frappe-detect [options] IMAGE...   (- reads one image from standard input)\n"
 	"       frappe-detect [options] --list LIST.txt --out DETS.jsonl [--repeat N]\n"
 	"\n"
 	"Finds square fiducial markers (ArUco, AprilTag) in 8-bit images.\n"
 	"\n"
+	"detector settings (frappe::Config; docs/settings.md says more of each):\n";
+
+const char kUsageTail[] =
+	"  -d NAME|FILE            --dictionary; a file is a dictionary of your own (the text\n"
+	"                          format of frappe-core/dictionaries, or OpenCV's aruco YAML/XML)\n"
+	"                          --threads: images detected at once; time_ms is then each\n"
+	"                          image's own detection time, and the images per second of the\n"
+	"                          whole list go to standard error\n"
+	"\n"
 	"options:\n"
-	"  -d, --dictionary NAME|FILE  marker family (default aruco_mip_36h12), see\n"
-	"                          --dictionaries; else a file of your own (the text format of\n"
-	"                          frappe-core/dictionaries, or OpenCV's aruco YAML/XML)\n"
-	"      --mode MODE         normal (default), ascale (adaptive scaling over a sequence)\n"
-	"                          or track (the list is a video: markers searched where the\n"
-	"                          last frames put them, the rest of the frame a band at a\n"
-	"                          time; each marker says whether it was \"tracked\")\n"
-	"      --track-cover-frames K  track: every part of the frame is searched for new\n"
-	"                          markers at least every K frames (default 4)\n"
-	"      --threads T         images detected at once, each on a thread of its own:\n"
-	"                          1 (default), 0 = one per core; time_ms is then each\n"
-	"                          image's own detection time, and the images per second\n"
-	"                          of the whole list go to standard error\n"
-	"      --edge-threshold E  Sobel magnitude for an edge, intensities in [0,1] (default 0.27)\n"
-	"      --corner-threshold C  Shi-Tomasi threshold for a corner (default 0.19)\n"
-	"      --region-contrast R  contrast for the dark-region candidates that find blurred\n"
-	"                          markers, intensities in [0,1]; 0 = off (default 0.16)\n"
-	"      --light-floor L     below mid-grey the thresholds follow the local brightness\n"
-	"                          plus L (intensities in [0,1]): markers in dim light and\n"
-	"                          shadows; 0.5 or more = absolute thresholds (default 0.063)\n"
-	"      --max-hamming H     bits read clearly that may be corrected (default: the\n"
-	"                          dictionary's careful default, see --dictionaries)\n"
-	"      --weak-margin W     a cell nearer the threshold than W (of half the contrast)\n"
-	"                          is a weak read, correctable beyond H (default 0.3; 0: off)\n"
-	"      --backend B         front end: auto, cpu, vc4 (the Pi's QPUs), vc4-emu (the QPU\n"
-	"                          kernels on an emulator: slow, bit-exact) (default auto)\n"
 	"  -a, --annotate PATH     write the image with the markers drawn (a folder for several images)\n"
 	"      --json              print one JSON line per image instead of text\n"
 	"      --stats             per-stage timings: a line of text, or with --json a \"stats\"\n"
@@ -103,8 +86,57 @@ const char kUsage[] =
 	"                          cols, size, gap, first_id); its sizes need no --marker-size\n"
 	"\n"
 	"Images are read one at a time and refused, with an error line, when larger\n"
-	"than 2^26 pixels (read from the header, before decoding) or cut short.\n"
+	"than --max-pixels (read from the header, before decoding) or cut short.\n"
 	"Exit status: 0, 1 when an image failed, 2 for bad options or files of options.\n";
+
+/* `text` wrapped to 80 columns, each line indented by `indent`. */
+std::string wrapped(const std::string &text, std::size_t indent)
+{
+	std::string out, line;
+	std::istringstream words(text);
+	std::string word;
+	while (words >> word) {
+		if (!line.empty() && indent + line.size() + 1 + word.size() > 80) {
+			out += std::string(indent, ' ') + line + "\n";
+			line.clear();
+		}
+		line += (line.empty() ? "" : " ") + word;
+	}
+	if (!line.empty())
+		out += std::string(indent, ' ') + line + "\n";
+	return out;
+}
+
+/* An option's line: its name at column 6, its text from column 26 (on
+ * the next line when the name is longer). */
+std::string optionHelp(const std::string &name, const std::string &text)
+{
+	const std::size_t column = 26;
+	const std::string head = "      " + name;
+	const std::string body = wrapped(text, column);
+	if (head.size() + 1 >= column)
+		return head + "\n" + body;
+	return head + std::string(column - head.size(), ' ') + body.substr(column);
+}
+
+/* The help: the detector's settings from the library's table, then the
+ * CLI's own options. */
+std::string usage()
+{
+	std::string out = kUsageHead;
+	const Config defaults;
+	for (const frappe::Setting &s : frappe::settings()) {
+		if (s.surfaces & frappe::kOnCli)
+			out += optionHelp("--" + s.kebabName() + " " + std::string(s.metavar),
+					  std::string(s.doc) + " (" + (s.isChoice() ? "" : "range ") + s.rangeText() +
+						  "; default " + s.text(defaults) + ")");
+	}
+	std::string backends;
+	for (const frappe::BackendName &b : frappe::backendNames())
+		backends += std::string(backends.empty() ? "" : "; ") + std::string(b.name) + ": " + std::string(b.doc);
+	out += optionHelp("--backend B", "where the front end runs: " + backends + " (default auto)");
+	return out + kUsageTail;
+}
 
 struct Options {
 	Config config;
@@ -219,6 +251,15 @@ void usePose(Options &o, const std::string &calibration, const std::string &came
 		usageError("marker sizes without a camera: add --calibration FILE or --camera fx,fy,cx,cy");
 }
 
+/* A detector setting the CLI offers, by its kebab-case name. */
+const frappe::Setting *cliSetting(const std::string &name)
+{
+	if (name.find('_') != std::string::npos)
+		return nullptr;
+	const frappe::Setting *s = frappe::findSetting(name);
+	return s && (s->surfaces & frappe::kOnCli) ? s : nullptr;
+}
+
 Options parse(int argc, char **argv)
 {
 	Options o;
@@ -232,7 +273,7 @@ Options parse(int argc, char **argv)
 			return argv[++i];
 		};
 		if (a == "-h" || a == "--help") {
-			std::cout << kUsage;
+			std::cout << usage();
 			std::exit(0);
 		} else if (a == "--version") {
 			std::cout << "frappe-detect " << frappe::version() << "\n";
@@ -267,36 +308,20 @@ Options parse(int argc, char **argv)
 			bundle = value();
 			if (bundle.empty())
 				usageError("--bundle needs a file");
-		} else if (a == "--mode") {
-			const std::string m = value();
-			if (m == "normal")
-				o.config.mode = frappe::Mode::Normal;
-			else if (m == "ascale")
-				o.config.mode = frappe::Mode::AScale;
-			else if (m == "track")
-				o.config.mode = frappe::Mode::Track;
-			else
-				usageError("--mode takes normal, ascale or track, got '" + m + "'");
-		} else if (a == "--track-cover-frames") {
-			o.config.track_cover_frames = parseNumber<int>(a, value());
-		} else if (a == "--threads") {
-			o.config.threads = parseNumber<int>(a, value());
-		} else if (a == "--edge-threshold") {
-			o.config.edge_threshold = parseNumber<float>(a, value());
-		} else if (a == "--corner-threshold") {
-			o.config.corner_threshold = parseNumber<float>(a, value());
-		} else if (a == "--region-contrast") {
-			o.config.region_contrast = parseNumber<float>(a, value());
-		} else if (a == "--light-floor") {
-			o.config.light_floor = parseNumber<float>(a, value());
-		} else if (a == "--max-hamming") {
-			o.config.max_hamming = parseNumber<int>(a, value());
-		} else if (a == "--weak-margin") {
-			o.config.weak_margin = parseNumber<float>(a, value());
 		} else if (a == "--backend") {
 			o.backend = value();
-			if (o.backend != "auto" && o.backend != "cpu" && o.backend != "vc4" && o.backend != "vc4-emu")
-				usageError("--backend takes auto, cpu, vc4 or vc4-emu, got '" + o.backend + "'");
+			const auto names = frappe::backendNames();
+			if (std::none_of(names.begin(), names.end(),
+					 [&](const auto &b) { return b.name == o.backend; }))
+				usageError("--backend takes " + frappe::backendNameList() + ", got '" + o.backend +
+					   "'");
+		} else if (const frappe::Setting *s = a.starts_with("--") ? cliSetting(a.substr(2)) : nullptr) {
+			const std::string text = value();
+			try {
+				s->parse(o.config, text);
+			} catch (const std::exception &e) {
+				usageError(a + " " + e.what());
+			}
 		} else if (a == "-a" || a == "--annotate") {
 			o.annotate = value();
 		} else if (a == "--json") {
@@ -331,7 +356,7 @@ using frappe::cli::jsonEscape;
 
 /* What a line may carry beyond the contract's fields. */
 struct LineExtras {
-	const std::vector<std::optional<frappe::Pose>> *poses = nullptr; /* one per marker */
+	const std::vector<std::optional<frappe::MarkerPose>> *poses = nullptr; /* one per marker */
 	const frappe::Bundle *bundle = nullptr; /* with its pose, when one was found */
 	const std::optional<frappe::BundlePose> *bundlePose = nullptr;
 	std::string stats; /* `"stats": {...}`, or empty */
@@ -354,40 +379,31 @@ std::string bundleJson(const frappe::Bundle &b, const std::optional<frappe::Bund
 	       ", \"rejected\": " + ids(p->rejected) + "}";
 }
 
-std::string jsonLine(const std::string &image, const std::vector<Marker> &markers, double ms,
-		     const std::string &error, const LineExtras &extras = {})
+/* A line of the benchmarks' format: the image, its markers as the
+ * library's one writer makes them (frappe/marker_record.h), the time. */
+std::string jsonLine(const std::string &image, const std::vector<Marker> &markers, std::string_view dictionary,
+		     double ms, const std::string &error, const LineExtras &extras = {})
 {
-	std::ostringstream o;
-	o << "{\"image\": \"" << jsonEscape(image) << "\"";
-	if (!error.empty()) {
-		o << ", \"markers\": [], \"error\": \"" << jsonEscape(error) << "\"}";
-		return o.str();
-	}
-	o << ", \"markers\": [";
-	char buf[64];
+	std::string o = "{\"image\": \"" + jsonEscape(image) + "\"";
+	if (!error.empty())
+		return o + ", \"markers\": [], \"error\": \"" + jsonEscape(error) + "\"}";
+	o += ", \"markers\": [";
 	for (std::size_t i = 0; i < markers.size(); ++i) {
-		const Marker &m = markers[i];
-		o << (i ? ", " : "") << "{\"id\": " << m.id << ", \"corners\": [";
-		for (int k = 0; k < 4; ++k) {
-			std::snprintf(buf, sizeof(buf), "%s[%.3f, %.3f]", k ? ", " : "", m.corners[k].x, m.corners[k].y);
-			o << buf;
-		}
-		std::snprintf(buf, sizeof(buf), "%.3f", m.margin);
-		o << "], \"hamming\": " << m.hamming << ", \"margin\": " << buf;
-		if (extras.tracking)
-			o << ", \"tracked\": " << (m.tracked ? "true" : "false");
-		if (extras.poses && (*extras.poses)[i])
-			o << frappe::cli::poseJson(*(*extras.poses)[i]);
-		o << "}";
+		const frappe::MarkerPose *pose = extras.poses && (*extras.poses)[i] ? &*(*extras.poses)[i] : nullptr;
+		if (i)
+			o += ", ";
+		frappe::appendMarkerJson(o, { &markers[i], dictionary, pose, extras.tracking },
+					 frappe::JsonNumbers::Rounded);
 	}
+	char buf[64];
 	std::snprintf(buf, sizeof(buf), "%.4f", ms);
-	o << "], \"time_ms\": " << buf;
+	o += "], \"time_ms\": ";
+	o += buf;
 	if (extras.bundle)
-		o << ", \"bundle\": " << bundleJson(*extras.bundle, *extras.bundlePose);
+		o += ", \"bundle\": " + bundleJson(*extras.bundle, *extras.bundlePose);
 	if (!extras.stats.empty())
-		o << ", " << extras.stats;
-	o << "}";
-	return o.str();
+		o += ", " + extras.stats;
+	return o + "}";
 }
 
 /* The per-stage times as a JSON member; the warm-up's wall time when one
@@ -425,7 +441,7 @@ struct Frame {
 	int in_flight = 0;            /* pushes whose result has not come back */
 	bool all_pushed = false;
 	double warm_up_ms = -1.0;     /* the untimed warm-up run on it, when one was */
-	std::vector<std::optional<frappe::Pose>> poses; /* one per marker, with a camera */
+	std::vector<std::optional<frappe::MarkerPose>> poses; /* one per marker, with a camera */
 	std::optional<frappe::BundlePose> bundlePose; /* with --bundle */
 };
 
@@ -508,7 +524,7 @@ double median(std::vector<double> v)
  * detectors; throws std::runtime_error saying what went wrong. */
 std::unique_ptr<frappe::Pipeline> makePipeline(const Options &opt)
 {
-	auto pipeline = std::make_unique<frappe::Pipeline>(opt.config, frappe::Pipeline::Mode::Frames);
+	auto pipeline = std::make_unique<frappe::Pipeline>(opt.config, frappe::Pipeline::Overlap::Frames);
 	std::string fallback;
 	try {
 		fallback = frappe::selectBackend(*pipeline, opt.backend);
@@ -700,7 +716,7 @@ private:
 		}
 		if (out_) {
 			/* The contract's line, with the poses when asked for. */
-			const std::string line = jsonLine(f.path, f.markers, ms, f.error, extras) + "\n";
+			const std::string line = jsonLine(f.path, f.markers, dictionary(), ms, f.error, extras) + "\n";
 			/* a line at a time: a run cut short keeps what it found */
 			if (std::fputs(line.c_str(), out_) < 0 || std::fflush(out_) != 0)
 				writeFailed_ = true;
@@ -709,7 +725,7 @@ private:
 			/* The stats inside the line: every line stays one JSON object. */
 			if (opt_.stats && f.error.empty())
 				extras.stats = statsJson(f.times, f.warm_up_ms, f.bytes_read, f.whole_frame);
-			std::cout << jsonLine(f.path, f.markers, ms, f.error, extras) << "\n";
+			std::cout << jsonLine(f.path, f.markers, dictionary(), ms, f.error, extras) << "\n";
 		} else if (f.error.empty() && opt_.out.empty()) {
 			std::printf("%s: %zu marker%s (%s) in %.2f ms\n", f.path.c_str(), f.markers.size(),
 				    f.markers.size() == 1 ? "" : "s",
@@ -721,7 +737,7 @@ private:
 					std::printf(" (%.2f, %.2f)", p.x, p.y);
 				std::printf("\n");
 				if (!f.poses.empty() && f.poses[i])
-					std::printf("           %s\n", frappe::cli::poseText(*f.poses[i]).c_str());
+					std::printf("           %s\n", frappe::cli::poseText(f.poses[i]->pose).c_str());
 			}
 			if (f.bundlePose)
 				std::printf("  bundle %s: %zu markers used, %zu rejected  %s\n", opt_.bundle->name.c_str(),
@@ -744,6 +760,8 @@ private:
 		if (!opt_.annotate.empty() && f.error.empty())
 			annotate(f);
 	}
+
+	std::string_view dictionary() { return pipeline_.detector().dictionary().name; }
 
 	void annotate(const Frame &f)
 	{

@@ -8,6 +8,8 @@
 
 #include <gst/gst.h>
 
+#include "gstfrappemeta-export.h"
+
 G_BEGIN_DECLS
 
 #define GST_FRAPPE_TYPE_MARKER (gst_frappe_marker_get_type())
@@ -34,6 +36,8 @@ G_BEGIN_DECLS
  * One marker of a buffer, copied out of its #GstFrappeMarkerMeta (see
  * there for the frames and conventions): a boxed type, so that bindings
  * can hold it after the buffer is gone.
+ *
+ * Since: 0.2
  */
 typedef struct {
 	gint id;
@@ -49,7 +53,7 @@ typedef struct {
 	gdouble alternative_reprojection_error;
 } GstFrappeMarker;
 
-GType gst_frappe_marker_get_type(void);
+GST_FRAPPE_META_API GType gst_frappe_marker_get_type(void);
 
 /**
  * gst_frappe_marker_copy:
@@ -57,16 +61,20 @@ GType gst_frappe_marker_get_type(void);
  *
  * Returns: (transfer full): a copy of @marker, freed with
  * gst_frappe_marker_free()
+ *
+ * Since: 0.2
  */
-GstFrappeMarker *gst_frappe_marker_copy(const GstFrappeMarker *marker);
+GST_FRAPPE_META_API GstFrappeMarker *gst_frappe_marker_copy(const GstFrappeMarker *marker);
 
 /**
  * gst_frappe_marker_free: (skip)
  * @marker: (transfer full): a #GstFrappeMarker
  *
  * Bindings free their markers themselves.
+ *
+ * Since: 0.2
  */
-void gst_frappe_marker_free(GstFrappeMarker *marker);
+GST_FRAPPE_META_API void gst_frappe_marker_free(GstFrappeMarker *marker);
 
 /**
  * gst_frappe_marker_get_corners:
@@ -74,8 +82,10 @@ void gst_frappe_marker_free(GstFrappeMarker *marker);
  *
  * Returns: (transfer none) (array fixed-size=8): the corners as x0, y0,
  * x1, y1, x2, y2, x3, y3 (a list of 8 floats in Python)
+ *
+ * Since: 0.2
  */
-const gfloat *gst_frappe_marker_get_corners(const GstFrappeMarker *marker);
+GST_FRAPPE_META_API const gfloat *gst_frappe_marker_get_corners(const GstFrappeMarker *marker);
 
 /**
  * gst_frappe_marker_get_corner:
@@ -87,8 +97,10 @@ const gfloat *gst_frappe_marker_get_corners(const GstFrappeMarker *marker);
  *
  * One corner (an (x, y) tuple in Python). An @index beyond 3 is a
  * programming error: a critical, and @x, @y untouched.
+ *
+ * Since: 0.2
  */
-void gst_frappe_marker_get_corner(const GstFrappeMarker *marker, guint index, gfloat *x, gfloat *y);
+GST_FRAPPE_META_API void gst_frappe_marker_get_corner(const GstFrappeMarker *marker, guint index, gfloat *x, gfloat *y);
 
 /**
  * gst_frappe_marker_get_rvec:
@@ -96,8 +108,10 @@ void gst_frappe_marker_get_corner(const GstFrappeMarker *marker, guint index, gf
  *
  * Returns: (transfer none) (array fixed-size=3): the rotation vector (all
  * zero unless has_pose)
+ *
+ * Since: 0.2
  */
-const gdouble *gst_frappe_marker_get_rvec(const GstFrappeMarker *marker);
+GST_FRAPPE_META_API const gdouble *gst_frappe_marker_get_rvec(const GstFrappeMarker *marker);
 
 /**
  * gst_frappe_marker_get_tvec:
@@ -105,8 +119,10 @@ const gdouble *gst_frappe_marker_get_rvec(const GstFrappeMarker *marker);
  *
  * Returns: (transfer none) (array fixed-size=3): the translation in metres
  * (all zero unless has_pose)
+ *
+ * Since: 0.2
  */
-const gdouble *gst_frappe_marker_get_tvec(const GstFrappeMarker *marker);
+GST_FRAPPE_META_API const gdouble *gst_frappe_marker_get_tvec(const GstFrappeMarker *marker);
 
 /**
  * gst_frappe_buffer_get_markers:
@@ -119,7 +135,9 @@ const gdouble *gst_frappe_marker_get_tvec(const GstFrappeMarker *marker);
  * Returns: (transfer full) (element-type GstFrappeMarker): the markers,
  * %NULL (an empty list) when there are none; free with
  * g_list_free_full (list, (GDestroyNotify) gst_frappe_marker_free)
+ *
+ * Since: 0.2
  */
-GList *gst_frappe_buffer_get_markers(GstBuffer *buffer);
+GST_FRAPPE_META_API GList *gst_frappe_buffer_get_markers(GstBuffer *buffer);
 
 G_END_DECLS

@@ -9,6 +9,8 @@
 
 #include <gst/gst.h>
 
+#include "gstfrappemeta-export.h"
+
 #include "gstfrappemarker.h"
 
 G_BEGIN_DECLS
@@ -57,6 +59,8 @@ G_BEGIN_DECLS
  *
  * The meta is copied with the buffer and rescaled by scaling elements
  * (videoscale); elements that crop or otherwise change the geometry drop it.
+ *
+ * Since: 0.1
  */
 typedef struct {
 	GstMeta meta;
@@ -80,15 +84,19 @@ typedef struct {
  *
  * Returns: the API type of #GstFrappeMarkerMeta, to find the metas of a
  * buffer with
+ *
+ * Since: 0.1
  */
-GType gst_frappe_marker_meta_api_get_type(void);
+GST_FRAPPE_META_API GType gst_frappe_marker_meta_api_get_type(void);
 
 /**
  * gst_frappe_marker_meta_get_info:
  *
  * Returns: (transfer none): the registration of #GstFrappeMarkerMeta
+ *
+ * Since: 0.1
  */
-const GstMetaInfo *gst_frappe_marker_meta_get_info(void);
+GST_FRAPPE_META_API const GstMetaInfo *gst_frappe_marker_meta_get_info(void);
 
 /**
  * gst_buffer_add_frappe_marker_meta:
@@ -104,16 +112,20 @@ const GstMetaInfo *gst_frappe_marker_meta_get_info(void);
  *
  * Returns: (transfer none) (nullable): the new meta, %NULL (and a
  * critical) when @buffer is not a buffer or @corners is %NULL
+ *
+ * Since: 0.1
  */
-GstFrappeMarkerMeta *gst_buffer_add_frappe_marker_meta(GstBuffer *buffer, gint id,
-						       const gchar *dictionary,
-						       const gfloat corners[8], guint hamming);
+GST_FRAPPE_META_API GstFrappeMarkerMeta *gst_buffer_add_frappe_marker_meta(GstBuffer *buffer, gint id,
+									   const gchar *dictionary,
+									   const gfloat corners[8], guint hamming);
 
 /**
  * gst_buffer_get_frappe_marker_meta:
  * @b: a #GstBuffer
  *
  * Returns: (transfer none) (nullable): the first marker meta of @buffer.
+ *
+ * Since: 0.1
  */
 #define gst_buffer_get_frappe_marker_meta(b) \
 	((GstFrappeMarkerMeta *)gst_buffer_get_meta((b), GST_FRAPPE_MARKER_META_API_TYPE))
@@ -123,14 +135,18 @@ GstFrappeMarkerMeta *gst_buffer_add_frappe_marker_meta(GstBuffer *buffer, gint i
  * @buffer: a #GstBuffer
  *
  * Returns: how many marker metas @buffer carries.
+ *
+ * Since: 0.1
  */
-guint gst_buffer_get_n_frappe_marker_metas(GstBuffer *buffer);
+GST_FRAPPE_META_API guint gst_buffer_get_n_frappe_marker_metas(GstBuffer *buffer);
 
 /**
  * GST_FRAPPE_ROI_TYPE:
  *
  * The roi_type of the GstVideoRegionOfInterestMeta frappedetect adds per
  * marker.
+ *
+ * Since: 0.1
  */
 #define GST_FRAPPE_ROI_TYPE "fiducial"
 

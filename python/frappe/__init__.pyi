@@ -16,6 +16,8 @@ GreyImage = npt.NDArray[np.uint8]
 Corners = Union["Marker", npt.ArrayLike]
 CameraMatrix = Union["Camera", npt.ArrayLike]
 
+MARKER_FIELDS: tuple[str, ...]
+
 def simd_target() -> str: ...
 
 class Dictionary:
@@ -36,11 +38,14 @@ class Dictionary:
     def __len__(self) -> int: ...
 
 def dictionaries() -> List[str]: ...
+def settings() -> List[Dict[str, Any]]: ...
 def get_dictionary(name: str) -> Dictionary: ...
 def load_dictionary(path: Union[str, bytes, PathLike[str], PathLike[bytes]]) -> Dictionary: ...
 
 class Marker:
-    def __init__(self, id: int, corners: Corners, hamming: int = 0, margin: float = 0.0) -> None: ...
+    def __init__(
+        self, id: int, corners: Corners, hamming: int = 0, margin: float = 0.0, dictionary: str = ""
+    ) -> None: ...
     @property
     def id(self) -> int: ...
     @property
@@ -51,6 +56,11 @@ class Marker:
     @property
     def margin(self) -> float: ...
     @property
+    def dictionary(self) -> str: ...
+    @property
+    def tracked(self) -> bool:
+        """mode="track": found where the last frames predicted it."""
+    @property
     def center(self) -> npt.NDArray[np.float64]: ...
 
 class Detector:
@@ -58,6 +68,7 @@ class Detector:
         self,
         dictionary: Union[str, Dictionary] = "aruco_mip_36h12",
         *,
+        # BEGIN generated: pyi (frappe/settings.h; ninja -C build update-generated)
         mode: str = "normal",
         edge_threshold: float = 0.27,
         corner_threshold: float = 0.19,
@@ -65,6 +76,7 @@ class Detector:
         weak_margin: float = 0.3,
         scaled_size: float = 28.0,
         max_scaled_frames: int = 5,
+        track_cover_frames: int = 4,
         region_contrast: float = 0.16,
         light_floor: float = 0.063,
         corner_cluster_radius: float = 4.0,
@@ -72,6 +84,7 @@ class Detector:
         max_pixels: int = 67108864,
         max_candidates: int = 4096,
         threads: int = 1,
+        # END generated
     ) -> None: ...
     def detect(self, image: GreyImage) -> List[Marker]: ...
     def reset(self) -> None: ...

@@ -12,27 +12,11 @@
 #include <vector>
 
 #include <frappe/detector.h>
+#include <frappe/settings.h>
 
 namespace frappe::python {
 
 namespace {
-
-Mode modeArg(std::string name)
-{
-	std::transform(name.begin(), name.end(), name.begin(), [](unsigned char c) { return std::tolower(c); });
-	if (name == "normal")
-		return Mode::Normal;
-	if (name == "ascale")
-		return Mode::AScale;
-	if (name == "track")
-		return Mode::Track;
-	throw py::value_error("mode must be 'normal', 'ascale' or 'track', not '" + name + "'");
-}
-
-const char *modeName(Mode mode)
-{
-	return mode == Mode::AScale ? "ascale" : mode == Mode::Track ? "track" : "normal";
-}
 
 /// `obj` as a 2-D uint8 array (a (h, w, 1) one too), or TypeError /
 /// ValueError saying what it is instead.
@@ -81,7 +65,7 @@ public:
 	std::string repr() const
 	{
 		return "frappe.Detector(dictionary='" + std::string(dict_.dict->name) + "', mode='" +
-		       modeName(config_.mode) + "', threads=" + std::to_string(config_.threads) + ")";
+		       std::string(modeName(config_.mode)) + "', threads=" + std::to_string(config_.threads) + ")";
 	}
 
 private:
@@ -147,7 +131,7 @@ py::list PyDetector::detect(py::handle obj)
 	py::list markers(result->markers.size());
 	for (std::size_t i = 0; i < result->markers.size(); ++i) {
 		const frappe::Marker &m = result->markers[i];
-		Marker out{ m.id, newFloatArray(4, 2), m.hamming, m.margin, m.tracked };
+		Marker out{ m.id, newFloatArray(4, 2), m.hamming, m.margin, std::string(dict_.dict->name), m.tracked };
 		float *c = out.corners.mutable_data();
 		for (int k = 0; k < 4; ++k) {
 			c[2 * k] = m.corners[k].x;
@@ -188,32 +172,35 @@ void PyDetector::reset()
 	detector_.reset();
 }
 
+/* A setting's value for Python: a number of its type, or a choice's name. */
+py::object settingValue(const Setting &s, const Config &c)
+{
+	if (s.isChoice())
+		return py::str(s.text(c));
+	if (s.isInteger())
+		return py::int_(static_cast<long long>(s.number(c)));
+	return py::float_(s.number(c));
+}
+
 py::dict PyDetector::configDict() const
 {
 	py::dict d;
+	for (const Setting &s : settings()) {
+		if (s.surfaces & kOnPython)
+			d[py::str(std::string(s.name))] = settingValue(s, config_);
+	}
 	d["dictionary"] = dict_.builtin() ? py::cast(std::string(dict_.dict->name)) : py::cast(dict_);
-	d["mode"] = modeName(config_.mode);
-	d["edge_threshold"] = config_.edge_threshold;
-	d["corner_threshold"] = config_.corner_threshold;
-	d["max_hamming"] = config_.max_hamming;
-	d["weak_margin"] = config_.weak_margin;
-	d["scaled_size"] = config_.scaled_size;
-	d["max_scaled_frames"] = config_.max_scaled_frames;
-	d["track_cover_frames"] = config_.track_cover_frames;
-	d["region_contrast"] = config_.region_contrast;
-	d["light_floor"] = config_.light_floor;
-	d["corner_cluster_radius"] = config_.corner_cluster_radius;
-	d["min_marker_side"] = config_.min_marker_side;
-	d["max_pixels"] = config_.max_pixels;
-	d["max_candidates"] = config_.max_candidates;
-	d["threads"] = config_.threads;
 	return d;
 }
 
-PyDetector *makeDetector(py::handle dictionary, const std::string &mode, float edge_threshold,
-			 float corner_threshold, int max_hamming, float weak_margin, float scaled_size,
-			 int max_scaled_frames, int track_cover_frames, float region_contrast, float light_floor, float corner_cluster_radius,
-			 float min_marker_side, long long max_pixels, int max_candidates, int threads)
+std::string typeName(py::handle value)
+{
+	return py::str(value.get_type().attr("__name__"));
+}
+
+/* frappe.Detector(dictionary, **settings): the keywords are the table's
+ * (frappe/settings.h) snake_case names; the stubs and docs list them. */
+PyDetector *makeDetector(py::handle dictionary, const py::kwargs &kwargs)
 {
 	DictionaryRef dict = dictionaryArg(dictionary);
 	Config c;
@@ -221,21 +208,35 @@ PyDetector *makeDetector(py::handle dictionary, const std::string &mode, float e
 		c.dictionary = std::string(dict.dict->name);
 	else
 		c.custom_dictionary = dict.dict;
-	c.mode = modeArg(mode);
-	c.edge_threshold = edge_threshold;
-	c.corner_threshold = corner_threshold;
-	c.max_hamming = max_hamming;
-	c.weak_margin = weak_margin;
-	c.scaled_size = scaled_size;
-	c.max_scaled_frames = max_scaled_frames;
-	c.track_cover_frames = track_cover_frames;
-	c.region_contrast = region_contrast;
-	c.light_floor = light_floor;
-	c.corner_cluster_radius = corner_cluster_radius;
-	c.min_marker_side = min_marker_side;
-	c.max_pixels = max_pixels;
-	c.max_candidates = max_candidates;
-	c.threads = threads;
+	for (const auto &[key, value] : kwargs) {
+		const std::string name = py::str(key);
+		const Setting *s = name.find('-') == std::string::npos ? findSetting(name) : nullptr;
+		if (!s || !(s->surfaces & kOnPython) || s->name == "dictionary")
+			throw py::type_error("Detector() got an unexpected keyword argument '" + name + "'");
+		if (s->isChoice()) {
+			if (!py::isinstance<py::str>(value))
+				throw py::type_error(name + " must be a str, not " + typeName(value));
+			try {
+				s->parse(c, value.cast<std::string>());
+			} catch (const std::invalid_argument &e) {
+				throw py::value_error(name + " " + e.what());
+			}
+		} else if (s->isInteger()) {
+			if (!py::isinstance<py::int_>(value) || py::isinstance<py::bool_>(value))
+				throw py::type_error(name + " must be an int, not " + typeName(value));
+			long long v = 0;
+			try {
+				v = value.cast<long long>();
+			} catch (const py::cast_error &) {
+				throw py::value_error(name + " is out of range: " + std::string(py::str(value)));
+			}
+			s->setNumber(c, static_cast<double>(v));
+		} else {
+			if (!py::isinstance<py::float_>(value) && !py::isinstance<py::int_>(value))
+				throw py::type_error(name + " must be a float, not " + typeName(value));
+			s->setNumber(c, value.cast<double>());
+		}
+	}
 	/* frappe::Detector's std::invalid_argument says which parameter: ValueError. */
 	return new PyDetector(c, std::move(dict));
 }
@@ -245,6 +246,26 @@ PyDetector *makeDetector(py::handle dictionary, const std::string &mode, float e
 void bindDetector(py::module_ &m)
 {
 	const Config d;
+	m.def(
+		"settings",
+		[]() {
+			const Config defaults;
+			py::list out;
+			for (const Setting &s : settings()) {
+				if (!(s.surfaces & kOnPython))
+					continue;
+				py::dict e;
+				e["name"] = std::string(s.name);
+				e["type"] = s.isChoice() ? "str" : s.isInteger() ? "int" : "float";
+				e["default"] = settingValue(s, defaults);
+				e["range"] = s.rangeText();
+				e["doc"] = std::string(s.doc);
+				out.append(e);
+			}
+			return out;
+		},
+		R"doc(Detector's keyword arguments, in frappe::Config's order: a dict per setting
+with its name, type ('float', 'int', 'str'), default, range and doc.)doc");
 	py::class_<PyDetector>(m, "Detector", R"doc(
 Finds the markers of one dictionary in 8-bit grey images.
 
@@ -254,24 +275,16 @@ Finds the markers of one dictionary in 8-bit grey images.
 
 `dictionary` is a name from frappe.dictionaries() (aliases such as
 'DICT_6X6_250' or 'tag36h11' too) or a frappe.Dictionary. The keyword
-arguments are frappe::Config's fields (frappe/config.h says what each trades
-off); the defaults are the paper's. An unknown dictionary or a value out of
-range raises ValueError saying which.
+arguments are frappe::Config's fields, by the names frappe.settings() lists
+(docs/settings.md says what each trades off); the defaults are the paper's.
+An unknown keyword or a value of the wrong type raises TypeError, an unknown
+dictionary or a value out of range ValueError saying which.
 
 One detector detects one frame at a time: calls from several threads take
 turns (the GIL is released while detecting). Use one detector per thread to
 detect in parallel; with mode='ascale' or 'track' one detector per video
 stream, its frames in order.)doc")
-		.def(py::init(&makeDetector), py::arg("dictionary") = d.dictionary, py::kw_only(),
-		     py::arg("mode") = "normal", py::arg("edge_threshold") = d.edge_threshold,
-		     py::arg("corner_threshold") = d.corner_threshold, py::arg("max_hamming") = d.max_hamming,
-		     py::arg("weak_margin") = d.weak_margin, py::arg("scaled_size") = d.scaled_size,
-		     py::arg("max_scaled_frames") = d.max_scaled_frames,
-		     py::arg("track_cover_frames") = d.track_cover_frames,
-		     py::arg("region_contrast") = d.region_contrast, py::arg("light_floor") = d.light_floor,
-		     py::arg("corner_cluster_radius") = d.corner_cluster_radius,
-		     py::arg("min_marker_side") = d.min_marker_side, py::arg("max_pixels") = d.max_pixels,
-		     py::arg("max_candidates") = d.max_candidates, py::arg("threads") = d.threads)
+		.def(py::init(&makeDetector), py::arg("dictionary") = d.dictionary)
 		.def("detect", &PyDetector::detect, py::arg("image"), R"doc(
 The markers in `image`, a 2-D uint8 numpy array (height, width) of grey
 levels, as a list of frappe.Marker. Any strides: an array whose rows are
@@ -280,8 +293,7 @@ into a buffer the detector keeps. A colour image raises ValueError (convert
 it to grey first: cv2.cvtColor(image, cv2.COLOR_BGR2GRAY), or read it with
 cv2.IMREAD_GRAYSCALE as frappe-detect does), another dtype TypeError, an image
 over max_pixels ValueError.)doc")
-		.def("reset", &PyDetector::reset,
-		     "Forgets what mode='ascale' or 'track' learned from earlier frames.")
+		.def("reset", &PyDetector::reset, "Forgets what mode='ascale' or 'track' learned from earlier frames.")
 		.def_property_readonly("stats", &PyDetector::stats, R"doc(
 The last detect() call: {'times_ms': {stage: ms, ..., 'total': ms},
 'scale': the resolution traced at, 'candidates': outlines decoded,

@@ -3,6 +3,8 @@
 // the corners that estimate_pose() and draw_marker() take.
 #include "module.h"
 
+#include <frappe/marker_record.h>
+
 #include <cstdio>
 #include <string>
 
@@ -30,10 +32,10 @@ std::array<Point2f, 4> cornersArg(py::handle obj)
 
 namespace {
 
-Marker makeMarker(int id, py::handle corners, int hamming, float margin)
+Marker makeMarker(int id, py::handle corners, int hamming, float margin, std::string dictionary, bool tracked)
 {
 	const std::array<Point2f, 4> c = cornersArg(corners);
-	Marker m{ id, newFloatArray(4, 2), hamming, margin };
+	Marker m{ id, newFloatArray(4, 2), hamming, margin, std::move(dictionary), tracked };
 	float *out = m.corners.mutable_data();
 	for (int i = 0; i < 4; ++i) {
 		out[2 * i] = c[i].x;
@@ -42,9 +44,16 @@ Marker makeMarker(int id, py::handle corners, int hamming, float margin)
 	return m;
 }
 
+/* frappe.Marker(...): made by hand, never tracked. */
+Marker newMarker(int id, py::handle corners, int hamming, float margin, std::string dictionary)
+{
+	return makeMarker(id, corners, hamming, margin, std::move(dictionary), false);
+}
+
 std::string repr(const Marker &m)
 {
-	std::string s = "frappe.Marker(id=" + std::to_string(m.id) + ", corners=[";
+	std::string s = "frappe.Marker(id=" + std::to_string(m.id) +
+			(m.dictionary.empty() ? "" : ", dictionary='" + m.dictionary + "'") + ", corners=[";
 	const float *c = m.corners.data();
 	char buf[64];
 	for (int i = 0; i < 4; ++i) {
@@ -62,22 +71,27 @@ void bindMarker(py::module_ &m)
 	py::class_<Marker>(m, "Marker", R"doc(
 One detected marker.
 
-id       its id in the detector's dictionary
-corners  (4, 2) float32 array, pixels: the outer corners of the black border,
-         top-left, top-right, bottom-right, bottom-left of the marker in its
-         upright orientation (clockwise on screen), as cv2.aruco orders them;
-         (0, 0) is the centre of the top-left pixel
-hamming  bits corrected to reach the code
-margin   how clearly the code was read, 0..1: filter on it to trade misses for
-         certainty
-tracked  mode='track': found where the last frames predicted it (its corners
-         measured on this frame all the same); False when found afresh)doc")
-		.def(py::init(&makeMarker), py::arg("id"), py::arg("corners"), py::arg("hamming") = 0,
-		     py::arg("margin") = 0.0f)
+id          its id in the detector's dictionary
+dictionary  the dictionary's name (the library's spelling)
+corners     (4, 2) float32 array, pixels: the outer corners of the black
+            border, top-left, top-right, bottom-right, bottom-left of the marker
+            in its upright orientation (clockwise on screen), as cv2.aruco
+            orders them; (0, 0) is the centre of the top-left pixel
+hamming     bits corrected to reach the code
+margin      how clearly the code was read, 0..1: filter on it to trade misses
+            for certainty
+tracked     mode='track': found where the last frames predicted it (its corners
+            measured on this frame all the same); False when found afresh
+
+The fields are frappe::forEachMarkerField()'s (frappe.MARKER_FIELDS, the pose's
+aside: frappe.estimate_pose), as frappe-detect's and frappejson's JSON.)doc")
+		.def(py::init(&newMarker), py::arg("id"), py::arg("corners"), py::arg("hamming") = 0,
+		     py::arg("margin") = 0.0f, py::arg("dictionary") = "")
 		.def_readonly("id", &Marker::id)
 		.def_readonly("corners", &Marker::corners)
 		.def_readonly("hamming", &Marker::hamming)
 		.def_readonly("margin", &Marker::margin)
+		.def_readonly("dictionary", &Marker::dictionary)
 		.def_readonly("tracked", &Marker::tracked)
 		.def_property_readonly(
 			"center",
@@ -92,12 +106,23 @@ tracked  mode='track': found where the last frames predicted it (its corners
 			"The mean of the corners, (2,) float64.")
 		.def("__repr__", &repr)
 		.def(py::pickle(
-			[](const Marker &mk) { return py::make_tuple(mk.id, mk.corners, mk.hamming, mk.margin); },
+			[](const Marker &mk) {
+				return py::make_tuple(mk.id, mk.corners, mk.hamming, mk.margin, mk.dictionary,
+						      mk.tracked);
+			},
 			[](const py::tuple &t) {
-				if (t.size() != 4)
-					throw py::value_error("a pickled frappe.Marker has 4 fields");
-				return makeMarker(t[0].cast<int>(), t[1], t[2].cast<int>(), t[3].cast<float>());
+				/* 4: pickled before the dictionary was a field, 5: before tracked */
+				if (t.size() < 4 || t.size() > 6)
+					throw py::value_error("a pickled frappe.Marker has 6 fields");
+				return makeMarker(t[0].cast<int>(), t[1], t[2].cast<int>(), t[3].cast<float>(),
+						  t.size() >= 5 ? t[4].cast<std::string>() : std::string(),
+						  t.size() == 6 && t[5].cast<bool>());
 			}));
+	/* The library's one list of a marker's output fields (pose ones last). */
+	py::tuple fields(markerFieldNames().size());
+	for (std::size_t i = 0; i < markerFieldNames().size(); ++i)
+		fields[i] = py::str(std::string(markerFieldNames()[i]));
+	m.attr("MARKER_FIELDS") = fields;
 }
 
 } // namespace frappe::python

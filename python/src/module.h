@@ -38,7 +38,8 @@ struct Marker {
 	py::array_t<float> corners; ///< (4, 2) float32: top-left, top-right, bottom-right, bottom-left
 	int hamming = 0;
 	float margin = 0.0f;
-	bool tracked = false; ///< mode='track': found where the last frames predicted it
+	std::string dictionary; ///< the detector's dictionary's name
+	bool tracked = false;   ///< mode='track': found where the last frames predicted it
 };
 
 /// Four corners from a Marker, or an array-like of 8 numbers shaped (4, 2)

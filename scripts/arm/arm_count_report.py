@@ -110,8 +110,13 @@ def object_of(ranges, starts, addr):
     return "?"
 
 
+# Object files are named after their source's path: src_<room>_<file>.cpp.o
+# (frappe-core/src/<room>/<file>.cpp).
+ROOM = r"^src_(?:(?:base|dictionary|front_end|trace|read|detector|pose|render)_(?=.))?"
+
+
 def stage_of(obj, name):
-    base = re.sub(r"^src_", "", obj.replace(".cpp.o", "").replace(".o", ""))
+    base = re.sub(ROOM, "", obj.replace(".cpp.o", "").replace(".o", ""))
     if base.startswith("front_end"):
         return "front_end"
     if base.startswith("region_map"):
@@ -372,7 +377,7 @@ def main():
     for b, (s, l) in ranked[: a.top]:
         dem, obj, stage = binfo.get(b, ("?", "?", "other"))
         tot = s + l
-        P(f"| `{short(dem)}` | {re.sub('^src_', '', obj.replace('.cpp.o', ''))} | {stage} | {tot/total_px:.2f} | {s/total_px:.2f} | "
+        P(f"| `{short(dem)}` | {re.sub(ROOM, '', obj.replace('.cpp.o', ''))} | {stage} | {tot/total_px:.2f} | {s/total_px:.2f} | "
           f"{l/total_px:.2f} | {100*tot/grand:.1f}% |")
     P("")
     text = "\n".join(out)

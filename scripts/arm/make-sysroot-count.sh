@@ -4,7 +4,8 @@
 # libjpeg (the counting driver decodes the images on the guest), plus
 # libopencv_aruco taken alone from libopencv-contrib406 (the package itself
 # would pull Qt, HDF5, Tesseract, VTK ...). Adapted from the team's
-# tools/arm/make-sysroot.sh. Nothing runs inside the sysroot (mmdebstrap
+# ../shared/tools/arm/make-sysroot.sh (the team's folder beside the
+# checkout). Nothing runs inside the sysroot (mmdebstrap
 # --variant=extract), so no emulation is needed to make it.
 #
 # usage: make-sysroot-count.sh DEST      (needs mmdebstrap and Debian's archive)

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// The ARMv6 SIMD32 row kernels (frappe-core/src/front_end_armv6.cpp) against
+// The ARMv6 SIMD32 row kernels (frappe-core/src/front_end/front_end_armv6.cpp) against
 // the scalar reference, byte for byte. Built for the ARM1176 by the cross
 // compiler and run under `qemu-arm -cpu arm1176` (see meson.build here), so
 // an ARMv7 or NEON instruction would also fail it (SIGILL).

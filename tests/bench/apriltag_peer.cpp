@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 // apriltag-peer: AprilTag 3.3 (Debian's libapriltag) on a list of images,
-// writing the detector contract's JSON lines (shared/design/
-// DETECTOR-CONTRACT.md), for the AprilTag families frappe-bench does not
+// writing the detector contract's JSON lines
+// (../shared/design/DETECTOR-CONTRACT.md), for the AprilTag families frappe-bench does not
 // run: the layout families of issue 32 (tagStandard41h12 and its kin), and
 // the classic ones.
 //

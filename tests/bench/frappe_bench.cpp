@@ -10,8 +10,9 @@
 // ratio, and each stage's share of frappe's time. OpenCV gets the same
 // dictionary as a custom Dictionary, at most 5 corrected bits (capped by
 // the dictionary's safe maximum), and no corner refinement, as in
-// shared/design/DETECTOR-CONTRACT.md. For AprilTag families, AprilTag 3.3
-// (Debian's libapriltag) runs too, single-threaded, at decimate 1 and 2.
+// ../shared/design/DETECTOR-CONTRACT.md (the team's folder beside the
+// checkout). For AprilTag families, AprilTag 3.3 (Debian's libapriltag)
+// runs too, single-threaded, at decimate 1 and 2.
 //
 // Then, unless --no-extras: throughput with two threads (front-end bands,
 // the staged pipeline, whole frames on two detectors at latency 2 and at the
@@ -157,8 +158,8 @@ void reportThroughput(const frappe::Config &base, const std::vector<cv::Mat> &im
 	one.threads = 1;
 	two.threads = 2;
 	frappe::Detector d1(one), d2(two);
-	frappe::Pipeline pipe(one, frappe::Pipeline::Mode::Stages), frames(two, frappe::Pipeline::Mode::Frames),
-		held(two, frappe::Pipeline::Mode::Frames, 1);
+	frappe::Pipeline pipe(one, frappe::Pipeline::Overlap::Stages), frames(two, frappe::Pipeline::Overlap::Frames),
+		held(two, frappe::Pipeline::Overlap::Frames, 1);
 	std::size_t sink = 0;
 	auto single = [&](const cv::Mat &g) { sink += d1.detect(viewOf(g)).markers.size(); };
 	auto bands = [&](const cv::Mat &g) { sink += d2.detect(viewOf(g)).markers.size(); };

@@ -13,7 +13,7 @@
 // scene at a higher resolution: markers F times larger); --canvas F puts
 // each frame in the middle of a frame F times larger, the rest the frame's
 // own pixels mirrored (the same markers, in pixels, in a larger scene). The
-// JSON lines are the contract's, for shared/tools/eval.py (with --resize
+// JSON lines are the contract's, for ../shared/tools/eval.py (with --resize
 // or --canvas the truth's corners no longer apply). --only runs one mode,
 // for instruction counts (valgrind --tool=callgrind
 // --toggle-collect='frappe::Detector::detect(*'). Not a test: speed is

@@ -148,9 +148,9 @@ def pose(exe, sample, expected, tmp):
         m = next(m for m in json_lines(r)[0]['markers'] if m['id'] == truth['id'])
         t = m['tvec']
         off = math.dist(t, (0, 0, 4 * size))
-        check(r.returncode == 0 and off < 0.01 * 4 * size and m['pose_error'] < 0.5,
+        check(r.returncode == 0 and off < 0.01 * 4 * size and m['reprojection_error'] < 0.5,
               'id %d: tvec %s within 1%% of (0, 0, %.2f) m in its rendering camera; reprojection %.3f px'
-              % (truth['id'], ['%.4f' % v for v in t], 4 * size, m['pose_error']))
+              % (truth['id'], ['%.4f' % v for v in t], 4 * size, m['reprojection_error']))
         check(len(m['rvec']) == 3, 'rvec given')
 
     # One camera for all: the id 17's; --marker-sizes gives 10 cm to id 17.

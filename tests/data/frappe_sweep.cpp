@@ -97,37 +97,26 @@ Run parseRun(const std::string &spec)
 	return r;
 }
 
-std::string escape(const std::string &s)
-{
-	std::string o;
-	for (char c : s) {
-		if (c == '"' || c == '\\')
-			o += '\\';
-		if (static_cast<unsigned char>(c) >= 0x20)
-			o += c;
-	}
-	return o;
-}
-
+/* frappe-detect's line (the library's one marker writer, rounded). */
 void writeLine(std::ofstream &out, const std::string &image, const std::vector<frappe::Marker> &markers,
-	       double ms, const std::string &error)
+	       std::string_view dictionary, double ms, const std::string &error)
 {
-	out << "{\"image\": \"" << escape(image) << "\", \"markers\": [";
-	char buf[200];
+	std::string line = "{\"image\": ";
+	frappe::appendJsonString(line, image);
+	line += ", \"markers\": [";
 	for (std::size_t i = 0; i < markers.size(); ++i) {
-		const frappe::Marker &m = markers[i];
-		const auto &c = m.corners;
-		std::snprintf(buf, sizeof(buf),
-			      "%s{\"id\": %d, \"corners\": [[%.3f, %.3f], [%.3f, %.3f], [%.3f, %.3f], [%.3f, %.3f]], \"hamming\": %d, \"margin\": %.3f}",
-			      i ? ", " : "", m.id, c[0].x, c[0].y, c[1].x, c[1].y, c[2].x, c[2].y, c[3].x, c[3].y, m.hamming,
-			      m.margin);
-		out << buf;
+		if (i)
+			line += ", ";
+		frappe::appendMarkerJson(line, { &markers[i], dictionary, nullptr }, frappe::JsonNumbers::Rounded);
 	}
-	out << "]";
-	if (!error.empty())
-		out << ", \"error\": \"" << escape(error) << "\"";
+	line += "]";
+	if (!error.empty()) {
+		line += ", \"error\": ";
+		frappe::appendJsonString(line, error);
+	}
+	char buf[64];
 	std::snprintf(buf, sizeof(buf), ", \"time_ms\": %.4f}\n", ms);
-	out << buf;
+	out << line << buf;
 }
 
 /* The image exposed `light` times as long, with sensor noise of 1.5 grey
@@ -224,7 +213,7 @@ int main(int argc, char **argv)
 			}
 			if (!error.empty())
 				std::cerr << "frappe-sweep: " << path << ": " << error << "\n";
-			writeLine(r.file, path, markers, ms, error);
+			writeLine(r.file, path, markers, r.detector->dictionary().name, ms, error);
 		}
 	}
 	for (Run &r : runs) {

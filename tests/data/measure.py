@@ -1,5 +1,5 @@
 """Runs frappe over the team's data sets and scores it with the team's scorer
-(shared/tools/eval.py): the part shared by tests/data/test_data.py, which
+(../shared/tools/eval.py): the part shared by tests/data/test_data.py, which
 holds the floors, and scripts/quality.py, which prints the tables.
 
 Subsets are named as in the floors table: 'synth/blur', 'real/visp_apriltag'.

@@ -9,7 +9,7 @@ dictionary over the other families' subsets), track (Mode::Track against
 Mode::Normal on the sequences), resolution (every subset
 upsampled 2x and 3x) or exposure (every subset darkened and brightened). Each check prints its measurement, the enforced floor
 and the issue's target. Exits 77 (skipped) when the shared folder is absent,
-as on a user's machine. Scoring is shared/tools/eval.py's (needs numpy).
+as on a user's machine. Scoring is ../shared/tools/eval.py's (needs numpy).
 """
 import math
 import os

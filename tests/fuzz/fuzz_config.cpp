@@ -78,19 +78,25 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t *data, std::size_t size
 
 	static constexpr frappe::Mode kModes[] = { frappe::Mode::Normal, frappe::Mode::AScale, frappe::Mode::Track };
 	c.mode = kModes[in.get<std::uint8_t>() % 3];
-	c.edge_threshold = number(in, 0.27f);
-	c.corner_threshold = number(in, 0.19f);
-	c.max_hamming = in.get<std::int8_t>() % 24;
-	c.weak_margin = number(in, 0.3f);
-	c.scaled_size = number(in, 28.0f);
-	c.max_scaled_frames = in.get<std::int16_t>();
-	c.track_cover_frames = in.get<std::int16_t>();
-	c.region_contrast = number(in, 0.16f);
-	c.light_floor = number(in, 0.063f);
-	c.corner_cluster_radius = number(in, 4.0f);
-	c.min_marker_side = number(in, 10.0f);
-	c.threads = in.get<std::int8_t>() % 4;
-	c.max_pixels = (in.get<std::uint8_t>() & 1) != 0 ? in.get<std::int64_t>() : c.max_pixels;
+	/* Every number of the settings table, from its default (Config{}'s):
+	 * a new setting is fuzzed without a line here. */
+	for (const frappe::Setting &s : frappe::settings()) {
+		if (s.isChoice())
+			continue;
+		const double typical = s.number(c);
+		if (!s.isInteger()) {
+			s.setNumber(c, number(in, static_cast<float>(typical)));
+			continue;
+		}
+		const std::uint8_t how = in.get<std::uint8_t>();
+		const std::int32_t raw = in.get<std::int32_t>();
+		switch (how % 4) {
+		case 0: s.setNumber(c, typical); break;
+		case 1: s.setNumber(c, typical + static_cast<std::int8_t>(how) / 8); break;
+		case 2: s.setNumber(c, raw % 8); break;
+		default: s.setNumber(c, raw); break; /* negatives, huge */
+		}
+	}
 
 	/* Geometry: sizes, strides and the pixel count around the limits. */
 	const int w = in.get<std::int16_t>() % 300;
@@ -100,11 +106,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t *data, std::size_t size
 					 static_cast<std::size_t>(std::max(0, h)) + 1, 128);
 	const frappe::ImageView view(pixels.data(), w, h, stride);
 
-	/* After the frame, so that the seeds keep their layout (zeros past
-	 * the end keep the default). */
 	const std::uint8_t pipelineMode = in.get<std::uint8_t>();
-	if ((in.get<std::uint8_t>() & 1) != 0)
-		c.max_candidates = in.get<std::int32_t>();
 
 	/* The public helpers: a bad argument is std::invalid_argument (or
 	 * std::out_of_range for an id), never undefined behaviour. Cells stay
@@ -125,10 +127,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t *data, std::size_t size
 			det.detect(view);
 		} catch (const std::invalid_argument &) {
 		}
-		/* Mode::Stages at latency 2 or 1 (the element's staged overlap). */
+		/* Overlap::Stages at latency 2 or 1 (the element's staged overlap). */
 		const bool staged = (pipelineMode & 1) != 0;
-		frappe::Pipeline pipeline(c, staged ? frappe::Pipeline::Mode::Stages : frappe::Pipeline::Mode::Frames,
-					  staged ? 2 - ((pipelineMode >> 1) & 1) : frappe::Pipeline::kDefaultLatency);
+		frappe::Pipeline pipeline(
+			c, staged ? frappe::Pipeline::Overlap::Stages : frappe::Pipeline::Overlap::Frames,
+			staged ? 2 - ((pipelineMode >> 1) & 1) : frappe::Pipeline::kDefaultLatency);
 		try {
 			pipeline.push(view);
 		} catch (const std::invalid_argument &) {

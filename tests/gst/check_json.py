@@ -27,6 +27,12 @@ def main():
         if a["pts"] != b["timestamp"]:
             print(f"out of order: {a['pts']} vs {b['timestamp']}")
             return 1
+        # One record, one writer: the meta's and the message's markers have
+        # the same fields in the same order, as frappe-detect's and frappejson's.
+        for ma, mb in zip(a["markers"], b["markers"]):
+            if list(ma) != list(mb) or list(ma)[:5] != ["id", "dictionary", "corners", "hamming", "margin"]:
+                print(f"frame {a['pts']}: fields {list(ma)} (meta) vs {list(mb)} (message)")
+                return 1
         ids = sorted(m["id"] for m in a["markers"])
         if ids != [0, 7, 23, 42] or ids != sorted(m["id"] for m in b["markers"]):
             print(f"frame {a['pts']}: ids {ids}")

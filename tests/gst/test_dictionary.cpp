@@ -2,6 +2,8 @@
 // frappedetect's dictionaries: the dictionary property by the library's
 // name and by its dashed nick, and dictionary-file (a dictionary of one's
 // own, named in the metas; a bad file refused at start or while playing).
+#include <algorithm>
+#include <cctype>
 #include <cstdio>
 #include <string>
 
@@ -29,13 +31,12 @@ std::string parsedDictionary(const std::string &launch)
 	EXPECT_EQ(error, nullptr) << (error ? error->message : "");
 	if (!e)
 		return "";
-	gint value = -1;
+	gchar *value = nullptr;
 	g_object_get(e, "dictionary", &value, nullptr);
-	GEnumClass *klass = G_ENUM_CLASS(g_type_class_peek(G_PARAM_SPEC_VALUE_TYPE(
-		g_object_class_find_property(G_OBJECT_GET_CLASS(e), "dictionary"))));
-	const GEnumValue *v = g_enum_get_value(klass, value);
 	gst_object_unref(e);
-	return v ? v->value_name : "";
+	std::string name = value ? value : "";
+	g_free(value);
+	return name;
 }
 
 /* The first `count` codes of a built-in dictionary in frappe's text
@@ -55,8 +56,8 @@ std::string dictionaryText(const frappe::Dictionary &d, int count, const char *n
 
 } // namespace
 
-/* Both spellings parse to the same value, for every built-in dictionary,
- * and detection then uses it. */
+/* Every spelling parses to the library's name, for every built-in
+ * dictionary, and detection then uses it. */
 TEST(Dictionary, ByLibraryNameAndByNick)
 {
 	for (const auto &d : frappe::dictionaries()) {
@@ -65,6 +66,14 @@ TEST(Dictionary, ByLibraryNameAndByNick)
 		std::replace(nick.begin(), nick.end(), '_', '-');
 		EXPECT_EQ(parsedDictionary("frappedetect dictionary=" + name), name);
 		EXPECT_EQ(parsedDictionary("frappedetect dictionary=" + nick), name);
+		/* OpenCV's spelling, and AprilTag's for its families: the CLI's and Python's. */
+		std::string opencv = "DICT_" + name;
+		std::transform(opencv.begin(), opencv.end(), opencv.begin(),
+			       [](unsigned char c) { return std::toupper(c); });
+		EXPECT_EQ(parsedDictionary("frappedetect dictionary=" + opencv), name);
+		if (name.starts_with("apriltag_")) {
+			EXPECT_EQ(parsedDictionary("frappedetect dictionary=tag" + name.substr(9)), name);
+		}
 	}
 
 	const FrameSpec spec{ GST_VIDEO_FORMAT_GRAY8, 320, 240 };

@@ -334,8 +334,8 @@ TEST(Properties, ChangeWhilePlaying)
 	out = gst_harness_push_and_pull(h, gst_buffer_ref(frame6x6));
 	EXPECT_EQ(gst_buffer_get_n_frappe_marker_metas(out), 0u);
 	gst_buffer_unref(out);
-	g_object_set(detector(h), "edge-threshold", 0.27f, "region-contrast", 0.16f, "mode", 1, "max-hamming", 2, "scaled-size", 20.0f,
-		     "max-scaled-frames", 3, "backend", 1, nullptr);
+	g_object_set(detector(h), "edge-threshold", 0.27f, "region-contrast", 0.16f, "mode", "ascale", "max-hamming", 2,
+		     "scaled-size", 20.0f, "max-scaled-frames", 3, "backend", 1, nullptr);
 	for (int i = 0; i < 6; ++i) {
 		out = gst_harness_push_and_pull(h, gst_buffer_ref(frame6x6));
 		expectMarkers(out, markers, "6x6_250", 0.5f);

@@ -1,8 +1,7 @@
 // SPDX-License-Identifier: MIT
-// frappedetect's detector properties against the library: their defaults
-// are frappe::Config{}'s, and the ends of their ranges are values the
-// library's validation accepts (and just beyond, where the GParamSpec end is
-// the library's, values it refuses).
+// frappedetect's detector properties against the library's settings table:
+// one per entry the element offers, Config{}'s defaults, ranges whose ends
+// the library accepts, and the dictionary's spellings.
 #include <algorithm>
 #include <cmath>
 #include <functional>
@@ -14,6 +13,7 @@
 #include <frappe/config.h>
 #include <frappe/detector.h>
 #include <frappe/dictionary.h>
+#include <frappe/settings.h>
 
 #include "helpers.h"
 
@@ -47,79 +47,104 @@ bool accepted(const std::function<void(frappe::Config &)> &set)
 	}
 }
 
-/* A float property: default, both ends accepted, beyond max refused. */
-void checkFloat(const Element &el, const char *name, float frappe::Config::*field, bool minIsLibrarys)
+/* The value of a numeric property's GParamSpec end as a double. */
+double specEnd(GParamSpec *p, bool maximum)
 {
-	SCOPED_TRACE(name);
-	auto *p = G_PARAM_SPEC_FLOAT(el.spec(name));
-	ASSERT_NE(p, nullptr);
-	EXPECT_EQ(p->default_value, frappe::Config{}.*field);
-	EXPECT_TRUE(accepted([&](frappe::Config &c) { c.*field = p->minimum; }));
-	EXPECT_TRUE(accepted([&](frappe::Config &c) { c.*field = p->maximum; }));
-	EXPECT_FALSE(accepted([&](frappe::Config &c) { c.*field = std::nextafter(p->maximum, 1e9f); }));
-	if (minIsLibrarys) {
-		EXPECT_FALSE(accepted([&](frappe::Config &c) { c.*field = std::nextafter(p->minimum, -1e9f); }));
-	}
-}
-
-/* An int property: default, both ends accepted, beyond either refused. */
-void checkInt(const Element &el, const char *name, int frappe::Config::*field)
-{
-	SCOPED_TRACE(name);
-	auto *p = G_PARAM_SPEC_INT(el.spec(name));
-	ASSERT_NE(p, nullptr);
-	EXPECT_EQ(p->default_value, frappe::Config{}.*field);
-	EXPECT_TRUE(accepted([&](frappe::Config &c) { c.*field = p->minimum; }));
-	EXPECT_TRUE(accepted([&](frappe::Config &c) { c.*field = p->maximum; }));
-	EXPECT_FALSE(accepted([&](frappe::Config &c) { c.*field = p->minimum - 1; }));
-	EXPECT_FALSE(accepted([&](frappe::Config &c) { c.*field = p->maximum + 1; }));
+	if (G_IS_PARAM_SPEC_FLOAT(p))
+		return maximum ? G_PARAM_SPEC_FLOAT(p)->maximum : G_PARAM_SPEC_FLOAT(p)->minimum;
+	if (G_IS_PARAM_SPEC_INT(p))
+		return maximum ? G_PARAM_SPEC_INT(p)->maximum : G_PARAM_SPEC_INT(p)->minimum;
+	return static_cast<double>(maximum ? G_PARAM_SPEC_INT64(p)->maximum : G_PARAM_SPEC_INT64(p)->minimum);
 }
 
 } // namespace
 
-TEST(Settings, DetectorPropertiesFollowTheLibrary)
+/* Every setting of the table the element offers is a property of the
+ * kebab-case name, with Config{}'s default and the table's range; the
+ * others are not properties. */
+TEST(Settings, DetectorPropertiesAreTheTable)
 {
 	Element el;
 	ASSERT_NE(el.e, nullptr);
-	/* edge_threshold is (0, 4]: a closed GParamSpec range starts above 0. */
-	checkFloat(el, "edge-threshold", &frappe::Config::edge_threshold, false);
-	checkFloat(el, "corner-threshold", &frappe::Config::corner_threshold, true);
-	checkFloat(el, "region-contrast", &frappe::Config::region_contrast, true);
-	checkFloat(el, "light-floor", &frappe::Config::light_floor, true);
-	checkFloat(el, "scaled-size", &frappe::Config::scaled_size, true);
-
-	checkInt(el, "max-scaled-frames", &frappe::Config::max_scaled_frames);
-	checkInt(el, "track-cover-frames", &frappe::Config::track_cover_frames);
-
-	/* max-hamming: the element clamps to the dictionary; its maximum is
-	 * the largest some dictionary accepts. */
-	auto *hamming = G_PARAM_SPEC_INT(el.spec("max-hamming"));
-	EXPECT_EQ(hamming->default_value, frappe::Config{}.max_hamming);
-	EXPECT_TRUE(accepted([&](frappe::Config &c) { c.max_hamming = hamming->minimum; }));
-	EXPECT_FALSE(accepted([&](frappe::Config &c) { c.max_hamming = hamming->minimum - 1; }));
-	bool someAcceptMax = false;
-	for (const auto &d : frappe::dictionaries()) {
-		const std::string name(d.name);
-		someAcceptMax |= accepted([&](frappe::Config &c) {
-			c.dictionary = name;
-			c.max_hamming = hamming->maximum;
-		});
-		EXPECT_FALSE(accepted([&](frappe::Config &c) {
-			c.dictionary = name;
-			c.max_hamming = hamming->maximum + 1;
-		})) << name;
+	const frappe::Config defaults;
+	for (const frappe::Setting &s : frappe::settings()) {
+		const std::string name = s.kebabName();
+		SCOPED_TRACE(name);
+		GParamSpec *p = g_object_class_find_property(G_OBJECT_GET_CLASS(el.e), name.c_str());
+		if (!(s.surfaces & frappe::kOnElement)) {
+			EXPECT_EQ(p, nullptr);
+			continue;
+		}
+		ASSERT_NE(p, nullptr);
+		GValue v = G_VALUE_INIT;
+		g_value_init(&v, p->value_type);
+		g_object_get_property(G_OBJECT(el.e), name.c_str(), &v);
+		if (s.isChoice()) {
+			ASSERT_TRUE(G_IS_PARAM_SPEC_STRING(p));
+			EXPECT_STREQ(G_PARAM_SPEC_STRING(p)->default_value, s.text(defaults).c_str());
+			EXPECT_EQ(g_value_get_string(&v), s.text(defaults));
+		} else {
+			frappe::Config lo, hi, beyond;
+			s.setNumber(lo, specEnd(p, false));
+			s.setNumber(hi, specEnd(p, true));
+			if (s.name == "max_hamming")
+				hi.dictionary = "apriltag_standard52h13"; /* the widest dictionary's most */
+			EXPECT_TRUE(accepted([&](frappe::Config &c) { c = lo; })) << specEnd(p, false);
+			if (std::isfinite(s.max)) {
+				EXPECT_TRUE(accepted([&](frappe::Config &c) { c = hi; })) << specEnd(p, true);
+				EXPECT_EQ(specEnd(p, true), s.max);
+			}
+			/* The closed end is the library's; an open one starts just above. */
+			EXPECT_EQ(specEnd(p, false) == s.min, !s.min_open);
+			GValue d = G_VALUE_INIT;
+			g_value_init(&d, G_TYPE_DOUBLE);
+			ASSERT_TRUE(g_value_transform(&v, &d));
+			EXPECT_EQ(g_value_get_double(&d), s.number(defaults));
+			g_value_unset(&d);
+		}
+		g_value_unset(&v);
 	}
-	EXPECT_TRUE(someAcceptMax);
+}
 
-	/* dictionary and mode default to the library's. */
-	auto *dictionary = G_PARAM_SPEC_ENUM(el.spec("dictionary"));
-	GEnumValue *v = g_enum_get_value(dictionary->enum_class, dictionary->default_value);
-	ASSERT_NE(v, nullptr);
-	std::string nick(v->value_nick);
-	std::replace(nick.begin(), nick.end(), '-', '_');
-	EXPECT_EQ(nick, frappe::Config{}.dictionary);
-	auto *mode = G_PARAM_SPEC_ENUM(el.spec("mode"));
-	v = g_enum_get_value(mode->enum_class, mode->default_value);
-	ASSERT_NE(v, nullptr);
-	EXPECT_STREQ(v->value_nick, frappe::Config{}.mode == frappe::Mode::AScale ? "ascale" : "normal");
+/* The dictionary property takes every spelling the library does, prints
+ * the library's, and refuses an unknown name with a warning that lists
+ * the valid ones, keeping the previous value. */
+TEST(Settings, DictionaryTakesEverySpelling)
+{
+	Element el;
+	ASSERT_NE(el.e, nullptr);
+	for (const char *spelling : { "tag36h11", "DICT_APRILTAG_36h11", "apriltag-36h11", "apriltag_36h11" }) {
+		g_object_set(el.e, "dictionary", "4x4_50", nullptr);
+		gst_util_set_object_arg(G_OBJECT(el.e), "dictionary", spelling);
+		gchar *value = nullptr;
+		g_object_get(el.e, "dictionary", &value, nullptr);
+		EXPECT_STREQ(value, "apriltag_36h11") << spelling;
+		g_free(value);
+	}
+	gst_util_set_object_arg(G_OBJECT(el.e), "dictionary", "DICT_6X6_250");
+	gst_util_set_object_arg(G_OBJECT(el.e), "mode", "ASCALE");
+	gchar *dictionary = nullptr, *mode = nullptr;
+	g_object_get(el.e, "dictionary", &dictionary, "mode", &mode, nullptr);
+	EXPECT_STREQ(dictionary, "6x6_250");
+	EXPECT_STREQ(mode, "ascale");
+	g_free(dictionary);
+	g_free(mode);
+
+	GstBus *bus = gst_bus_new();
+	gst_element_set_bus(el.e, bus);
+	g_object_set(el.e, "dictionary", "no-such-family", nullptr);
+	GstMessage *msg = gst_bus_pop_filtered(bus, GST_MESSAGE_WARNING);
+	ASSERT_NE(msg, nullptr);
+	GError *err = nullptr;
+	gst_message_parse_warning(msg, &err, nullptr);
+	EXPECT_NE(std::string(err->message).find("no-such-family"), std::string::npos) << err->message;
+	EXPECT_NE(std::string(err->message).find("aruco_mip_36h12"), std::string::npos) << err->message;
+	EXPECT_NE(std::string(err->message).find("apriltag_36h11"), std::string::npos) << err->message;
+	g_error_free(err);
+	gst_message_unref(msg);
+	g_object_get(el.e, "dictionary", &dictionary, nullptr);
+	EXPECT_STREQ(dictionary, "6x6_250");
+	g_free(dictionary);
+	gst_element_set_bus(el.e, nullptr);
+	gst_object_unref(bus);
 }

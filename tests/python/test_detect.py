@@ -186,6 +186,32 @@ def test_marker_object():
     assert (m2.id, m2.corners.tolist(), m2.hamming, m2.margin) == (m.id, m.corners.tolist(), m.hamming, m.margin)
 
 
+def test_marker_has_the_librarys_fields(scene):
+    # One list of a marker's fields (frappe/marker_record.h): Python's
+    # Marker has each that is not the pose's (frappe.estimate_pose's).
+    image, _ = scene
+    m = frappe.Detector("aruco-mip-36h12").detect(image)[0]
+    pose_fields = ("rvec", "tvec", "reprojection_error", "alternative_reprojection_error")
+    assert frappe.MARKER_FIELDS[:5] == ("id", "dictionary", "corners", "hamming", "margin")
+    for name in frappe.MARKER_FIELDS:
+        assert name in pose_fields or hasattr(m, name), name
+    assert m.dictionary == "aruco_mip_36h12"
+
+
+def test_settings_are_the_keywords():
+    # Every setting frappe.settings() lists is a keyword with its default,
+    # and config gives each back.
+    names = [s["name"] for s in frappe.settings()]
+    assert names[:2] == ["dictionary", "mode"] and "weak_margin" in names
+    cfg = frappe.Detector().config
+    for s in frappe.settings():
+        assert cfg[s["name"]] == s["default"], s["name"]
+    kwargs = {s["name"]: s["default"] for s in frappe.settings() if s["name"] != "dictionary"}
+    assert frappe.Detector(**kwargs).config == cfg
+    with pytest.raises(TypeError, match="unexpected keyword argument 'edge-threshold'"):
+        frappe.Detector(**{"edge-threshold": 0.3})
+
+
 def test_track_mode_reports_tracked_markers_and_reads_less(scene):
     image, truth = scene
     det = frappe.Detector(mode="track", track_cover_frames=3)

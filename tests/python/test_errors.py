@@ -52,7 +52,7 @@ def test_image_too_large():
 def test_config_values():
     with pytest.raises(ValueError, match="unknown dictionary 'nope'.*aruco_mip_36h12"):
         frappe.Detector("nope")
-    with pytest.raises(ValueError, match="mode must be 'normal', 'ascale' or 'track'"):
+    with pytest.raises(ValueError, match="mode must be normal, ascale or track, got 'fast'"):
         frappe.Detector(mode="fast")
     with pytest.raises(ValueError, match="edge_threshold"):
         frappe.Detector(edge_threshold=-1)

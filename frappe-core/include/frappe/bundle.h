@@ -8,6 +8,8 @@
 // order (top-left, top-right, bottom-right, bottom-left of the marker in its
 // canonical orientation); for a marker placed by a pose, its own frame is
 // frappe/pose.h's (x right, y up, z out of the marker).
+//
+// Since: 0.3
 #pragma once
 
 #include "frappe/export.h"

@@ -31,8 +31,8 @@ enum class Mode {
 	/// NORMAL's instructions on the synthetic sequences, the same markers
 	/// found (docs/tracking.md). Needs a front end that can run on regions
 	/// (the CPU's); others run every frame whole. One detector per video,
-	/// its frames in order (a Pipeline's Mode::Frames on several threads
-	/// gives each detector a part of them; Mode::Stages keeps one).
+	/// its frames in order (a Pipeline's Overlap::Frames on several threads
+	/// gives each detector a part of them; Overlap::Stages keeps one).
 	Track,
 };
 
@@ -149,7 +149,7 @@ struct Config {
 	int max_candidates = 4096;
 
 	/// Threads; 1 = strictly single-threaded, 0 = one per hardware core. A
-	/// Pipeline (Mode::Frames) runs this many whole frames at once, one per
+	/// Pipeline (Overlap::Frames) runs this many whole frames at once, one per
 	/// thread: what pays on a stream (1.8x with two threads, for a frame of
 	/// latency per thread and a detector's memory per thread). A
 	/// lone Detector, which has one frame at a time, splits its front end

@@ -61,10 +61,13 @@ struct FRAPPE_EXPORT Dictionary {
 /// Every built-in dictionary, in a stable order.
 FRAPPE_EXPORT std::span<const Dictionary> dictionaries();
 
-/// Looks a dictionary up by name. Accepts the file names
+/// Looks a dictionary up by name: the one set of spellings every surface
+/// (C++, the element, the CLI, Python) accepts. The file names
 /// ("aruco_mip_36h12", "6x6_250", "apriltag_36h11"), case-insensitively,
-/// and the common aliases "opencv_6x6_250", "DICT_6X6_250",
-/// "DICT_APRILTAG_36h11", "tag36h11". Returns nullptr when unknown.
+/// with dashes for underscores ("apriltag-36h11", the element's), and the
+/// common aliases "opencv_6x6_250", OpenCV's "DICT_6X6_250" and
+/// "DICT_APRILTAG_36h11", AprilTag's "tag36h11". Returns nullptr when
+/// unknown. Every surface prints the library's name (Dictionary::name).
 FRAPPE_EXPORT const Dictionary *findDictionary(std::string_view name);
 
 /// The names of all built-in dictionaries, for error messages and --help.

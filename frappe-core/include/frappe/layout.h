@@ -5,6 +5,8 @@
 // black border) are MarkerLayout::classic(n); AprilTag 3's newer families
 // put bits outside a black ring and are found where that ring meets a white
 // one (frappe-core/dictionaries/README.md).
+//
+// Since: 0.3
 #pragma once
 
 #include "frappe/export.h"

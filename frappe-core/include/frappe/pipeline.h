@@ -17,7 +17,7 @@ namespace frappe {
 /// The only place in Frappe where frames overlap: the CLI and the GStreamer
 /// element drive one.
 ///
-/// Mode::Frames (the default): whole frames, each on a detector of its own.
+/// Overlap::Frames (the default): whole frames, each on a detector of its own.
 /// `config.threads` threads (0: one per core; 1: each frame on the calling
 /// thread as it is pushed, latency 0). A frame starts on an idle worker as
 /// soon as it is pushed and runs on after push() returns; the calling
@@ -30,7 +30,7 @@ namespace frappe {
 /// detector runs single-threaded, and in AScale mode scales from the last
 /// frame it ran.
 ///
-/// Mode::Stages (the paper's pipelined mode): one detector, two threads,
+/// Overlap::Stages (the paper's pipelined mode): one detector, two threads,
 /// three stages: the front end (on a QPU backend, the QPU passes), the
 /// contour trace, and the finish (refine, warp, decode). Latency 2 (the
 /// default): while the calling thread traces frame N, a worker thread runs
@@ -49,16 +49,18 @@ namespace frappe {
 /// either mode; the frames beside it are unaffected.
 class FRAPPE_EXPORT Pipeline {
 public:
-	enum class Mode { Frames, Stages };
+	/// What the pipeline overlaps (frappe::Mode is the detector's resolution:
+	/// another thing, another name).
+	enum class Overlap { Frames, Stages };
 
-	/// The latency of a mode when none is asked for: Mode::Frames as many
-	/// frames as threads (none with one thread), Mode::Stages 2.
+	/// The latency of a mode when none is asked for: Overlap::Frames as many
+	/// frames as threads (none with one thread), Overlap::Stages 2.
 	static constexpr int kDefaultLatency = -1;
 
 	/// Throws std::invalid_argument like Detector's constructor, and for a
-	/// latency other than 1 or 2 in Mode::Stages or outside [0, 256] in
-	/// Mode::Frames (below threads - 1, threads are left idle).
-	explicit Pipeline(const Config &config, Mode mode = Mode::Frames, int latency = kDefaultLatency);
+	/// latency other than 1 or 2 in Overlap::Stages or outside [0, 256] in
+	/// Overlap::Frames (below threads - 1, threads are left idle).
+	explicit Pipeline(const Config &config, Overlap overlap = Overlap::Frames, int latency = kDefaultLatency);
 	~Pipeline();
 	Pipeline(const Pipeline &) = delete;
 	Pipeline &operator=(const Pipeline &) = delete;
@@ -94,7 +96,7 @@ public:
 	/// Threads that detect, the calling one included.
 	int threads() const;
 
-	/// The detectors, configured alike (Mode::Frames has one per thread,
+	/// The detectors, configured alike (Overlap::Frames has one per thread,
 	/// detector 0 the calling thread's): to set a front end or a warper on
 	/// each before the first push.
 	int detectorCount() const;

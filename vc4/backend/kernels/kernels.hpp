@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
 // The QPU kernels of Frappe's front end (issue 6), reproducing frappe-core's CPU front end
-// (frappe-core/src/front_end_cpu.cpp) byte for byte.
+// (frappe-core/src/front_end/front_end_cpu.cpp) byte for byte.
 //
 // Two passes over the scaled frame, one launch of 12 programs each. A program invocation
 // takes a list of work units: its uniform stream is a header (the first struct below) then

@@ -208,7 +208,7 @@ TEST(ZeroCopyEmu, StagedPipelineCopiesEachFrameOnceAndWarpsItsOwnCopy)
 {
 	Detector cpu{ Config{} };
 	for (int latency : { 1, 2 }) {
-		Pipeline pipeline(Config{}, Pipeline::Mode::Stages, latency);
+		Pipeline pipeline(Config{}, Pipeline::Overlap::Stages, latency);
 		vc4::BackendChoice c = vc4::selectFrontEnd("vc4-emu", 1);
 		const FrontEnd *frontEnd = c.frontEnd.get();
 		pipeline.detector().setFrontEnd(std::move(c.frontEnd));

@@ -2,7 +2,7 @@
 // Typed builders for the setup words written to the VPM/VCD and TMU registers, so that
 // kernels contain no magic numbers. Reference guide section 7 (Tables 32-37) and
 // section 4 (texture config parameters, Tables 15-18); bit layouts as tabulated in
-// design/vc4-research.md sections 1.4.
+// ../shared/design/vc4-research.md sections 1.4 (the team's folder beside the checkout).
 #pragma once
 
 #include <cstdint>

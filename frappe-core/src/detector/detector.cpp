@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: MIT
 // The Detector: runs the stages of Algorithm 1 in order and times each.
 // Here: the set-up, the front end and the trace; the reading of the
-// candidates is candidate_reader.cpp's, the state both share
-// detector_impl.h's.
+// candidates is detail::CandidateReader's (read/candidate_reader.h), which
+// the detector's state (detector_impl.h) holds.
 #include "frappe/version.h"
 
 #include <algorithm>
@@ -11,10 +11,11 @@
 #include <stdexcept>
 #include <string>
 
+#include "frappe/settings.h"
+
 #include "detector_impl.h"
 #include "front_end_rows.h"
 #include "quad_geometry.h"
-#include "utf8.h"
 
 namespace frappe {
 
@@ -28,60 +29,6 @@ constexpr float kClipScale = 48.0f;
 using detail::quadArea;
 using detail::StageTimer;
 using detail::toFullResolution;
-
-void validate(const Config &c, const Dictionary &d)
-{
-	auto fail = [](const std::string &what) { throw std::invalid_argument("frappe::Config: " + what); };
-	if (!(c.edge_threshold > 0.0f && c.edge_threshold <= 4.0f))
-		fail("edge_threshold must be in (0, 4], got " + std::to_string(c.edge_threshold));
-	if (!(c.corner_threshold >= 0.0f && c.corner_threshold <= 100.0f))
-		fail("corner_threshold must be in [0, 100], got " + std::to_string(c.corner_threshold));
-	if (c.custom_dictionary) {
-		/* One made by hand rather than by loadDictionary(): what the
-		 * decoder and the sample grid rely on. */
-		if (!d.layout && (d.bits < 3 || d.bits > 8))
-			fail("custom_dictionary: bits must be 3..8, got " + std::to_string(d.bits));
-		if (d.layout && (d.layout->size + 2 > 16 || d.bits != d.layout->square_cells - 2))
-			fail("custom_dictionary: a layout of at most 14 cells a side, with bits its square's cells less 2");
-		if (d.codes.empty())
-			fail("custom_dictionary: no codes");
-		/* Every output carries the name: JSON, GStreamer, Python. */
-		if (detail::invalidUtf8At(d.name) != std::string_view::npos)
-			fail("custom_dictionary: the name is not UTF-8 text");
-		const int cells = d.codeBits();
-		for (std::uint64_t code : d.codes) {
-			if (cells < 64 && code >> cells)
-				fail("custom_dictionary: a code with bits beyond the " + std::to_string(cells) + " cells");
-		}
-	}
-	if (c.max_hamming < -1 || c.max_hamming > d.codeBits() / 2)
-		fail("max_hamming must be -1 (dictionary default) or 0.." + std::to_string(d.codeBits() / 2) +
-		     " for " + std::string(d.name) + ", got " + std::to_string(c.max_hamming));
-	if (!(c.weak_margin >= 0.0f && c.weak_margin <= 1.0f))
-		fail("weak_margin must be in [0, 1], got " + std::to_string(c.weak_margin));
-	if (!(c.scaled_size >= 8.0f && c.scaled_size <= 1000.0f))
-		fail("scaled_size must be in [8, 1000] pixels, got " + std::to_string(c.scaled_size));
-	if (c.max_scaled_frames < 0 || c.max_scaled_frames > 1000)
-		fail("max_scaled_frames must be in [0, 1000], got " + std::to_string(c.max_scaled_frames));
-	if (c.mode != Mode::Normal && c.mode != Mode::AScale && c.mode != Mode::Track)
-		fail("mode must be Normal, AScale or Track");
-	if (c.track_cover_frames < 1 || c.track_cover_frames > 1000)
-		fail("track_cover_frames must be in [1, 1000], got " + std::to_string(c.track_cover_frames));
-	if (!(c.corner_cluster_radius >= 1.0f && c.corner_cluster_radius <= 32.0f))
-		fail("corner_cluster_radius must be in [1, 32], got " + std::to_string(c.corner_cluster_radius));
-	if (!(c.min_marker_side >= 4.0f))
-		fail("min_marker_side must be at least 4 pixels, got " + std::to_string(c.min_marker_side));
-	if (!(c.region_contrast >= 0.0f && c.region_contrast <= 1.0f))
-		fail("region_contrast must be in [0, 1], got " + std::to_string(c.region_contrast));
-	if (!(c.light_floor >= 0.0f && c.light_floor <= 1.0f))
-		fail("light_floor must be in [0, 1], got " + std::to_string(c.light_floor));
-	if (c.threads < 0 || c.threads > 256)
-		fail("threads must be in [0, 256], got " + std::to_string(c.threads));
-	if (c.max_pixels < 1 || c.max_pixels > (1LL << 30))
-		fail("max_pixels must be in [1, 2^30], got " + std::to_string(c.max_pixels));
-	if (c.max_candidates < 1 || c.max_candidates > (1 << 20))
-		fail("max_candidates must be in [1, 2^20], got " + std::to_string(c.max_candidates));
-}
 
 /* Reads a traced quad as a marker, so that the tracer can skip the
  * marker's inside: one sample at each cell's centre (a quarter of the warp
@@ -222,12 +169,10 @@ void Detector::Impl::trace(Slot &slot)
 
 Detector::Detector(const Config &config) : impl_(std::make_unique<Impl>())
 {
+	validate(config); /* frappe/settings.h: the table's ranges */
 	/* A dictionary of the user's own wins over the name. */
-	const Dictionary *d = config.custom_dictionary ? config.custom_dictionary.get() : findDictionary(config.dictionary);
-	if (!d)
-		throw std::invalid_argument("frappe::Config: unknown dictionary '" + config.dictionary +
-					    "'; known: " + dictionaryNames() + ", or a file (loadDictionary())");
-	validate(config, *d);
+	const Dictionary *d =
+		config.custom_dictionary ? config.custom_dictionary.get() : findDictionary(config.dictionary);
 	impl_->config = config;
 	impl_->customDictionary = config.custom_dictionary;
 	impl_->dict = d;

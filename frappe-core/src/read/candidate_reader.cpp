@@ -2,15 +2,17 @@
 // The back end after the trace: each candidate, smallest first, placed on
 // the frame (or the frame halved into blocks for large cells), its corners
 // refined, warped to the sample grid, binarised, decoded and verified; the
-// markers kept once. Detector::Impl::finish() is the entry.
+// markers kept once: detail::CandidateReader (candidate_reader.h), whose
+// read() the detector calls.
 #include <algorithm>
 #include <cmath>
 #include <span>
 
 #include "corner_refine.h"
-#include "detector_impl.h"
+#include "candidate_reader.h"
 #include "marker_set.h"
 #include "quad_geometry.h"
+#include "region_map.h" // halveImage()
 
 namespace frappe {
 
@@ -49,8 +51,8 @@ constexpr float kSearch = 2.5f;
  * -> 0.35 px). It can fail to measure a side where the default one does
  * not (large blurred markers upsampled 3x): then the default one. `image`
  * is the frame or the frame halved to blocks of `block` pixels (finish()). */
-bool Detector::Impl::refineQuad(const ImageView &image, const Slot &slot, detail::Quad &q, float search,
-				 int block) const
+bool detail::CandidateReader::refineQuad(const ImageView &image, const Slot &slot, detail::Quad &q, float search,
+					 int block) const
 {
 	if (q.fromRegion)
 		search = std::max(search, 2.0f / slot.edges.regions.scale / static_cast<float>(block));
@@ -62,8 +64,9 @@ bool Detector::Impl::refineQuad(const ImageView &image, const Slot &slot, detail
 
 /* `image` halved f (2, 4, 8) times, whole or the blocks of a patch
  * reaching `margin` pixels beyond the outline's box. */
-Detector::Impl::BlockView Detector::Impl::blockView(const ImageView &image, int f,
-						   const std::array<Point2f, 4> &outline, float margin)
+detail::CandidateReader::BlockView detail::CandidateReader::blockView(const ImageView &image, int f,
+								      const std::array<Point2f, 4> &outline,
+								      float margin)
 {
 	const std::size_t frameArea = static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height);
 	if (image.width != blockSizedW || image.height != blockSizedH) {
@@ -124,7 +127,7 @@ Detector::Impl::BlockView Detector::Impl::blockView(const ImageView &image, int 
 }
 
 /* Batch mode: every candidate refined, then all warped in one call. */
-void Detector::Impl::refineAndWarpAll(const ImageView &image, Slot &slot, float search)
+void detail::CandidateReader::refineAndWarpAll(const ImageView &image, Slot &slot, float search)
 {
 	const std::size_t n = slot.quads.size();
 	batch.outlines.resize(n);
@@ -158,8 +161,8 @@ void Detector::Impl::refineAndWarpAll(const ImageView &image, Slot &slot, float 
 
 /* Candidates not worth refining: the outline of a decoded marker's quiet
  * zone, and clutter as the probe's read at the traced outline shows it. */
-bool Detector::Impl::skipCandidate(const detail::Quad &q, const std::array<Point2f, 4> &tracedOutline,
-				   const std::vector<Marker> &found) const
+bool detail::CandidateReader::skipCandidate(const detail::Quad &q, const std::array<Point2f, 4> &tracedOutline,
+					    const std::vector<Marker> &found) const
 {
 	const int bits = dict->bits;
 	const int traced = q.probeRead;
@@ -194,8 +197,8 @@ bool Detector::Impl::skipCandidate(const detail::Quad &q, const std::array<Point
  * search and profile: 13 pixels of the halved frame at most) and the reads'
  * ring a cell outside the border; a white frame is only read inside
  * (insetQuad()). Leaves q's corners in the block's pixels. */
-Detector::Impl::Reading Detector::Impl::placeCandidate(const ImageView &image, detail::Quad &q,
-							const std::array<Point2f, 4> &tracedOutline)
+detail::CandidateReader::Reading detail::CandidateReader::placeCandidate(const ImageView &image, detail::Quad &q,
+									 const std::array<Point2f, 4> &tracedOutline)
 {
 	Reading r;
 	const float cellPx = cellSide(tracedOutline, dict->bits);
@@ -219,8 +222,8 @@ Detector::Impl::Reading Detector::Impl::placeCandidate(const ImageView &image, d
 
 /* Warps and binarises a refined candidate large enough to read, on the
  * policy's scale (a batch's samples are grey levels: a copy is rescaled). */
-void Detector::Impl::sampleRefined(Reading &r, const detail::Quad &q, std::size_t k, const detail::DecodePolicy &pol,
-				   StageTimer &timer)
+void detail::CandidateReader::sampleRefined(Reading &r, const detail::Quad &q, std::size_t k,
+					    const detail::DecodePolicy &pol, StageTimer &timer)
 {
 	r.samples = &warped;
 	if (!r.refined || !bigEnough(q.corners, r.minSide))
@@ -247,7 +250,7 @@ void Detector::Impl::sampleRefined(Reading &r, const detail::Quad &q, std::size_
 /* No dark frame inside the outline, or a white one: this may be the outline
  * of the quiet zone (the marker's own outline merged with its code's edges,
  * as on small or blurred markers). The marker would lie one cell inside. */
-void Detector::Impl::readInset(Reading &r, detail::Quad &q, const detail::DecodePolicy &pol, StageTimer &timer)
+void detail::CandidateReader::readInset(Reading &r, detail::Quad &q, const detail::DecodePolicy &pol, StageTimer &timer)
 {
 	timer.lap(Stage::Refine);
 	if (r.inset == 0) {
@@ -267,7 +270,8 @@ void Detector::Impl::readInset(Reading &r, detail::Quad &q, const detail::Decode
 
 /* Decodes a sampled candidate, trying what else may read when its samples
  * do not; on a read at the traced outline, q takes that outline. */
-detail::MarkerRead Detector::Impl::decodeCandidate(const Reading &r, detail::Quad &q, const detail::DecodePolicy &pol)
+detail::MarkerRead detail::CandidateReader::decodeCandidate(const Reading &r, detail::Quad &q,
+							    const detail::DecodePolicy &pol)
 {
 	const ImageView &img = r.block.view;
 	const int bits = dict->bits;
@@ -329,8 +333,8 @@ bool clipsWhite(const detail::WarpedMarker &w)
 /* Reads candidate k: refine, warp, binarise; the inset read when that finds
  * no dark frame; then decoding and its fallbacks. A marker read is left in
  * `m`, its corners in frame pixels from the code's first. */
-bool Detector::Impl::readCandidate(const ImageView &image, Slot &slot, std::size_t k, float search,
-				   StageTimer &timer, Marker &m)
+bool detail::CandidateReader::readCandidate(const ImageView &image, Slot &slot, std::size_t k, float search,
+					    StageTimer &timer, Marker &m)
 {
 	if (dict->layout)
 		return readLayoutCandidate(image, slot, k, search, timer, m);
@@ -384,8 +388,8 @@ bool Detector::Impl::readCandidate(const ImageView &image, Slot &slot, std::size
 	return true;
 }
 
-void Detector::Impl::toMarker(detail::Quad &q, int f, const BlockView &block, const detail::MarkerRead &read,
-			      Marker &m)
+void detail::CandidateReader::toMarker(detail::Quad &q, int f, const BlockView &block, const detail::MarkerRead &read,
+				       Marker &m)
 {
 	if (f > 1) {
 		const float ff = static_cast<float>(f);
@@ -405,7 +409,7 @@ void Detector::Impl::toMarker(detail::Quad &q, int f, const BlockView &block, co
 
 /* The candidates in order, smallest first: each read, each marker kept
  * once. */
-void Detector::Impl::finish(const ImageView &image, Slot &slot)
+void detail::CandidateReader::finish(const ImageView &image, Slot &slot)
 {
 	Result &res = slot.result;
 	res.markers.clear();

@@ -77,7 +77,7 @@ void pushTheRest(Pipeline &pipeline, const std::vector<Image> &frames, std::size
 /* A mode and its thread count (Config::threads), with the latency and the
  * detectors that go with them. */
 struct Setup {
-	Pipeline::Mode mode;
+	Pipeline::Overlap mode;
 	int threads;
 	int latencyAsked;
 	int latency;
@@ -290,40 +290,40 @@ TEST_P(PipelineModes, AFailedFrameThrowsInItsOwnPlaceAndTheOthersGoOn)
 }
 
 INSTANTIATE_TEST_SUITE_P(All, PipelineModes,
-			 ::testing::Values(Setup{ Pipeline::Mode::Stages, 1, -1, 2, 1, "Stages" },
-					   Setup{ Pipeline::Mode::Stages, 1, 1, 1, 1, "StagesLatencyOne" },
-					   Setup{ Pipeline::Mode::Frames, 1, -1, 0, 1, "FramesOneThread" },
-					   Setup{ Pipeline::Mode::Frames, 2, -1, 2, 2, "FramesTwoThreads" },
-					   Setup{ Pipeline::Mode::Frames, 2, 1, 1, 2, "FramesTwoThreadsLatencyOne" },
-					   Setup{ Pipeline::Mode::Frames, 3, -1, 3, 3, "FramesThreeThreads" }),
+			 ::testing::Values(Setup{ Pipeline::Overlap::Stages, 1, -1, 2, 1, "Stages" },
+					   Setup{ Pipeline::Overlap::Stages, 1, 1, 1, 1, "StagesLatencyOne" },
+					   Setup{ Pipeline::Overlap::Frames, 1, -1, 0, 1, "FramesOneThread" },
+					   Setup{ Pipeline::Overlap::Frames, 2, -1, 2, 2, "FramesTwoThreads" },
+					   Setup{ Pipeline::Overlap::Frames, 2, 1, 1, 2, "FramesTwoThreadsLatencyOne" },
+					   Setup{ Pipeline::Overlap::Frames, 3, -1, 3, 3, "FramesThreeThreads" }),
 			 [](const auto &info) { return std::string(info.param.name); });
 
 TEST(Pipeline, ThreadsAndLatencyAreCheckedAndZeroThreadsIsOnePerCore)
 {
 	Config c;
 	c.threads = -1;
-	EXPECT_THROW(Pipeline(c, Pipeline::Mode::Frames), std::invalid_argument);
+	EXPECT_THROW(Pipeline(c, Pipeline::Overlap::Frames), std::invalid_argument);
 	c.threads = 257;
-	EXPECT_THROW(Pipeline(c, Pipeline::Mode::Frames), std::invalid_argument);
+	EXPECT_THROW(Pipeline(c, Pipeline::Overlap::Frames), std::invalid_argument);
 	c.threads = 0;
-	Pipeline perCore(c, Pipeline::Mode::Frames);
+	Pipeline perCore(c, Pipeline::Overlap::Frames);
 	EXPECT_EQ(perCore.threads(), static_cast<int>(std::max(1u, std::thread::hardware_concurrency())));
 	EXPECT_EQ(perCore.latency(), perCore.threads() > 1 ? perCore.threads() : 0);
-	/* Each detector of Mode::Frames runs on its own thread only. */
+	/* Each detector of Overlap::Frames runs on its own thread only. */
 	EXPECT_EQ(perCore.detector(0).config().threads, 1);
-	EXPECT_THROW(Pipeline(Config{}, Pipeline::Mode::Stages).detector(1), std::out_of_range);
-	EXPECT_THROW(Pipeline(Config{}, Pipeline::Mode::Stages, 0), std::invalid_argument);
-	EXPECT_THROW(Pipeline(Config{}, Pipeline::Mode::Stages, 3), std::invalid_argument);
-	EXPECT_EQ(Pipeline(Config{}, Pipeline::Mode::Stages, 1).latency(), 1);
-	EXPECT_THROW(Pipeline(Config{}, Pipeline::Mode::Frames, -2), std::invalid_argument);
-	EXPECT_THROW(Pipeline(Config{}, Pipeline::Mode::Frames, 257), std::invalid_argument);
+	EXPECT_THROW(Pipeline(Config{}, Pipeline::Overlap::Stages).detector(1), std::out_of_range);
+	EXPECT_THROW(Pipeline(Config{}, Pipeline::Overlap::Stages, 0), std::invalid_argument);
+	EXPECT_THROW(Pipeline(Config{}, Pipeline::Overlap::Stages, 3), std::invalid_argument);
+	EXPECT_EQ(Pipeline(Config{}, Pipeline::Overlap::Stages, 1).latency(), 1);
+	EXPECT_THROW(Pipeline(Config{}, Pipeline::Overlap::Frames, -2), std::invalid_argument);
+	EXPECT_THROW(Pipeline(Config{}, Pipeline::Overlap::Frames, 257), std::invalid_argument);
 }
 
 TEST(Pipeline, BadFrameIsRefusedAndTheFrameInFlightSurvives)
 {
 	const std::vector<Image> frames = sequence(3);
 	Detector reference(Config{});
-	Pipeline pipeline(Config{}, Pipeline::Mode::Stages);
+	Pipeline pipeline(Config{}, Pipeline::Overlap::Stages);
 	EXPECT_EQ(pipeline.push(frames[0].view()), nullptr);
 	EXPECT_THROW(pipeline.push(ImageView(nullptr, 10, 10, 10)), std::invalid_argument);
 	EXPECT_EQ(pipeline.push(frames[1].view()), nullptr);
@@ -348,7 +348,7 @@ TEST(Pipeline, FramesModeRefusesABadFrameAndKeepsTheOrder)
 	const std::vector<Image> frames = sequence(24);
 	Config three;
 	three.threads = 3;
-	Pipeline pipeline(three, Pipeline::Mode::Frames);
+	Pipeline pipeline(three, Pipeline::Overlap::Frames);
 	EXPECT_EQ(pipeline.push(frames[0].view()), nullptr);
 	EXPECT_EQ(pipeline.push(frames[1].view()), nullptr);
 	EXPECT_THROW(pipeline.push(ImageView(nullptr, 10, 10, 10)), std::invalid_argument);

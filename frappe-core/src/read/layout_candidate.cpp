@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// finish() for a dictionary with a layout (frappe/layout.h): a candidate is
+// CandidateReader::finish() for a dictionary with a layout (frappe/layout.h): a candidate is
 // the detected square, where a black ring meets a white one (or today's
 // border against its quiet zone); its corners are refined with the edge's
 // own polarity, the layout's whole grid is warped from them (on the QPUs in
@@ -8,8 +8,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "candidate_reader.h"
 #include "corner_refine.h"
-#include "detector_impl.h"
 #include "layout_reader.h"
 #include "marker_set.h"
 #include "quad_geometry.h"
@@ -33,7 +33,7 @@ std::array<Point2f, 4> reversedOrder(const std::array<Point2f, 4> &q)
 /* refineCorners() finds a light-to-dark step going inwards; a reversed
  * layout's square is dark outside: the quad is handed over anticlockwise,
  * which turns its normals outwards. */
-bool Detector::Impl::refineLayoutQuad(const ImageView &image, detail::Quad &q, float search) const
+bool detail::CandidateReader::refineLayoutQuad(const ImageView &image, detail::Quad &q, float search) const
 {
 	if (!dict->layout->reversed)
 		return detail::refineCorners(image, q.corners, search);
@@ -46,7 +46,7 @@ bool Detector::Impl::refineLayoutQuad(const ImageView &image, detail::Quad &q, f
 
 /* Batch mode: the candidates read on the frame refined, then their grids
  * warped in one call. */
-void Detector::Impl::refineAndWarpLayouts(const ImageView &image, Slot &slot, float search)
+void detail::CandidateReader::refineAndWarpLayouts(const ImageView &image, Slot &slot, float search)
 {
 	const MarkerLayout &layout = *dict->layout;
 	const std::size_t n = slot.quads.size();
@@ -77,8 +77,8 @@ void Detector::Impl::refineAndWarpLayouts(const ImageView &image, Slot &slot, fl
 		     batch.warpedOk);
 }
 
-bool Detector::Impl::readLayoutCandidate(const ImageView &image, Slot &slot, std::size_t k, float search,
-					 StageTimer &timer, Marker &m)
+bool detail::CandidateReader::readLayoutCandidate(const ImageView &image, Slot &slot, std::size_t k, float search,
+						  StageTimer &timer, Marker &m)
 {
 	const MarkerLayout &layout = *dict->layout;
 	detail::Quad &q = slot.quads[k];

@@ -79,7 +79,7 @@ private:
 
 /// The tracks of Mode::Track and the plan of each frame. plan() (the front
 /// end's) and update() (the finish's) may run on different threads in a
-/// Pipeline's Mode::Stages: the tracks are under a lock.
+/// Pipeline's Overlap::Stages: the tracks are under a lock.
 class Tracker
 {
 public:

@@ -342,7 +342,7 @@ TEST(Tracking, StagedPipelineTracksEveryFrame)
 	Config cfg;
 	cfg.mode = Mode::Track;
 	for (int latency : { 1, 2 }) {
-		Pipeline pipeline(cfg, Pipeline::Mode::Stages, latency);
+		Pipeline pipeline(cfg, Pipeline::Overlap::Stages, latency);
 		std::vector<Image> frames;
 		for (int f = 0; f < 12; ++f)
 			frames.push_back(movingFrame(f, sceneAt(f, false, 0)));

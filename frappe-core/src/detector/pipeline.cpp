@@ -41,7 +41,7 @@ int threadCount(const Config &config)
 
 } // namespace
 
-/// Mode::Frames. Frames wait in a ring of latency + 1 entries (a frame
+/// Overlap::Frames. Frames wait in a ring of latency + 1 entries (a frame
 /// in flight beyond those `threads` run gives a thread slack to start the
 /// next while the caller waits for a slow one); each idle
 /// worker drains it with its own detector and runs on after push() returns;
@@ -227,7 +227,7 @@ private:
 	std::vector<std::unique_ptr<Helper>> helpers_; /* last: they go first */
 };
 
-/// Mode::Stages. One detector, each frame in a slot of its own, oldest
+/// Overlap::Stages. One detector, each frame in a slot of its own, oldest
 /// first. Latency 2: each push runs the new frame's front end and then the
 /// finish (refine, warp, decode) of the oldest on the worker while the
 /// caller traces the frame in between. Latency 1: the worker runs the new
@@ -377,18 +377,18 @@ private:
 } // namespace detail
 
 struct FRAPPE_HIDDEN Pipeline::Impl {
-	std::unique_ptr<detail::FrameQueue> frames; /* Mode::Frames */
-	std::unique_ptr<detail::StageQueue> stages; /* Mode::Stages */
+	std::unique_ptr<detail::FrameQueue> frames; /* Overlap::Frames */
+	std::unique_ptr<detail::StageQueue> stages; /* Overlap::Stages */
 };
 
-Pipeline::Pipeline(const Config &config, Mode mode, int latency) : impl_(std::make_unique<Impl>())
+Pipeline::Pipeline(const Config &config, Overlap mode, int latency) : impl_(std::make_unique<Impl>())
 {
 	auto fail = [](const std::string &what) { throw std::invalid_argument("frappe::Pipeline: " + what); };
-	if (mode == Mode::Stages) {
+	if (mode == Overlap::Stages) {
 		if (latency == kDefaultLatency)
 			latency = 2;
 		if (latency != 1 && latency != 2)
-			fail("Mode::Stages has a latency of 1 or 2, not " + std::to_string(latency));
+			fail("Overlap::Stages has a latency of 1 or 2, not " + std::to_string(latency));
 		impl_->stages = std::make_unique<detail::StageQueue>(config, latency);
 		return;
 	}
@@ -450,7 +450,7 @@ Detector &Pipeline::detector(int index)
 	if (d.frames)
 		return d.frames->detector(index);
 	if (index != 0)
-		throw std::out_of_range("frappe::Pipeline: one detector in Mode::Stages");
+		throw std::out_of_range("frappe::Pipeline: one detector in Overlap::Stages");
 	return d.stages->detector();
 }
 

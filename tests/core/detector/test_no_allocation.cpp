@@ -115,7 +115,7 @@ TEST_P(NoAllocation, PipelinePushAllocatesNothingOnceWarm)
 	const std::vector<Image> s = scenes();
 	Config config;
 	config.threads = GetParam();
-	Pipeline pipeline(config, Pipeline::Mode::Frames);
+	Pipeline pipeline(config, Pipeline::Overlap::Frames);
 	for (int i = 0; i < pipeline.detectorCount(); ++i)
 		for (const Image &img : s)
 			pipeline.detector(i).detect(img.view());
@@ -142,7 +142,7 @@ TEST_P(NoAllocation, StagedPipelinePushAllocatesNothingOnceWarm)
 	Config config;
 	config.threads = GetParam();
 	for (int latency : { 1, 2 }) {
-		Pipeline pipeline(config, Pipeline::Mode::Stages, latency);
+		Pipeline pipeline(config, Pipeline::Overlap::Stages, latency);
 		for (int k = 0; k < 12; ++k)
 			pipeline.push(s[static_cast<std::size_t>(k) % 3].view());
 

@@ -66,12 +66,14 @@ std::string lower(std::string_view s)
 	return out;
 }
 
-/* Maps the names other libraries use onto ours: opencv_6x6_250 and
+/* Maps the names other libraries use onto ours: 6x6-250, opencv_6x6_250 and
  * DICT_6X6_250 -> 6x6_250, DICT_APRILTAG_36h11 and tag36h11 ->
  * apriltag_36h11, DICT_ARUCO_ORIGINAL -> aruco_original. */
 std::string canonicalName(std::string_view name)
 {
 	std::string n = lower(name);
+	/* The element's dashed spelling ("apriltag-36h11") too. */
+	std::replace(n.begin(), n.end(), '-', '_');
 	for (std::string_view prefix : { "opencv_", "dict_", "cv2.aruco.dict_" }) {
 		if (n.starts_with(prefix))
 			n.erase(0, prefix.size());
