@@ -229,6 +229,11 @@ bool printable(const Alu &i)
 	const bool add = i.op_add != AddOp::Nop, mul = i.op_mul != MulOp::Nop;
 	if (add && !isValid(i.op_add))
 		return false;
+	// The breakpoint signal is spelt "bkpt" by the current vc4asm but "bpkt"/"break" by
+	// older ones, and no shader's code holds one: in GPU_FFT it is only the data table at
+	// the start of shader_256_new (words of 0x0000xxxx / 0x8802xxxx), so it stays data.
+	if (i.sig == Sig::Breakpoint)
+		return false;
 	// An idle ALU keeps vc4asm's defaults: no destination, inputs r0, cond never.
 	if (!add && (i.waddr_add != waddr::nop || i.add_a != Mux::R0 || i.add_b != Mux::R0 ||
 	             i.cond_add != Cond::Never || i.sf))

@@ -269,3 +269,32 @@ TEST(DisassemblerGpuFft, WordsOfTheGpuFftShaders)
 	          "\t.int 0x87726ff6, 0xd0024831\n");
 	EXPECT_EQ(qasm::assembleText(listing(code)), code);
 }
+
+TEST(DisassemblerGpuFft, WordsOfShader256New)
+{
+	// Words of vc4asm's test/shader_256_new.hex. Its data table (37 words before the
+	// code) holds two that decode as ALU words with the breakpoint signal: data, as
+	// vc4asm's spelling of that signal changed ("bpkt", "bkpt"). Its code branches
+	// through a register plus an offset (with one or both link registers), links into
+	// r5 by regfile B (r5rep) and writes r2 as "ra34" from the MUL ALU (ws = 1).
+	const std::vector<uint64_t> code = {
+		word(0x88024020, 0x00000100), word(0x88024820, 0x00000500), word(0x00000000, 0xf0fc8000),
+		word(0x00000230, 0xf0f80025), word(0xffffff88, 0xf0fc8027), word(0xffffff18, 0xf0fc89e7),
+		word(0x809ff000, 0xd00159e2),
+	};
+	EXPECT_EQ(listing(code),
+		  "\t.int 0x88024020, 0x00000100\n"
+		  "\t.int 0x88024820, 0x00000500\n"
+		  "\tbrr ra0, rb0, ra4, +0\n"
+		  "\tbrr ra0, r5rep, -, +560\n"
+		  "\tbrr ra0, ra4, -120\n"
+		  "\tbrr -, ra4, -232\n"
+		  "\tnop; v8min.ifnn.rot 15, ra34, r0, r0\n");
+	EXPECT_EQ(qasm::assembleText(listing(code)), code);
+	// Any breakpoint word is data, whatever its other fields.
+	isa::Alu alu;
+	alu.sig = isa::Sig::Breakpoint;
+	EXPECT_FALSE(isa::printsAsInstruction(isa::encode(alu)));
+	alu.sig = isa::Sig::None;
+	EXPECT_TRUE(isa::printsAsInstruction(isa::encode(alu)));
+}
