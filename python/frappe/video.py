@@ -124,10 +124,8 @@ class Pairer:
             if not whole and not everything and len(self._frames) <= self.max_waiting:
                 break
             self._frames.popleft()
-            if whole:
-                del self._lines[key]
-            else:
-                self.unpaired += 1
+            self._lines.pop(key, None)
+            self.unpaired += not whole
             out.append(Paired(key, image, line.merged() if whole else None, sample))
         return out
 

@@ -7,7 +7,7 @@ markers (python/frappe/video.py), end to end on loopback.
 The robot: stream-markers.sh with 45 frames standing in for the camera,
 each showing another subset of the six markers of
 examples/images/markers-36h12.png (frame n shows marker j when bit j of
-n + 1 is set), paced at 30 frames a second; H.264 from x264enc.
+n + 1 is set), paced at 15 frames a second; H.264 from x264enc.
 The host: receive_ts() decodes the MPEG-TS and runs frappedetect again on
 each decoded (annotated) frame. For every one of the 45 frames:
   * its line's `frame` number n is new, and all 45 come;
@@ -117,7 +117,7 @@ def main():
         env = dict(os.environ, HOST="127.0.0.1", VIDEO_PORT=str(video_port),
                    MARKER_PORT=str(markers_sock.getsockname()[1]), QUEUE="queue",
                    SOURCE=f"multifilesrc location={tmp}/frame%03d.pgm index=0 stop-index={FRAMES - 1} "
-                          "caps=image/x-portable-graymap,framerate=30/1 ! pnmdec ! videoconvert ! "
+                          "caps=image/x-portable-graymap,framerate=15/1 ! pnmdec ! videoconvert ! "
                           "video/x-raw,format=I420 ! identity sync=true",
                    ENCODER="x264enc tune=zerolatency speed-preset=ultrafast key-int-max=15 bitrate=4000 ! "
                            "h264parse")
