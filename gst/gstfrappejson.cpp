@@ -418,11 +418,20 @@ static gboolean gst_frappe_json_set_caps(GstBaseTransform *trans, GstCaps *incap
 	return TRUE;
 }
 
-/* The buffer's parts into priv->output, as buffers with its timestamps. */
+static void clear_output(FrappeJsonPrivate *priv)
+{
+	for (GstBuffer *b : priv->output)
+		gst_buffer_unref(b);
+	priv->output.clear();
+}
+
+/* The buffer's parts into priv->output, as buffers with its timestamps;
+ * parts of an earlier frame whose push failed are dropped first. */
 static GstFlowReturn format_buffer(GstFrappeJson *self, GstBuffer *input)
 {
 	FrappeJsonPrivate *priv = self->priv;
 	GstBaseTransform *trans = GST_BASE_TRANSFORM(self);
+	clear_output(priv);
 
 	GST_OBJECT_LOCK(self);
 	const std::string frameId = priv->frameId;
@@ -499,13 +508,6 @@ static gboolean gst_frappe_json_propose_allocation(GstBaseTransform *, GstQuery 
 {
 	gst_query_add_allocation_meta(query, GST_VIDEO_META_API_TYPE, nullptr);
 	return TRUE;
-}
-
-static void clear_output(FrappeJsonPrivate *priv)
-{
-	for (GstBuffer *b : priv->output)
-		gst_buffer_unref(b);
-	priv->output.clear();
 }
 
 static gboolean gst_frappe_json_start(GstBaseTransform *trans)
