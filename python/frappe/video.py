@@ -134,7 +134,7 @@ class Pairer:
 # `video_caps`, the KLV packets as they are; {source} and {decode} filled in.
 HOST_PIPELINE = ("{source} ! tsdemux name=demux "
                  "demux. ! video/x-h264 ! queue ! {decode} ! videoconvert ! {video_caps} ! {then}"
-                 "appsink name=video sync=false "
+                 "appsink name=video sync=false max-buffers={max_frames} drop={drop} "
                  "demux. ! meta/x-klv ! queue ! appsink name=klv sync=false")
 
 
@@ -143,15 +143,19 @@ CHANNELS = {"GRAY8": 1, "BGR": 3, "RGB": 3, "BGRx": 4, "BGRA": 4, "RGBx": 4, "RG
 
 
 def receive_ts(port=5000, address="0.0.0.0", source=None, decode="h264parse ! avdec_h264",
-               video_caps="video/x-raw,format=BGR", then="", max_waiting=30, timeout=None):
+               video_caps="video/x-raw,format=BGR", then="", max_waiting=30, max_frames=0, timeout=None):
     """Yields a Paired for every decoded frame of the robot's MPEG-TS: its
     `image` a numpy array (height, width, channels) of `video_caps`, its
     `line` the frame's markers and times, `sample` the Gst.Sample. `source`
     replaces the UDP source (e.g. "filesrc location=robot.ts"); `decode`
     the decoder; `then` elements between the video caps and the appsink
     (e.g. "frappedetect ! ": the decoded frame's own markers in the
-    sample's metas). Stops at the end of the stream, or after `timeout`
-    seconds without a frame."""
+    sample's metas). `max_frames` > 0 keeps only that many decoded frames
+    waiting for the caller, dropping the oldest (a program slower than the
+    camera then sees the newest frames; a dropped frame's line is counted
+    as an orphan); 0 keeps every frame. Stops at the end of the stream, or
+    after `timeout` seconds without a frame (an EOS then pushes out the
+    frame the demuxer still holds)."""
     import gi
     gi.require_version("Gst", "1.0")
     from gi.repository import Gst
@@ -163,7 +167,8 @@ def receive_ts(port=5000, address="0.0.0.0", source=None, decode="h264parse ! av
     if source is None:
         source = (f"udpsrc address={address} port={port} buffer-size=4194304 "
                   "caps=video/mpegts,systemstream=true,packetsize=188")
-    pipeline = Gst.parse_launch(HOST_PIPELINE.format(source=source, decode=decode, video_caps=video_caps, then=then))
+    pipeline = Gst.parse_launch(HOST_PIPELINE.format(source=source, decode=decode, video_caps=video_caps, then=then,
+                                                     max_frames=max_frames, drop=str(max_frames > 0).lower()))
     video, klv = pipeline.get_by_name("video"), pipeline.get_by_name("klv")
     # Playing (the socket bound) before the first frame is asked for.
     pipeline.set_state(Gst.State.PLAYING)
