@@ -24,7 +24,8 @@ except (ImportError, ValueError):
     print("no gi or Gst for this python: skipped")
     sys.exit(77)
 
-LINE = "videotestsrc num-buffers=1 ! video/x-raw,format=GRAY8,width=64,height=48 ! frappedetect {} ! frappejson {} ! fakesink"
+LINE = ("videotestsrc num-buffers=1 ! video/x-raw,format=GRAY8,width=64,height=48 ! "
+        "frappedetect {} ! frappejson {} ! fakesink")
 OWN = {"frappedetect": "GstFrappeDetect", "frappejson": "GstFrappeJson"}
 
 

@@ -82,7 +82,8 @@ def main():
             for j, m in enumerate(truth["markers"]):
                 if not (n + 1) >> j & 1:
                     xs, ys = [c[0] for c in m["corners"]], [c[1] for c in m["corners"]]
-                    frame[max(0, int(min(ys)) - 12):int(max(ys)) + 12, max(0, int(min(xs)) - 12):int(max(xs)) + 12] = 255
+                    top, left = max(0, int(min(ys)) - 12), max(0, int(min(xs)) - 12)
+                    frame[top:int(max(ys)) + 12, left:int(max(xs)) + 12] = 255
             with open(os.path.join(tmp, f"frame{n:03d}.pgm"), "wb") as f:
                 f.write(b"P5\n%d %d\n255\n" % (width, height) + frame.tobytes())
 
