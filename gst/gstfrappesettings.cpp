@@ -10,6 +10,7 @@
 #include <variant>
 #include <cstddef>
 #include <exception>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -23,6 +24,16 @@ GST_DEBUG_CATEGORY_EXTERN(gst_frappe_detect_debug);
 namespace frappe::gst {
 
 namespace {
+
+/* The least float above an open minimum. Not a subnormal: in a process
+ * where any library built with -ffast-math set flush-to-zero (GStreamer
+ * scanning its plugins in-process loads some), a subnormal minimum reads
+ * as the refused minimum itself. */
+float aboveOpenMinimum(float lo, float hi)
+{
+	const float v = std::nextafter(lo, hi);
+	return std::fpclassify(v) == FP_SUBNORMAL ? std::numeric_limits<float>::min() : v;
+}
 
 /* The element's own: the pose's marker side in metres. */
 constexpr gdouble kMarkerSizeMax = 1000.0;
@@ -67,7 +78,7 @@ GParamSpec *settingSpec(const frappe::Setting &s, GParamFlags flags)
 			using T = std::remove_cvref_t<decltype(defaults.*m)>;
 			if constexpr (std::is_same_v<T, float>) {
 				const float lo = static_cast<float>(s.min), hi = static_cast<float>(s.max);
-				return g_param_spec_float(name, nick, text, s.min_open ? std::nextafter(lo, hi) : lo,
+				return g_param_spec_float(name, nick, text, s.min_open ? aboveOpenMinimum(lo, hi) : lo,
 							  std::isinf(s.max) ? G_MAXFLOAT : hi, defaults.*m, flags);
 			} else if constexpr (std::is_same_v<T, int>) {
 				return g_param_spec_int(name, nick, text, static_cast<gint>(s.min) + s.min_open,

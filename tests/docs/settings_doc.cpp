@@ -14,8 +14,13 @@ namespace {
 
 std::string pythonDefault(const frappe::Setting &s, const frappe::Config &c)
 {
-	if (s.isChoice())
-		return "\"" + s.text(c) + "\"";
+	if (s.isChoice()) {
+		/* Appended, not "\"" + text: GCC 12's -Wrestrict misreads that. */
+		std::string quoted = "\"";
+		quoted += s.text(c);
+		quoted += '"';
+		return quoted;
+	}
 	std::string t = s.text(c);
 	/* A float default reads as a float: 28 -> 28.0. */
 	if (!s.isInteger() && t.find_first_of(".e") == std::string::npos)

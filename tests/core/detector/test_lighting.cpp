@@ -300,8 +300,9 @@ TEST(Lighting, ToneTableFollowsTheCurve)
 		tabled.apply(b);
 		for (int i = 0; i < a.side * a.side; ++i) {
 			const float v = a.samples[static_cast<std::size_t>(i)], t = b.samples[static_cast<std::size_t>(i)];
-			if (i % 2)
+			if (i % 2) {
 				EXPECT_EQ(t, table[static_cast<std::size_t>(v)]) << v;
+			}
 			EXPECT_NEAR(t, exact.apply(std::min(v, 255.0f)), 0.05f) << "sample " << v << " expScale " << exact.expScale;
 		}
 		detail::WarpedMarker ramp;

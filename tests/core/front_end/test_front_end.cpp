@@ -204,8 +204,9 @@ TEST(FrontEnd, SimdTargetNamesTheKernelsThatRun)
 #if defined(__aarch64__) && defined(FRAPPE_TEST_HWY_TARGETS)
 	EXPECT_EQ(target, "NEON");
 	/* tests/cross/hide_aes.cpp took effect: Highway's check declines NEON. */
-	if (std::getenv("FRAPPE_TEST_NO_AES"))
+	if (std::getenv("FRAPPE_TEST_NO_AES")) {
 		EXPECT_EQ(offered.find("NEON"), std::string::npos) << offered;
+	}
 #elif defined(FRAPPE_TEST_HWY_TARGETS)
 	/* Dynamic dispatch: the best target built that this CPU has. */
 	EXPECT_EQ(target, hwy::TargetName(hwy::SupportedAndGeneratedTargets().front()));

@@ -466,7 +466,7 @@ TEST(ReadMarker, EachRejectionOnItsOwn)
 {
 	const Dictionary &d = *findDictionary("aruco_mip_36h12");
 	const detail::CodeBook book(d);
-	detail::DecodePolicy policy{ 2, 5, 0.3f };
+	detail::DecodePolicy policy{ 2, 5, 0.3f, {} };
 	Image img(120, 120, 255);
 	const Quad q = square(19.5f, 19.5f, 64.0f);
 	RenderOptions opt;
@@ -563,7 +563,7 @@ TEST(ReadCellCentres, SmallMarkerYesDarkSquareNo)
 {
 	const Dictionary &d = *findDictionary("aruco_mip_36h12");
 	const detail::CodeBook book(d);
-	const detail::DecodePolicy policy{ 2, 5, 0.3f };
+	const detail::DecodePolicy policy{ 2, 5, 0.3f, {} };
 	const Quad q = square(20.5f, 20.5f, 17.0f); /* 8 cells of 2.1 px */
 	Image img(60, 60, 220);
 	RenderOptions opt;
@@ -597,7 +597,7 @@ TEST(ReadCellCentres, AnotherFamilyOnTheWrongGrid)
 	const Dictionary &mip = *findDictionary("aruco_mip_36h12");
 	const Dictionary &d = *findDictionary("4x4_1000");
 	const detail::CodeBook book(d);
-	const detail::DecodePolicy policy{ d.defaultMaxHamming(), d.weakMaxHamming(), 0.3f };
+	const detail::DecodePolicy policy{ d.defaultMaxHamming(), d.weakMaxHamming(), 0.3f, {} };
 	const Quad q = square(20.5f, 20.5f, 18.0f);
 	int read = 0;
 	for (int id = 0; id < 100; ++id) {
