@@ -43,12 +43,15 @@ void appendNumber(std::string &out, T v, NumberStyle style)
 			out += "null";
 			return;
 		}
-		if (style.decimals >= 0 || style.digits > 0) {
-			const int n = style.decimals >= 0 ? std::snprintf(text, sizeof(text), "%.*f", style.decimals,
-									  static_cast<double>(v))
-							  : std::snprintf(text, sizeof(text), "%.*g", style.digits,
-									  static_cast<double>(v));
+		if (style.decimals >= 0) {
+			const int n = std::snprintf(text, sizeof(text), "%.*f", style.decimals, static_cast<double>(v));
 			out.append(text, static_cast<std::size_t>(n));
+			return;
+		}
+		if (style.digits > 0) { /* printf's %g, without its locale and parsing */
+			const auto r = std::to_chars(text, text + sizeof(text), static_cast<double>(v),
+						     std::chars_format::general, style.digits);
+			out.append(text, r.ptr);
 			return;
 		}
 	}
