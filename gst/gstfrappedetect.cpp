@@ -71,6 +71,20 @@
  * of OpenCV aruco: origin at the marker centre, x right, y up, z out of the
  * marker towards the camera.
  *
+ * A value the element refuses (an unknown dictionary or mode, a malformed
+ * marker-sizes, a camera-matrix of other than 9 numbers, a distortion of
+ * another count, a file it cannot read) set while the element is stopped,
+ * as on a gst-launch-1.0 line, makes its next state change fail with an
+ * element error (GST_RESOURCE_ERROR_SETTINGS) naming the property, the
+ * value, why and what the property takes: gst-launch-1.0 prints it and
+ * exits. Set while playing, the previous value is kept and the same text is
+ * a warning on the bus.
+ *
+ * Every buffer the element detects on is numbered: its offset (and offset
+ * end, one more) is its count since the element started, 0 first, as
+ * GstBuffer's offset is a video frame's number; frappejson writes it as
+ * the line's `frame`. A buffer passed through unread keeps its own.
+ *
  * #GstFrappeDetect:backend chooses where the front end (Sobel, edges,
  * corners, empty tiles) runs: `cpu`; `vc4`, the QPUs of a Raspberry Pi Zero,
  * 1, 2 or 3 (it fails to start when they cannot be used, e.g. while the vc4
@@ -186,7 +200,8 @@ struct FrappeDetectPrivate {
 	/* Under the object lock. */
 	Settings props;
 	GstStructure *stats = nullptr;
-	bool running = false; /* started: files are read when set */
+	bool running = false;          /* started: files are read when set */
+	frappe::gst::Refusals refused; /* values refused while stopped */
 
 	/* Streaming thread only. */
 	Settings active;
@@ -203,6 +218,7 @@ struct FrappeDetectPrivate {
 	bool warnedFallback = false, warnedDropped = false;
 	bool poolOffered = false; /* a GstFrappePool went upstream */
 	guint64 frames = 0;
+	guint64 numbered = 0; /* buffers numbered (offset) since start */
 	frappe::gst::StatsWindow window;
 };
 
@@ -513,6 +529,11 @@ static GstFlowReturn process(GstFrappeDetect *self, GstBuffer *input)
 		return GST_FLOW_NOT_NEGOTIATED;
 	}
 
+	/* Every buffer has a number since start, its offset as GstBuffer's is
+	 * for video (frappejson's `frame`, the same in every branch after); a
+	 * buffer passed through untouched keeps its own. */
+	const guint64 number = priv->numbered++;
+
 	/* Before anything maps or reads it: the luma plane the detector
 	 * reads and, to annotate, the chroma planes it writes. */
 	const GstVideoInfo *info = &GST_VIDEO_FILTER(self)->in_info;
@@ -523,9 +544,13 @@ static GstFlowReturn process(GstFrappeDetect *self, GstBuffer *input)
 		return pass_through(self, input);
 	}
 
-	/* Metas need a writable buffer: a shallow copy when shared, which
-	 * keeps the memory (and zero-copy) as long as we map read-only. */
+	/* Metas and the number need a writable buffer: a shallow copy when
+	 * shared, which keeps the memory (and zero-copy) as long as we map
+	 * read-only. */
 	GstBuffer *buffer = gst_buffer_make_writable(input);
+	GST_BUFFER_OFFSET(buffer) = number;
+	GST_BUFFER_OFFSET_END(buffer) = number + 1;
+
 	priv->bufferLog.memory(GST_ELEMENT(self), buffer, info, priv->active.annotate);
 
 	MappedFrame f;
@@ -664,6 +689,7 @@ static gboolean gst_frappe_detect_start(GstBaseTransform *trans)
 	GST_OBJECT_UNLOCK(self);
 	self->priv->camera.reset();
 	self->priv->frames = 0;
+	self->priv->numbered = 0;
 	self->priv->window.reset();
 	self->priv->bufferLog.reset();
 	self->priv->warnedDropped = false;
@@ -697,6 +723,16 @@ static gboolean gst_frappe_detect_set_info(GstVideoFilter *filter, GstCaps *, Gs
 	return TRUE;
 }
 
+/* A value refused while stopped fails the next state change up: on a
+ * gst-launch-1.0 line its warning had no bus to go to. */
+static GstStateChangeReturn gst_frappe_detect_change_state(GstElement *element, GstStateChange transition)
+{
+	if ((transition == GST_STATE_CHANGE_NULL_TO_READY || transition == GST_STATE_CHANGE_READY_TO_PAUSED) &&
+	    !frappe::gst::failRefused(element, GST_FRAPPE_DETECT(element)->priv->refused))
+		return GST_STATE_CHANGE_FAILURE;
+	return GST_ELEMENT_CLASS(parent_class)->change_state(element, transition);
+}
+
 /* -------------------------------------------------------------------------
  * GObject
  */
@@ -704,7 +740,8 @@ static gboolean gst_frappe_detect_set_info(GstVideoFilter *filter, GstCaps *, Gs
 static void gst_frappe_detect_set_property(GObject *object, guint prop_id, const GValue *value, GParamSpec *pspec)
 {
 	GstFrappeDetect *self = GST_FRAPPE_DETECT(object);
-	if (!frappe::gst::setProperty(GST_ELEMENT(self), self->priv->props, self->priv->running, prop_id, value))
+	if (!frappe::gst::setProperty(GST_ELEMENT(self), self->priv->props, self->priv->running, self->priv->refused,
+				      prop_id, value))
 		G_OBJECT_WARN_INVALID_PROPERTY_ID(object, prop_id, pspec);
 }
 
@@ -762,6 +799,7 @@ static void gst_frappe_detect_class_init(GstFrappeDetectClass *klass)
 					      "The Frappe authors");
 	gst_element_class_add_static_pad_template(element_class, &sink_template);
 	gst_element_class_add_static_pad_template(element_class, &src_template);
+	element_class->change_state = GST_DEBUG_FUNCPTR(gst_frappe_detect_change_state);
 
 	trans_class->passthrough_on_same_caps = FALSE;
 	trans_class->generate_output = GST_DEBUG_FUNCPTR(gst_frappe_detect_generate_output);

@@ -7,6 +7,8 @@
 #include <cstddef>
 #include <string>
 
+#include <frappe/marker_record.h>
+
 #include "frappe_backend.h"
 
 /* Made from frappe::backendNames(), the one list of the names: the enum's
@@ -43,6 +45,28 @@ GType gst_frappe_overlap_get_type(void)
 	};
 	if (g_once_init_enter(&type)) {
 		GType t = g_enum_register_static("GstFrappeOverlap", values);
+		g_once_init_leave(&type, t);
+	}
+	return type;
+}
+
+/* Made from frappe::markerFieldNames(), the one list of a marker's
+ * fields: flag 1 << i is name i, in kebab-case. */
+GType gst_frappe_json_fields_get_type(void)
+{
+	static GType type = 0;
+	if (g_once_init_enter(&type)) {
+		const auto names = frappe::markerFieldNames();
+		GFlagsValue *values = g_new0(GFlagsValue, names.size());
+		for (std::size_t i = 1; i < names.size(); ++i) {
+			std::string nick(names[i]);
+			for (char &c : nick)
+				c = c == '_' ? '-' : c;
+			values[i - 1].value = 1u << i;
+			values[i - 1].value_name = g_intern_string(("The marker's " + std::string(names[i])).c_str());
+			values[i - 1].value_nick = g_intern_string(nick.c_str());
+		}
+		GType t = g_flags_register_static("GstFrappeJsonFields", values);
 		g_once_init_leave(&type, t);
 	}
 	return type;

@@ -1,7 +1,8 @@
 /* SPDX-License-Identifier: MIT
  *
  * gstfrappeenums.h: the enum types of frappedetect's own properties (the
- * detector's choices, dictionary and mode, are strings: frappe/settings.h).
+ * detector's choices, dictionary and mode, are strings: frappe/settings.h)
+ * and the flags of frappejson's fields.
  */
 #pragma once
 
@@ -29,6 +30,11 @@ GType gst_frappe_backend_get_type(void);
 
 #define GST_TYPE_FRAPPE_OVERLAP (gst_frappe_overlap_get_type())
 GType gst_frappe_overlap_get_type(void);
+
+/* frappejson's fields: bit i is frappe::markerFieldNames()[i] (the id, bit
+ * 0, is always written and not a flag). */
+#define GST_TYPE_FRAPPE_JSON_FIELDS (gst_frappe_json_fields_get_type())
+GType gst_frappe_json_fields_get_type(void);
 
 G_END_DECLS
 

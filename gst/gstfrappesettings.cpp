@@ -148,8 +148,8 @@ struct FileValue {
 };
 
 /* Outside the object lock (a dictionary may take a while to check):
- * false, and `warning` set, when the file cannot be used. */
-bool readFileProperty(guint propId, const GValue *value, bool running, FileValue &out, std::string &warning)
+ * false, and `why` set, when the file cannot be used. */
+bool readFileProperty(guint propId, const GValue *value, bool running, FileValue &out, std::string &why)
 {
 	const gchar *path = g_value_get_string(value);
 	out.path = path ? path : "";
@@ -162,8 +162,7 @@ bool readFileProperty(guint propId, const GValue *value, bool running, FileValue
 		out.dictionary = readDictionaryFile(out.path, error);
 	if (error.empty())
 		return true;
-	warning = "Ignoring " + std::string(propId == PROP_CALIBRATION_FILE ? "calibration" : "dictionary") +
-		  " file " + out.path + ", keeping the previous one: " + error;
+	why = error;
 	return false;
 }
 
@@ -300,17 +299,17 @@ void installProperties(GObjectClass *gobject_class)
 
 namespace {
 
-/* A value that needs no file; `warning` set when it is refused (and the
+/* A value that needs no file; `why` set when it is refused (and the
  * previous one kept). */
-bool setValue(Settings &p, guint propId, const GValue *value, std::string &warning)
+bool setValue(Settings &p, guint propId, const GValue *value, std::string &why)
 {
 	if (const frappe::Setting *s = settingOf(propId)) {
 		if (s->isChoice()) {
 			const gchar *text = g_value_get_string(value);
 			try {
 				s->parse(p.library, text ? text : "");
-			} catch (const std::exception &e) {
-				warning = s->kebabName() + " " + e.what() + "; keeping " + s->text(p.library);
+			} catch (const std::exception &) {
+				why = "not one of its values"; /* which the property's text lists */
 			}
 		} else if (G_VALUE_HOLDS_FLOAT(value)) {
 			s->setNumber(p.library, g_value_get_float(value));
@@ -346,15 +345,14 @@ bool setValue(Settings &p, guint propId, const GValue *value, std::string &warni
 			break;
 		}
 		if (m.size() != 9) {
-			warning = "camera-matrix needs 9 numbers (row-major 3x3), got " + std::to_string(m.size()) +
-				  "; ignored";
+			why = "needs 9 numbers (row-major 3x3), got " + std::to_string(m.size());
 			return true;
 		}
 		std::copy(m.begin(), m.end(), c.matrix.begin());
 		try {
 			c.validate();
 		} catch (const std::exception &e) {
-			warning = std::string("camera-matrix ignored: ") + e.what();
+			why = e.what();
 			return true;
 		}
 		p.camera = c;
@@ -367,7 +365,7 @@ bool setValue(Settings &p, guint propId, const GValue *value, std::string &warni
 		try {
 			c.validate();
 		} catch (const std::exception &e) {
-			warning = std::string("distortion ignored: ") + e.what();
+			why = e.what();
 			return true;
 		}
 		p.camera.distortion = c.distortion;
@@ -379,18 +377,10 @@ bool setValue(Settings &p, guint propId, const GValue *value, std::string &warni
 	return true;
 }
 
-/* The start of a refused text for a warning: a value may be up to
- * MarkerSizes::kMaxSpecBytes long. */
-std::string quoted(const std::string &text)
-{
-	constexpr std::size_t kShown = 60;
-	return "\"" + (text.size() <= kShown ? text : text.substr(0, kShown) + "...") + "\"";
-}
-
 /* marker-size and marker-sizes make one MarkerSizes: parsed outside the
  * object lock, which the streaming thread takes for every buffer, and
- * parsed again if either changed meanwhile. `warning` set when refused. */
-void setMarkerSizes(GstElement *element, Settings &p, guint propId, const GValue *value, std::string &warning)
+ * parsed again if either changed meanwhile. `why` set when refused. */
+void setMarkerSizes(GstElement *element, Settings &p, guint propId, const GValue *value, std::string &why)
 {
 	const gchar *given = propId == PROP_MARKER_SIZES ? g_value_get_string(value) : nullptr;
 	for (;;) {
@@ -403,7 +393,7 @@ void setMarkerSizes(GstElement *element, Settings &p, guint propId, const GValue
 		try {
 			sizes = frappe::MarkerSizes::parse(text, size);
 		} catch (const std::exception &e) {
-			warning = "marker-sizes " + quoted(text) + " refused: " + e.what();
+			why = e.what();
 			return;
 		}
 		GST_OBJECT_LOCK(element);
@@ -420,17 +410,68 @@ void setMarkerSizes(GstElement *element, Settings &p, guint propId, const GValue
 	}
 }
 
+/* The start of a value for a message: a value may be up to
+ * MarkerSizes::kMaxSpecBytes long. */
+std::string shortened(const std::string &text)
+{
+	constexpr std::size_t kShown = 60;
+	return text.size() <= kShown ? text : text.substr(0, kShown) + "...";
+}
+
+/* What a refused value's warning and error say: the property, the value
+ * as it would be written on a gst-launch-1.0 line, why, and the property's
+ * own text (its blurb: what it takes, a choice's valid values). */
+std::string refusal(GstElement *element, guint propId, const std::string &valueText, const std::string &why)
+{
+	GParamSpec *spec = nullptr;
+	guint n = 0;
+	GParamSpec **specs = g_object_class_list_properties(G_OBJECT_GET_CLASS(element), &n);
+	for (guint i = 0; i < n && !spec; ++i)
+		if (specs[i]->param_id == propId && specs[i]->owner_type == G_OBJECT_TYPE(element))
+			spec = specs[i];
+	g_free(specs);
+	const char *name = spec ? g_param_spec_get_name(spec) : "?";
+	std::string text = std::string(name) + "=\"" + shortened(valueText) + "\" refused: " + why;
+	if (spec)
+		text += ". " + std::string(name) + ": " + g_param_spec_get_blurb(spec);
+	return text;
+}
+
+std::string refusal(GstElement *element, guint propId, const GValue *value, const std::string &why)
+{
+	std::string valueText;
+	if (G_VALUE_HOLDS_STRING(value)) {
+		const gchar *v = g_value_get_string(value);
+		valueText = v ? v : "";
+	} else if (GST_VALUE_HOLDS_ARRAY(value)) {
+		/* As a gst-launch line writes it: <1.0, 2.5>. */
+		std::vector<double> numbers;
+		setDoubleArray(value, numbers);
+		for (double x : numbers) {
+			char text[32];
+			g_ascii_dtostr(text, sizeof(text), x);
+			valueText += (valueText.empty() ? "<" : ", ") + std::string(text);
+		}
+		valueText += valueText.empty() ? "<>" : ">";
+	} else if (gchar *v = gst_value_serialize(value)) {
+		valueText = v;
+		g_free(v);
+	}
+	return refusal(element, propId, valueText, why);
+}
+
 } /* namespace */
 
-bool setProperty(GstElement *element, Settings &props, const bool &running, guint propId, const GValue *value)
+bool setProperty(GstElement *element, Settings &props, const bool &running, Refusals &refused, guint propId,
+		 const GValue *value)
 {
-	std::string warning;
+	std::string why;
 	if (propId == PROP_CALIBRATION_FILE || propId == PROP_DICTIONARY_FILE) {
 		GST_OBJECT_LOCK(element);
 		const bool read = running;
 		GST_OBJECT_UNLOCK(element);
 		FileValue file;
-		if (readFileProperty(propId, value, read, file, warning)) {
+		if (readFileProperty(propId, value, read, file, why)) {
 			GST_OBJECT_LOCK(element);
 			if (propId == PROP_CALIBRATION_FILE) {
 				props.calibrationFile = file.path;
@@ -444,24 +485,47 @@ bool setProperty(GstElement *element, Settings &props, const bool &running, guin
 			GST_OBJECT_UNLOCK(element);
 		}
 	} else if (propId == PROP_MARKER_SIZE || propId == PROP_MARKER_SIZES) {
-		setMarkerSizes(element, props, propId, value, warning);
+		setMarkerSizes(element, props, propId, value, why);
 	} else {
 		GST_OBJECT_LOCK(element);
 		const guint cameraGeneration = props.cameraGeneration;
-		if (!setValue(props, propId, value, warning)) {
+		if (!setValue(props, propId, value, why)) {
 			GST_OBJECT_UNLOCK(element);
 			return false;
 		}
-		if (warning.empty()) {
+		if (why.empty()) {
 			++props.generation;
 			if (propId == PROP_CAMERA_MATRIX || propId == PROP_DISTORTION)
 				props.cameraGeneration = cameraGeneration + 1;
 		}
 		GST_OBJECT_UNLOCK(element);
 	}
-	if (!warning.empty())
-		GST_ELEMENT_WARNING(element, RESOURCE, SETTINGS, ("%s", warning.c_str()), (nullptr));
+
+	const std::string text = why.empty() ? std::string() : refusal(element, propId, value, why);
+	GST_OBJECT_LOCK(element);
+	if (why.empty())
+		refused.erase(propId);
+	else if (!running)
+		refused[propId] = text;
+	GST_OBJECT_UNLOCK(element);
+	if (!why.empty())
+		GST_ELEMENT_WARNING(element, RESOURCE, SETTINGS, ("%s; keeping the previous value", text.c_str()),
+				    (nullptr));
 	return true;
+}
+
+bool failRefused(GstElement *element, const Refusals &refused)
+{
+	GST_OBJECT_LOCK(element);
+	std::string text;
+	for (const auto &[id, why] : refused)
+		text += (text.empty() ? "" : "\n") + why;
+	GST_OBJECT_UNLOCK(element);
+	if (text.empty())
+		return true;
+	GST_ELEMENT_ERROR(element, RESOURCE, SETTINGS, ("%s", text.c_str()),
+			  ("refused while the element was stopped; set a valid value before starting"));
+	return false;
 }
 
 bool startSettings(GstElement *element, Settings &props, bool &running)
@@ -477,11 +541,11 @@ bool startSettings(GstElement *element, Settings &props, bool &running)
 	std::shared_ptr<const frappe::Dictionary> dictionary;
 	if (!calibrationFile.empty() && !(calibration = readCalibrationFile(calibrationFile, error))) {
 		GST_ELEMENT_ERROR(element, RESOURCE, SETTINGS,
-				  ("Cannot use calibration file %s: %s", calibrationFile.c_str(), error.c_str()),
+				  ("%s", refusal(element, PROP_CALIBRATION_FILE, calibrationFile, error).c_str()),
 				  (nullptr));
 	} else if (!dictionaryFile.empty() && !(dictionary = readDictionaryFile(dictionaryFile, error))) {
 		GST_ELEMENT_ERROR(element, RESOURCE, SETTINGS,
-				  ("Cannot use dictionary file %s: %s", dictionaryFile.c_str(), error.c_str()),
+				  ("%s", refusal(element, PROP_DICTIONARY_FILE, dictionaryFile, error).c_str()),
 				  (nullptr));
 	}
 

@@ -7,6 +7,7 @@
  */
 #pragma once
 
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -88,19 +89,33 @@ struct Settings {
 /* Installs every property; PROP_STATS is the element's to answer. */
 void installProperties(GObjectClass *klass);
 
+/* The values refused while the element was stopped, by property id: each
+ * text names the property, the value, why and what the property takes.
+ * The next state change fails on them (failRefused()): a gst-launch-1.0
+ * line sets the properties before the pipeline has a bus, so a warning
+ * then reaches nobody. Setting a property again clears its entry. */
+using Refusals = std::map<guint, std::string>;
+
 /* Sets a property of `props` (not PROP_STATS), taking `element`'s object
  * lock around it; false for an id that is not a setting. A value that
  * cannot be used is refused with a GST_ELEMENT_WARNING and the previous
- * one kept. The files of calibration-file and dictionary-file are read
+ * one kept; when not `running` it also goes into `refused` (under the
+ * lock). The files of calibration-file and dictionary-file are read
  * (outside the lock) when `running` (read under the lock) is set, else at
  * start by startSettings(). */
-bool setProperty(GstElement *element, Settings &props, const bool &running, guint propId, const GValue *value);
+bool setProperty(GstElement *element, Settings &props, const bool &running, Refusals &refused, guint propId,
+		 const GValue *value);
+
+/* Before a state change from NULL or READY: a GST_ELEMENT_ERROR
+ * (GST_RESOURCE_ERROR_SETTINGS) listing the refused values and false, or
+ * true when there are none. Takes the object lock. */
+bool failRefused(GstElement *element, const Refusals &refused);
 /* Gets a property of `s` (not PROP_STATS); false for an unknown id. */
 bool getProperty(const Settings &s, guint propId, GValue *value);
 
 /* At start: reads the files that calibration-file and dictionary-file
  * name into `props` and sets `running`. A file that cannot be used is a
- * GST_ELEMENT_ERROR naming it, and false. */
+ * GST_ELEMENT_ERROR naming the property, the file and why, and false. */
 bool startSettings(GstElement *element, Settings &props, bool &running);
 
 /* Puts the front end `backend` names into the pipeline's detectors: an

@@ -26,6 +26,9 @@ packages=(
 	# the GStreamer element and its examples
 	libgstreamer1.0-dev libgstreamer-plugins-base1.0-dev
 	gstreamer1.0-tools gstreamer1.0-plugins-base gstreamer1.0-plugins-good
+	# video and markers in one MPEG-TS (examples/stream-markers.sh and its
+	# test: mpegtsmux, tsdemux, h264parse, pnmdec; x264enc; avdec_h264)
+	gstreamer1.0-plugins-bad gstreamer1.0-plugins-ugly gstreamer1.0-libav
 	# the typelib GstFrappe-1.0 of gstfrappemeta and its Python test
 	gobject-introspection libgirepository1.0-dev gir1.2-gstreamer-1.0 gir1.2-gst-plugins-base-1.0
 	python3-gi python3-gst-1.0

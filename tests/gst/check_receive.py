@@ -1,10 +1,12 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: MIT
 """examples/stream-markers.sh and examples/receive-markers.py on loopback,
-the sample video standing in for the camera and MJPEG for the Pi's H.264:
-the receiver gets all 120 frames with marker 0 at z = 0.27 m (1 %), and the
-video branch sends RTP packets to its port. Exit 77 when jpegenc or the
-sample's decoder is missing."""
+the sample video standing in for the camera and x264enc for the Pi's
+encoder: the receiver gets all 120 frames with marker 0 at z = 0.27 m (1 %)
+(MAX_BYTES=0: one datagram per frame, as receive-markers.py reads them), and
+the video branch sends MPEG-TS datagrams (7 packets of 188 bytes) to its
+port (check_stream_pairing.py pairs them). Exit 77 when x264enc, mpegtsmux
+or the sample's decoder is missing."""
 import os
 import re
 import socket
@@ -37,7 +39,7 @@ def main():
     env = dict(os.environ, HOST="127.0.0.1", VIDEO_PORT=str(video_sock.getsockname()[1]),
                MARKER_PORT=str(marker_port), CALIBRATION=calibration, QUEUE="queue",
                SOURCE=f"filesrc location={video} ! decodebin ! videoconvert",
-               ENCODER="videoconvert ! jpegenc quality=50 ! rtpjpegpay")
+               MAX_BYTES="0", ENCODER="x264enc tune=zerolatency speed-preset=ultrafast ! h264parse")
     sender = subprocess.run(["sh", script], env=env, capture_output=True, text=True, timeout=120)
     if sender.returncode != 0:
         recv.kill()
@@ -64,11 +66,14 @@ def main():
     packets = 0
     try:
         while True:
-            video_sock.recv(65536)
+            data = video_sock.recv(65536)
+            if len(data) != 7 * 188 or any(data[i] != 0x47 for i in range(0, len(data), 188)):
+                print(f"a video datagram of {len(data)} bytes that is not 7 TS packets")
+                return 1
             packets += 1
     except BlockingIOError:
         pass
-    print(f"receiver: 120 frames, marker 0 depth error {100 * worst:.2f} %; video: {packets} RTP packets")
+    print(f"receiver: 120 frames, marker 0 depth error {100 * worst:.2f} %; video: {packets} MPEG-TS datagrams")
     return 0 if worst < 0.01 and packets > 0 else 1
 
 

@@ -73,9 +73,23 @@ FRAPPE_EXPORT std::span<const std::string_view> markerFieldNames();
 /// that is not finite as null.
 enum class JsonNumbers { Exact, Rounded };
 
+/// How appendMarkerJson() writes a marker: its numbers and which fields
+/// (frappejson's precision and fields properties).
+struct JsonStyle {
+	JsonNumbers numbers = JsonNumbers::Exact;
+	/// With Exact: 0 for the shortest exact text, 1-17 for that many
+	/// significant digits (printf's %.*g).
+	int digits = 0;
+	/// Bit i leaves out markerFieldNames()[i]; the id (bit 0) is always
+	/// written.
+	unsigned omit = 0;
+};
+
 /// Appends `r` as one JSON object: {"id": 7, "dictionary": "...",
 /// "corners": [[x, y], ...], ...}. Allocates only when `out` grows.
 FRAPPE_EXPORT void appendMarkerJson(std::string &out, const MarkerRecord &r, JsonNumbers numbers);
+/// The same in a style: rounded or to some digits, some fields left out.
+FRAPPE_EXPORT void appendMarkerJson(std::string &out, const MarkerRecord &r, const JsonStyle &style);
 /// Appends `s` as a JSON string: valid UTF-8 kept, a byte that is not part
 /// of it written \u00XX, quotes, backslashes and control characters escaped.
 FRAPPE_EXPORT void appendJsonString(std::string &out, std::string_view s);

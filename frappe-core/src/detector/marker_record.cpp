@@ -2,7 +2,9 @@
 // The one JSON writer of a marker (frappe/marker_record.h).
 #include "frappe/marker_record.h"
 
+#include <algorithm>
 #include <charconv>
+#include <iterator>
 #include <cmath>
 #include <cstdio>
 #include <type_traits>
@@ -24,9 +26,16 @@ constexpr std::string_view kFieldNames[] = { "id",
 					     "reprojection_error",
 					     "alternative_reprojection_error" };
 
-/* `decimals` < 0: the shortest exact text. */
+/* How a field's floating-point numbers are written: `decimals` >= 0 that
+ * many decimals, else `digits` > 0 that many significant digits, else the
+ * shortest exact text. */
+struct NumberStyle {
+	int decimals = -1;
+	int digits = 0;
+};
+
 template<typename T>
-void appendNumber(std::string &out, T v, int decimals)
+void appendNumber(std::string &out, T v, NumberStyle style)
 {
 	char text[48];
 	if constexpr (std::is_floating_point_v<T>) {
@@ -34,9 +43,15 @@ void appendNumber(std::string &out, T v, int decimals)
 			out += "null";
 			return;
 		}
-		if (decimals >= 0) {
-			const int n = std::snprintf(text, sizeof(text), "%.*f", decimals, static_cast<double>(v));
+		if (style.decimals >= 0) {
+			const int n = std::snprintf(text, sizeof(text), "%.*f", style.decimals, static_cast<double>(v));
 			out.append(text, static_cast<std::size_t>(n));
+			return;
+		}
+		if (style.digits > 0) { /* printf's %g, without its locale and parsing */
+			const auto r = std::to_chars(text, text + sizeof(text), static_cast<double>(v),
+						     std::chars_format::general, style.digits);
+			out.append(text, r.ptr);
 			return;
 		}
 	}
@@ -93,11 +108,24 @@ void appendJsonString(std::string &out, std::string_view s)
 
 void appendMarkerJson(std::string &out, const MarkerRecord &r, JsonNumbers numbers)
 {
+	appendMarkerJson(out, r, JsonStyle{ numbers, 0, 0 });
+}
+
+void appendMarkerJson(std::string &out, const MarkerRecord &r, const JsonStyle &jsonStyle)
+{
 	bool first = true;
 	out += '{';
 	forEachMarkerField(r, [&](std::string_view name, const auto &value) {
 		using T = std::remove_cvref_t<decltype(value)>;
-		const int decimals = numbers == JsonNumbers::Rounded ? roundedDecimals(name) : -1;
+		const std::size_t index = static_cast<std::size_t>(
+			std::find(std::begin(kFieldNames), std::end(kFieldNames), name) - std::begin(kFieldNames));
+		if (index > 0 && index < 32 && (jsonStyle.omit >> index & 1u))
+			return;
+		NumberStyle style;
+		if (jsonStyle.numbers == JsonNumbers::Rounded)
+			style.decimals = roundedDecimals(name);
+		else
+			style.digits = jsonStyle.digits;
 		out += first ? "\"" : ", \"";
 		first = false;
 		out += name;
@@ -107,14 +135,14 @@ void appendMarkerJson(std::string &out, const MarkerRecord &r, JsonNumbers numbe
 		} else if constexpr (std::is_same_v<T, bool>) {
 			out += value ? "true" : "false";
 		} else if constexpr (std::is_same_v<T, Count>) {
-			appendNumber(out, value.value, -1);
+			appendNumber(out, value.value, NumberStyle{});
 		} else if constexpr (std::is_same_v<T, std::array<Point2f, 4>>) {
 			out += '[';
 			for (std::size_t k = 0; k < value.size(); ++k) {
 				out += k ? ", [" : "[";
-				appendNumber(out, value[k].x, decimals);
+				appendNumber(out, value[k].x, style);
 				out += ", ";
-				appendNumber(out, value[k].y, decimals);
+				appendNumber(out, value[k].y, style);
 				out += ']';
 			}
 			out += ']';
@@ -123,11 +151,11 @@ void appendMarkerJson(std::string &out, const MarkerRecord &r, JsonNumbers numbe
 			for (std::size_t k = 0; k < value.size(); ++k) {
 				if (k)
 					out += ", ";
-				appendNumber(out, value[k], decimals);
+				appendNumber(out, value[k], style);
 			}
 			out += ']';
 		} else {
-			appendNumber(out, value, std::is_floating_point_v<T> ? decimals : -1);
+			appendNumber(out, value, std::is_floating_point_v<T> ? style : NumberStyle{});
 		}
 	});
 	out += '}';
