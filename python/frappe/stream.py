@@ -31,8 +31,10 @@ header; a marker is whole in one part). Rules of reassembly, which the tests
   given-up frame all count. Frames before the first one received do not;
 * a robot that restarts counts from 0 again: a frame number below the last
   delivered one is a restart (`Stats.restarts`, nothing counted lost) when it
-  is 0, when it is more than `reorder` frames back, or when it is the first
-  frame of a new TCP connection; otherwise it is a late part;
+  is 0 or more than `reorder` frames back; otherwise it is a late part;
+* a new TCP connection counts afresh: what the robot sent while the host was
+  not connected is not counted lost (`Stats.reconnects` says it happened),
+  and a first frame numbered below the last one is a restart;
 * old lines without `frame` (frappejson before the time base) are whole frames
   numbered by arrival; no loss can be counted for them.
 """
@@ -199,7 +201,7 @@ class Reassembler:
             part = parse_line(line)
         except (ValueError, KeyError, TypeError, IndexError) as e:
             self.stats.bad_lines += 1
-            raise ValueError(f"bad marker line ({e}): {bytes(line[:80]) if isinstance(line, (bytes, bytearray)) else line[:80]!r}") from None
+            raise ValueError(f"bad marker line ({e}): {line[:80]!r}") from None
         number = part["frame"]
         if number is None:  # the old form: whole, numbered by arrival
             self._arrivals += 1
@@ -208,15 +210,18 @@ class Reassembler:
             return [self._deliver(pending.frame(self._arrivals - 1), count_gap=False)]
         number = int(number)
         out = []
-        if self._last is not None and number <= self._last and number not in self._pending:
-            if self._new_stream or number == 0 or self._last - number > self.reorder:
+        if self._new_stream:  # a new connection counts afresh
+            if self._last is not None and number <= self._last:
+                self.stats.restarts += 1
+            self._last, self._new_stream = None, False
+        elif self._last is not None and number <= self._last and number not in self._pending:
+            if number == 0 or self._last - number > self.reorder:
                 self.stats.restarts += 1
                 out += self._give_up(None)
                 self._last = None
             else:
                 self.stats.late += 1
                 return out
-        self._new_stream = False
         pending = self._pending.get(number)
         if pending is None:
             pending = self._pending[number] = _Pending(part)

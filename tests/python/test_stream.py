@@ -76,6 +76,16 @@ def test_a_restart_long_after_frame_0_is_seen_whatever_frame_comes_first():
     assert (r.stats.frames, r.stats.restarts, r.stats.lost) == (13, 1, 0)
 
 
+def test_a_new_connection_counts_afresh():
+    r = stream.Reassembler()
+    feed(r, frame_lines(40, [marker(0)]) + frame_lines(41, [marker(0)]))
+    r.new_stream()  # the host was away: frames 42..59 never reached it
+    feed(r, frame_lines(60, [marker(0)]) + frame_lines(62, [marker(0)]))
+    r.new_stream()  # the robot restarted: its frame 3 is the first the host sees
+    feed(r, frame_lines(3, [marker(0)]))
+    assert (r.stats.frames, r.stats.lost, r.stats.restarts) == (5, 1, 1)
+
+
 def test_a_late_part_of_a_given_up_frame_is_dropped():
     r = stream.Reassembler()
     late = frame_lines(1, [marker(0), marker(1)], parts=2)
