@@ -13,10 +13,13 @@ claim checked (examples/README.md):
   stream-mjpeg.sh    a page at http://HOST:PORT/, multipart/x-mixed-replace
                      JPEGs, /markers.json listing markers 0, 7, 23, 42
   env.sh             sourced, gst-inspect-1.0 finds frappedetect
+  render-sample      a WebM of the frames asked for, frame 0 with the sample's
+                     markers 0, 7, 23, 42 (frappedetect reads them back)
 
 (stream-markers.sh and receive-markers.py: the receive-markers test; the page
 in a browser: watch-page.) A check whose plugins are missing is skipped; exit
-77 when all are. Run with /usr/bin/python3 (gi): check_examples.py SOURCE_ROOT BUILD_ROOT"""
+77 when all are. Run with /usr/bin/python3 (gi):
+  check_examples.py SOURCE_ROOT BUILD_ROOT RENDER_SAMPLE"""
 import json
 import os
 import shutil
@@ -36,7 +39,7 @@ from gi.repository import Gst  # noqa: E402
 Gst.init(None)
 
 SKIP = 77
-ROOT, BUILD = sys.argv[1:3]
+ROOT, BUILD, RENDER_SAMPLE = sys.argv[1:4]
 EXAMPLES = os.path.join(ROOT, "examples")
 SAMPLE = os.path.join(EXAMPLES, "data", "markers.webm")
 # Marker 0 in the sample's frame 0: the middle of each side of its outline.
@@ -222,9 +225,29 @@ def check_env_sh(tmp):
     return "gst-inspect-1.0 frappedetect after sourcing it"
 
 
+def check_render_sample(tmp):
+    need("vp8enc", "webmmux", "vp8dec", "matroskademux")
+    out = os.path.join(tmp, "sample.webm")
+    p = subprocess.run([RENDER_SAMPLE, out, "10"], capture_output=True, text=True, timeout=120)
+    assert p.returncode == 0, p.stderr[-2000:]
+    head = f'filesrc location="{out}" ! decodebin'
+    assert count_frames(head) == 10, f"{out}: not 10 frames"
+    d = Gst.parse_launch(head + " ! videoconvert ! frappedetect ! frappejson ! appsink name=s sync=false")
+    d.set_state(Gst.State.PLAYING)
+    sample = d.get_by_name("s").emit("try-pull-sample", 20 * Gst.SECOND)
+    d.set_state(Gst.State.NULL)
+    assert sample is not None, "no marker line"
+    buf = sample.get_buffer()
+    line = json.loads(buf.extract_dup(0, buf.get_size()).split(b"\n")[0])
+    ids = sorted(m["id"] for m in line["markers"])
+    assert ids == [0, 7, 23, 42], f"frame 0: ids {ids}"
+    return "10 frames, frame 0 with markers 0, 7, 23, 42"
+
+
 def main():
     results = {"ok": 0, "skip": 0, "fail": 0}
-    for check in (check_annotate_file, check_libcamera_pi, check_stream_h264_rtp, check_stream_mjpeg, check_env_sh):
+    for check in (check_annotate_file, check_libcamera_pi, check_stream_h264_rtp, check_stream_mjpeg, check_env_sh,
+                  check_render_sample):
         name = check.__name__[len("check_"):].replace("_", "-")
         start = time.monotonic()
         with tempfile.TemporaryDirectory(prefix="frappe-example-") as tmp:
