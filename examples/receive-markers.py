@@ -18,7 +18,7 @@ except ImportError:  # from a checkout: the package's pure-Python part is enough
 url, count = sys.argv[1], int(sys.argv[2]) if len(sys.argv) > 2 else 0
 with stream.open_url(url) as markers:
     print(f"receiving on {markers.address}", file=sys.stderr, flush=True)
-    for n, frame in enumerate(markers.frames(timeout=10), 1):
+    for n, frame in enumerate(markers, 1):  # for ever, or FRAMES frames
         print(f"frame {frame.number}:", "; ".join(
             f"id {m.id} at ({m.pose.tvec[0]:+.4f}, {m.pose.tvec[1]:+.4f}, {m.pose.tvec[2]:.4f}) m" if m.pose
             else f"id {m.id} at pixel {m.center}" for m in frame.markers), flush=True)

@@ -74,8 +74,9 @@ def main(argv=None) -> int:
             if not port.isdigit():
                 print(f"frappe-receive: --tcp {args.tcp}: expected HOST:PORT", file=sys.stderr)
                 return 2
-            receiver = stream.tcp(host or "127.0.0.1", int(port), reconnect=not args.no_reconnect,
-                                  incomplete=args.incomplete)
+            receiver = stream.tcp(host.strip("[]") or "127.0.0.1", int(port), reconnect=not args.no_reconnect,
+                                  incomplete=args.incomplete,
+                                  log=lambda text: print(f"frappe-receive: {text}", file=sys.stderr, flush=True))
     except OSError as e:
         print(f"frappe-receive: cannot listen on udp {args.bind}:{args.udp}: {e}", file=sys.stderr)
         return 1

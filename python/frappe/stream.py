@@ -372,8 +372,9 @@ class _Tcp:
     `backoff[0]` doubling to `backoff[1]` seconds, when the robot is not up
     yet or goes away; a line cut by a lost connection is dropped."""
 
-    def __init__(self, host: str, port: int, backoff=(0.1, 2.0), reconnect: bool = True):
+    def __init__(self, host: str, port: int, backoff=(0.1, 2.0), reconnect: bool = True, log=None):
         self.host, self.port = host, port
+        self.log = log or (lambda text: None)
         self.backoff, self.reconnect = backoff, reconnect
         self.sock = None
         self.pending = b""
@@ -403,11 +404,14 @@ class _Tcp:
                                                      timeout=min(left or 5.0, 5.0))
                 self.sock.setblocking(False)
                 self.delay = self.backoff[0]
+                self.log(f"connected to {self.describe()}")
                 if self.connections:
                     self.reconnects += 1
                 self.connections += 1
                 return True
             except OSError as e:
+                if self.last_error is None or type(e) is not type(self.last_error):
+                    self.log(f"{self.describe()}: {e.strerror or e}; trying again")
                 self.last_error = e
                 self.next_try = time.monotonic() + self.delay
                 self.delay = min(self.delay * 2, self.backoff[1])
@@ -433,6 +437,8 @@ class _Tcp:
         except OSError as e:
             data, self.last_error = b"", e
         if not data:  # the robot went away: connect again, from a clean line
+            self.log(f"{self.describe()}: connection closed")
+            self.last_error = None
             self.sock.close()
             self.sock, self.pending = None, b""
             self.next_try = time.monotonic() + self.delay
@@ -452,11 +458,12 @@ def udp(port: int, host: str = "0.0.0.0", **options) -> Receiver:
     return Receiver(_Udp(port, host), **options)
 
 
-def tcp(host: str, port: int, backoff=(0.1, 2.0), reconnect: bool = True, **options) -> Receiver:
+def tcp(host: str, port: int, backoff=(0.1, 2.0), reconnect: bool = True, log=None, **options) -> Receiver:
     """Connects to the robot's `tcpserversink port=PORT`, again whenever it
     is not there; with `reconnect=False`, iterating ends (EOFError from
-    read) when the first connection closes."""
-    return Receiver(_Tcp(host, port, backoff, reconnect), **options)
+    read) when the first connection closes. `log(text)`, when given, hears
+    of each connection, its end, and a new reason for a refusal."""
+    return Receiver(_Tcp(host, port, backoff, reconnect, log), **options)
 
 
 def open_url(url: str, **options) -> Receiver:

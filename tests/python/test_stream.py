@@ -136,7 +136,8 @@ def test_read_times_out_with_none():
 
 def test_tcp_waits_for_a_robot_that_starts_late_and_follows_its_restart():
     port = free_port()
-    rx = stream.tcp("127.0.0.1", port, backoff=(0.05, 0.2))
+    log = []
+    rx = stream.tcp("127.0.0.1", port, backoff=(0.05, 0.2), log=log.append)
     got = []
     reader = threading.Thread(target=lambda: got.extend(rx.frames(timeout=3.0)))
     reader.start()
@@ -152,6 +153,10 @@ def test_tcp_waits_for_a_robot_that_starts_late_and_follows_its_restart():
     assert [m.id for m in got[12].markers] == [2, 3]
     s = rx.stats
     assert (s.frames, s.lost, s.restarts, s.reconnects, s.bad_lines) == (15, 0, 1, 1, 0)
+    where = f"tcp 127.0.0.1:{port}"
+    # Down (one line, however many tries), up, gone: twice, and down at the end.
+    assert log == [f"{where}: Connection refused; trying again", f"connected to {where}",
+                   f"{where}: connection closed"] * 2 + [f"{where}: Connection refused; trying again"]
 
 
 def test_tcp_without_reconnect_ends_with_the_connection():
@@ -204,4 +209,4 @@ def test_frappe_receive_says_when_no_robot_answers():
     p = frappe_receive("--tcp", f"127.0.0.1:{free_port()}", "--timeout", "0.5")
     out, err = p.communicate(timeout=20)
     assert p.returncode == 1 and out == ""
-    assert "no frame in 0.5 s" in err and "Traceback" not in err
+    assert "Connection refused; trying again" in err and "no frame in 0.5 s" in err and "Traceback" not in err
