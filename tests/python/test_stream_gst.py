@@ -10,6 +10,7 @@ import shutil
 import signal
 import socket
 import subprocess
+import sys
 import threading
 import time
 
@@ -22,12 +23,17 @@ SAMPLE = os.path.join(ROOT, "examples", "data", "markers.webm")
 CALIBRATION = os.path.join(ROOT, "examples", "data", "camera-700.yaml")
 
 
-def robot(sink):
-    """gst-launch-1.0: the sample, detected with poses, frappejson into `sink`."""
+def gst_launch():
+    """gst-launch-1.0, or skip without it or the element's build."""
     launch = shutil.which("gst-launch-1.0")
     if not launch or not os.environ.get("GST_PLUGIN_PATH"):
         pytest.skip("gst-launch-1.0 or the element's build (GST_PLUGIN_PATH) missing")
-    return subprocess.Popen([launch, "-q", "filesrc", f"location={SAMPLE}", "!", "decodebin", "!", "videoconvert",
+    return launch
+
+
+def robot(sink):
+    """gst-launch-1.0: the sample, detected with poses, frappejson into `sink`."""
+    return subprocess.Popen([gst_launch(), "-q", "filesrc", f"location={SAMPLE}", "!", "decodebin", "!", "videoconvert",
                              "!", "frappedetect", "marker-size=0.05", f"calibration-file={CALIBRATION}", "!",
                              "frappejson", "!", *sink.split()], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                             text=True)
@@ -98,3 +104,14 @@ def test_tcp_robot_starts_late_and_restarts_mid_stream():
         assert after[0].number < got[before - 1].number
         numbers = [f.number for f in after]
         assert numbers == list(range(numbers[0], numbers[0] + len(numbers)))
+
+
+def test_frappe_watch_says_why_it_cannot_start():
+    pytest.importorskip("gi")
+    gst_launch()
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(p for p in sys.path if p))
+    p = subprocess.run([sys.executable, "-m", "frappe.watch", "--port", "0", "--file", "/nonexistent.webm"],
+                       capture_output=True, text=True, env=env, timeout=60)
+    assert p.returncode == 1
+    assert 'frappe-watch: filesrc0: Resource not found.' in p.stderr and 'No such file "/nonexistent.webm"' in p.stderr
+    assert "Traceback" not in p.stderr
