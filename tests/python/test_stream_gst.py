@@ -93,8 +93,8 @@ def test_tcp_robot_starts_late_and_restarts_mid_stream():
     reader.join(30)
     rx.close()
     after = got[before:]
-    # Connected within the back-off of the second run's start: most of its 4 s.
-    assert len(after) >= 90, f"{len(after)} frames from the second run"
+    # Connected within the back-off (0.5 s at most) of the second run's start: most of its 4 s.
+    assert len(after) >= 60, f"{len(after)} frames from the second run"
     for f in got:
         check_sample_frame(f)
     s = rx.stats
