@@ -18,7 +18,7 @@
 #   for f in receive_ts(port=5000): print(f.line["frame"], [m["id"] for m in f.markers])'
 #   gst-launch-1.0 udpsrc port=5000 caps=video/mpegts,systemstream=true ! tsdemux ! \
 #       h264parse ! avdec_h264 ! videoconvert ! autovideosink     (or: vlc udp://@:5000)
-#   examples/receive-markers.py --udp 5001   (the markers alone; --tcp ROBOT:5001)
+#   examples/receive-markers.py udp://:5001   (the markers alone; tcp://ROBOT:5001)
 #
 # CALIBRATION must be your camera's (ROS camera_calibration's YAML or an
 # OpenCV one) at any size of the same aspect ratio: the default is the

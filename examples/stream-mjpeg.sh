@@ -1,17 +1,27 @@
 #!/bin/sh
 # SPDX-License-Identifier: MIT
-# Headless annotated streaming as MJPEG over TCP (multipart, so a browser
-# or VLC can show http-less "tcp://HOST:8080"; e.g. on the viewer:
-#   gst-launch-1.0 tcpclientsrc host=PI port=8080 ! multipartdemux ! jpegdec ! autovideosink
-# ).
-# SOURCE defaults to the sample video in a loop-free single pass; on a Pi use
-#   SOURCE='libcamerasrc ! video/x-raw,format=I420,width=640,height=480,framerate=30/1'
-# and replace jpegenc by v4l2jpegenc (the VideoCore's hardware encoder).
+# Headless annotated video for a browser: frappe-watch serves a page at
+# http://THIS_HOST:${PORT:-8080}/ with the annotated video (MJPEG over HTTP, a
+# multipart/x-mixed-replace answer any browser shows, also at /video.mjpeg for
+# VLC or an <img>) and the markers listed beside it (/markers.json).
+# SOURCE defaults to the sample video, looping; on a Pi use
+#   SOURCE='libcamerasrc ! video/x-raw,width=640,height=480,framerate=30/1' FORMAT=NV12 \
+#   ENCODER=v4l2jpegenc examples/stream-mjpeg.sh
+# (v4l2jpegenc: the VideoCore's hardware encoder). DETECT adds frappedetect's
+# properties, e.g. DETECT='marker-size=0.05 calibration-file=camera.yaml'.
+# From a build tree (GST_PLUGIN_PATH, the Python package in python/) or installed
+# (frappe-watch on PATH, from python3-frappe).
 set -eu
 here="$(cd "$(dirname "$0")" && pwd)"
 export GST_PLUGIN_PATH="${GST_PLUGIN_PATH:-$here/../build/gst}"
-SOURCE="${SOURCE:-filesrc location=$here/data/markers.webm ! decodebin ! videoconvert ! video/x-raw,format=I420 ! identity sync=true}"
-ENCODER="${ENCODER:-jpegenc quality=80}"
-# SOURCE and ENCODER are pipeline fragments: eval keeps their quoting.
-eval exec gst-launch-1.0 "$SOURCE ! frappedetect annotate=true ! $ENCODER ! \
-	multipartmux boundary=frame ! tcpserversink host=0.0.0.0 port=${PORT:-8080}"
+set -- --port "${PORT:-8080}" --format "${FORMAT:-I420}" --encoder "${ENCODER:-jpegenc quality=80}" \
+	--detect "${DETECT:-}"
+if [ -n "${SOURCE:-}" ]; then
+	set -- "$@" --source "$SOURCE"
+else
+	set -- "$@" --file "$here/data/markers.webm" --loop
+fi
+if [ -f "$here/../python/frappe/watch.py" ]; then
+	PYTHONPATH="$here/../python${PYTHONPATH:+:$PYTHONPATH}" exec /usr/bin/python3 -m frappe.watch "$@"
+fi
+exec frappe-watch "$@"

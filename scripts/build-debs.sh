@@ -7,6 +7,12 @@
 #   gstreamer1.0-frappe  the plugin (frappedetect, frappejson), libgstfrappemeta-1.0.so.S and
 #                        its typelib GstFrappe-1.0 (Python apps)
 #   frappe-tools         frappe-detect, frappe-render, vc4-dis, vc4-run, vc4-probe
+#   python3-frappe       the Python package frappe for /usr/bin/python3 (the detector's
+#                        extension and frappe.stream), frappe-receive, frappe-watch
+#
+# Each carries README.md and its man pages; libfrappe-dev the docs (docs/*.md),
+# gstreamer1.0-frappe the examples, python3-frappe docs/python.md and docs/host.md,
+# all in /usr/share/doc/PACKAGE.
 #
 # Usage: scripts/build-debs.sh [--arch amd64|arm64] [--builddir DIR [--no-rebuild]] [OUTDIR]
 #
@@ -129,7 +135,21 @@ take gstreamer1.0-frappe "$lib/gstreamer-1.0/libgstfrappe.so" "$lib/libgstfrappe
 	"$lib/girepository-1.0/GstFrappe-1.0.typelib"
 take libfrappe-dev usr/include/frappe usr/include/gstreamer-1.0 "$lib/libfrappe-core.so" \
 	"$lib/libgstfrappemeta-1.0.so" "$lib/pkgconfig" "$lib/cmake" usr/share/gir-1.0
-take frappe-tools "usr/bin/*"
+# The Python package, wherever meson's Python put it (lib/python3/dist-packages
+# for /usr, lib/python3.X/... for another prefix), goes where Debian's python3 looks.
+for pydir in "$root"/lib/python3*/*-packages/frappe; do
+	[ -d "$pydir" ] || continue
+	mkdir -p "$work/pkg/python3-frappe/usr/lib/python3/dist-packages"
+	mv "$pydir" "$work/pkg/python3-frappe/usr/lib/python3/dist-packages/frappe"
+	rmdir -p "$(dirname "$pydir")" 2>/dev/null || true
+done
+take python3-frappe usr/bin/frappe-receive usr/bin/frappe-watch "usr/share/man/man1/frappe-receive.1*" \
+	"usr/share/man/man1/frappe-watch.1*"
+# Its commands run Debian's python3, whatever Python meson ran with.
+for f in "$work"/pkg/python3-frappe/usr/bin/*; do
+	[ -f "$f" ] && sed -i '1s|^#!.*|#!/usr/bin/python3|' "$f"
+done
+take frappe-tools "usr/bin/*" "usr/share/man/man1/*"
 # A file no package took is a new install() that needs a home here.
 left=$(find "$root" ! -type d)
 [ -z "$left" ] || die "installed but in no package: $left"
@@ -158,7 +178,8 @@ printf 'Source: frappe\n\nPackage: frappe\nArchitecture: any\n' >"$work/debian/c
 # shlibs_depends PKG: the Depends of the ELF files in PKG's tree.
 shlibs_depends() {
 	local dir=$work/pkg/$1 elves
-	mapfile -t elves < <(find "$dir" -type f \( -name '*.so*' -o -path '*/bin/*' \) | sort)
+	mapfile -t elves < <(find "$dir" -type f \( -name '*.so*' -o -path '*/bin/*' \) \
+		-exec sh -c 'head -c4 "$1" | grep -q ELF' _ {} \; -print | sort)
 	[ ${#elves[@]} -gt 0 ] || return 0
 	if command -v dpkg-shlibdeps >/dev/null; then
 		local out
@@ -197,6 +218,8 @@ control() {
 	shift 4
 	local depends
 	depends=$(shlibs_depends "$pkg") || die "cannot work out the Depends of $pkg"
+	# What no ELF file says (python3-frappe's interpreter): extra_depends=... control ...
+	[ -z "${extra_depends:-}" ] || depends="${depends:+$depends, }$extra_depends"
 	mkdir -p "$dir/DEBIAN" "$dir/usr/share/doc/$pkg"
 	# DEP-5, with the license text from LICENSE (an empty line as " .")
 	{
@@ -237,6 +260,41 @@ control libfrappe-dev libdevel "" "Frappe fiducial marker detector - development
 	control gstreamer1.0-frappe video same "Frappe fiducial marker detector - GStreamer elements frappedetect, frappejson"
 [ ! -d "$work/pkg/frappe-tools" ] ||
 	control frappe-tools video foreign "Frappe fiducial marker detector - command-line tools"
+if [ -d "$work/pkg/python3-frappe" ]; then
+	# The extension is built for one Python: its ABI tag (cpython-311-...) pins python3.
+	py_depends=python3
+	ext=$(find "$work/pkg/python3-frappe" -name '_frappe.cpython-*.so' | head -n1)
+	if [ -n "$ext" ]; then
+		abi=$(basename "$ext" | sed -n 's/^_frappe\.cpython-\([0-9]\)\([0-9]*\)-.*/\1.\2/p')
+		py_depends="python3 (>= $abi), python3 (<< ${abi%%.*}.$((${abi#*.} + 1))), python3-numpy"
+	fi
+	extra_depends=$py_depends control python3-frappe python "" \
+		"Frappe fiducial marker detector - Python module and host tools" \
+		"Recommends: python3-gi, gir1.2-gstreamer-1.0, gstreamer1.0-frappe (= $version)"
+fi
+
+# ---- docs and examples -------------------------------------------------------
+
+# docs PKG FILE...: copies files of the source tree into /usr/share/doc/PKG.
+docs() {
+	local pkg=$1 f
+	shift
+	[ -d "$work/pkg/$pkg" ] || return 0
+	for f in "$@"; do
+		mkdir -p "$work/pkg/$pkg/usr/share/doc/$pkg/$(dirname "$f")"
+		cp -R "$src/$f" "$work/pkg/$pkg/usr/share/doc/$pkg/$f"
+	done
+}
+for dir in "$work"/pkg/*; do docs "$(basename "$dir")" README.md; done
+mapfile -t all_docs < <(cd "$src" && ls docs/*.md docs/*.png)
+docs libfrappe-dev "${all_docs[@]}"
+docs gstreamer1.0-frappe gst/README.md docs/overlay.md docs/overlay.png docs/settings.md examples
+docs frappe-tools docs/settings.md docs/quality.md
+docs python3-frappe docs/python.md docs/host.md examples/receive-markers.py
+# Installed-Size counted before the docs: count again.
+for dir in "$work"/pkg/*; do
+	sed -i "s/^Installed-Size: .*/Installed-Size: $(du -sk --exclude=DEBIAN "$dir" | cut -f1)/" "$dir/DEBIAN/control"
+done
 
 # ---- the packages --------------------------------------------------------------
 

@@ -3,7 +3,8 @@
 # fresh virtual environment (with the system's meson-python, pybind11 and
 # numpy, --no-build-isolation: no network needed), then, from outside the
 # source tree, imports frappe, detects a rendered marker and estimates its
-# pose. Prints the time taken; about 4 minutes of compiling on two cores.
+# pose; frappe-receive, a console script, runs. Prints the time taken; about
+# 4 minutes of compiling on two cores.
 #   scripts/check-pip-install.sh [PYTHON]     (default /usr/bin/python3)
 set -euo pipefail
 
@@ -16,14 +17,19 @@ start=$(date +%s)
 "$python" -m venv --system-site-packages "$work/venv"
 "$work/venv/bin/pip" install --no-build-isolation --no-index --quiet "$src"
 
-# Nothing but the package went into the environment.
+# Nothing but the package and its two commands went into the environment.
 "$work/venv/bin/pip" show --files frappe-markers | sed -n '/^Files:/,$p' | tail -n +2 | sed 's/^ *//' |
-	grep -v -e '^frappe/' -e '^frappe_markers-.*\.dist-info/' && {
+	grep -v -e '^frappe/' -e '^frappe_markers-.*\.dist-info/' -e '^\.\./\.\./\.\./bin/frappe-receive$' \
+		-e '^\.\./\.\./\.\./bin/frappe-watch$' && {
 	echo "check-pip-install: files outside the package were installed" >&2
 	exit 1
 }
 
 cd "$work"
+"$work/venv/bin/frappe-receive" --help | grep -q -- '--udp PORT' || {
+	echo "check-pip-install: frappe-receive --help does not list --udp" >&2
+	exit 1
+}
 FRAPPE_SRC=$src "$work/venv/bin/python" - <<'PY'
 import numpy as np
 import frappe

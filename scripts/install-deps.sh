@@ -32,6 +32,9 @@ packages=(
 	# the typelib GstFrappe-1.0 of gstfrappemeta and its Python test
 	gobject-introspection libgirepository1.0-dev gir1.2-gstreamer-1.0 gir1.2-gst-plugins-base-1.0
 	python3-gi python3-gst-1.0
+	# the examples' test (stream-h264-rtp.sh: x264enc, avdec_h264), the page in
+	# a real browser (frappe-watch, tests/host), the man pages rendered (groff)
+	gstreamer1.0-plugins-ugly gstreamer1.0-libav chromium groff-base
 	# the Raspberry Pis' CPUs, emulated: the core and vc4 suites cross-built
 	# for ARMv6 (scripts/arm/armv6-armel.ini) and aarch64
 	# (scripts/arm/armv8-arm64.ini), and the ARMv6 kernels' test (tests/armv6)

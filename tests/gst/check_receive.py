@@ -32,10 +32,9 @@ def main():
     marker_port = probe.getsockname()[1]
     probe.close()
 
-    recv = subprocess.Popen([sys.executable, receiver, "--udp", str(marker_port), "--bind", "127.0.0.1",
-                             "--count", "120", "--timeout", "60"],
+    recv = subprocess.Popen([sys.executable, receiver, f"udp://127.0.0.1:{marker_port}", "120"],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    recv.stderr.readline()  # "listening on ...": bound before anything is sent
+    recv.stderr.readline()  # "receiving on ...": bound before anything is sent
     env = dict(os.environ, HOST="127.0.0.1", VIDEO_PORT=str(video_sock.getsockname()[1]),
                MARKER_PORT=str(marker_port), CALIBRATION=calibration, QUEUE="queue",
                SOURCE=f"filesrc location={video} ! decodebin ! videoconvert",
@@ -51,7 +50,7 @@ def main():
         return 1
 
     frames = out.splitlines()
-    if len(frames) != 120:
+    if len(frames) != 120 or "lost=0," not in err:
         print(f"expected 120 frames, got {len(frames)}:\n{err}")
         return 1
     worst = 0.0

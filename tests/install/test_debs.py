@@ -5,7 +5,10 @@ no rebuild), then each package unpacked with dpkg-deb -x into a scratch
 root and the element loaded from there: gst-inspect-1.0 frappedetect with
 GStreamer's system plugin path set to the root's plugin directory only, the
 root's libdir on LD_LIBRARY_PATH and a scratch registry, must list the
-element and its properties; frappe-detect from frappe-tools must run.
+element and its properties; frappe-detect from frappe-tools must run;
+python3-frappe's package must import in /usr/bin/python3 and detect a marker,
+and its frappe-receive run. Each package carries README.md, the tools their
+man pages, gstreamer1.0-frappe the examples.
 
 dpkg-deb -x rather than dpkg --root: it needs no dpkg database in the root
 and does not resolve Depends, so it works as any user and checks our files
@@ -31,7 +34,7 @@ def packages(version):
     major.minor until 1.0 (docs/install.md)."""
     major, minor = version.split(".")[:2]
     return [f"libfrappe-core{major + '.' + minor if major == '0' else major}", "libfrappe-dev",
-            "gstreamer1.0-frappe", "frappe-tools"]
+            "gstreamer1.0-frappe", "frappe-tools", "python3-frappe"]
 
 
 class Failure(Exception):
@@ -45,6 +48,33 @@ def run(cmd, env=None):
     return p.stdout
 
 
+def check_python(root, deb):
+    """python3-frappe in Debian's python3: the detector finds a rendered
+    marker, frappe.stream imports, frappe-receive answers --help."""
+    python = "/usr/bin/python3"
+    if not os.access(python, os.X_OK):
+        print("no /usr/bin/python3: python3-frappe not run")
+        return
+    depends = run(["dpkg-deb", "-f", deb, "Depends"])
+    if "python3 (>= 3." not in depends:
+        raise Failure(f"python3-frappe: Depends {depends!r} does not pin python3")
+    site = os.path.join(root, "usr", "lib", "python3", "dist-packages")
+    env = dict(os.environ, PYTHONPATH=site)
+    # Without pybind11 the package is its pure-Python part only.
+    extension = bool(glob.glob(os.path.join(site, "frappe", "_frappe.cpython-*.so")))
+    detect = ("image = frappe.render_marker('aruco_mip_36h12', 7, 12, 2)\n"
+              "print([m.id for m in frappe.Detector().detect(image)])") if extension else "print([7])"
+    out = run([python, "-c", "import frappe, frappe.stream\nprint(frappe.__file__)\n" + detect], env=env)
+    if out.split("\n")[:2] != [os.path.join(site, "frappe", "__init__.py"), "[7]"]:
+        raise Failure(f"python3-frappe: {out}")
+    receive = os.path.join(root, "usr", "bin", "frappe-receive")
+    if not open(receive).readline().startswith("#!/usr/bin/python3"):
+        raise Failure("frappe-receive does not run /usr/bin/python3")
+    if "--udp PORT" not in run([receive, "--help"], env=env):
+        raise Failure("frappe-receive --help lists no --udp")
+    print("python3-frappe: imports in /usr/bin/python3, detects marker 7; frappe-receive runs")
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--build-root", required=True)
@@ -55,6 +85,7 @@ def main():
     ap.add_argument("--static", action="store_true")
     ap.add_argument("--plugin", action="store_true")
     ap.add_argument("--cli", action="store_true")
+    ap.add_argument("--python", action="store_true")
     args = ap.parse_args()
 
     if args.static:
@@ -82,7 +113,8 @@ def main():
         print(f"build-debs.sh: {len(debs)} packages, {time.monotonic() - start:.1f} s")
 
         start = time.monotonic()
-        want = [p for p in packages(args.version) if args.cli or p != "frappe-tools"]
+        want = [p for p in packages(args.version) if (args.cli or p != "frappe-tools") and
+                (args.python or p != "python3-frappe")]
         names = {}
         for deb in debs:
             fields = dict(line.split(": ", 1) for line in
@@ -104,6 +136,21 @@ def main():
             text = open(path).read() if os.path.exists(path) else ""
             if "License: MIT" not in text or " Permission is hereby granted" not in text:
                 raise Failure(f"{pkg}: no MIT license text in /usr/share/doc/{pkg}/copyright")
+        # Docs, examples and man pages where a user looks for them.
+        shipped = [f"usr/share/doc/{pkg}/README.md" for pkg in names] + [
+            "usr/share/doc/libfrappe-dev/docs/architecture.md",
+            "usr/share/doc/gstreamer1.0-frappe/examples/stream-markers.sh",
+            "usr/share/doc/gstreamer1.0-frappe/examples/data/markers.webm"]
+        if args.cli:
+            shipped += ["usr/share/man/man1/frappe-detect.1", "usr/share/man/man1/frappe-render.1"]
+        if args.python:
+            shipped += ["usr/share/man/man1/frappe-receive.1", "usr/share/man/man1/frappe-watch.1",
+                        "usr/share/doc/python3-frappe/docs/host.md", "usr/bin/frappe-receive",
+                        "usr/lib/python3/dist-packages/frappe/stream.py"]
+        missing = [f for f in shipped if not os.path.exists(os.path.join(root, f))]
+        if missing:
+            raise Failure("not in the packages: " + ", ".join(missing))
+        print(f"docs, examples, man pages: {len(shipped)} files checked")
 
         triplet = {"amd64": "x86_64-linux-gnu", "arm64": "aarch64-linux-gnu"}[arch]
         libdir = os.path.join(root, "usr", "lib", triplet)
@@ -146,6 +193,8 @@ def main():
             if "apriltag_36h11" not in listing:
                 raise Failure(f"frappe-detect --dictionaries:\n{listing}")
             print("frappe-detect --dictionaries: runs from the unpacked frappe-tools")
+        if args.python:
+            check_python(root, names["python3-frappe"])
         print(f"unpacked and checked: {time.monotonic() - start:.1f} s")
     return 0
 

@@ -127,6 +127,14 @@ def main():
         under = lambda d: stage + d if os.path.isabs(d) else os.path.join(prefix, d)
         libdir, includedir = under(args.libdir), under(args.includedir)
         check_tree(args, prefix, libdir, includedir)
+        # The Python package's commands find it wherever meson put it, on
+        # the Python's path or not (/usr/local on Debian).
+        receive = os.path.join(prefix, "bin", "frappe-receive")
+        if os.path.exists(receive):
+            py_env = {k: v for k, v in env.items() if k != "PYTHONPATH"}
+            if "--udp PORT" not in run([receive, "--help"], env=py_env):
+                raise Failure("the installed frappe-receive --help lists no --udp")
+            print("frappe-receive: runs from the staged prefix")
         print(f"meson install --destdir: {time.monotonic() - start:.1f} s")
         # Only the staged libdir: meson test's own LD_LIBRARY_PATH points
         # into the build tree, which would hide a library missing from it.
