@@ -16,6 +16,9 @@ each decoded (annotated) frame. For every one of the 45 frames:
     the frame and the line are each other's, not a neighbour's;
   * the markers-only datagrams (MARKER_PORT, parts of at most 1400
     bytes) paired by `frame` give the same markers, poses included.
+Then the robot restarts (a second run of the script, frame numbers from
+0 again) while the same host program reads on: every frame of the second
+run is paired as well.
 Exit 77 without gi, the typelib, or the GStreamer elements it takes."""
 import importlib.util
 import json
@@ -27,6 +30,7 @@ import tempfile
 import threading
 
 FRAMES = 45
+RUNS = 2  # the robot's first run, then a restart
 
 
 def load_video_module(path):
@@ -103,7 +107,7 @@ def main():
             try:
                 frames = video.receive_ts(port=video_port, address="127.0.0.1",
                                           video_caps="video/x-raw,format=GRAY8", then="frappedetect ! ",
-                                          timeout=3)
+                                          timeout=6)  # longer than a restart takes
                 started.set()
                 for f in frames:
                     read = sorted(m.id for m in GstFrappe.buffer_get_markers(f.sample.get_buffer()))
@@ -122,43 +126,56 @@ def main():
                           "video/x-raw,format=I420 ! identity sync=true",
                    ENCODER="x264enc tune=zerolatency speed-preset=ultrafast key-int-max=15 bitrate=4000 ! "
                            "h264parse")
-        robot = subprocess.run(["sh", script], env=env, capture_output=True, text=True, timeout=120)
+        # The markers-only datagrams of the first run are read before the
+        # restart: frame numbers start again at 0 in the second.
+        datagrams_first = []
+        robots = []
+        for run in range(RUNS):
+            robots.append(subprocess.run(["sh", script], env=env, capture_output=True, text=True, timeout=120))
+            if run == 0:
+                markers_sock.settimeout(1.0)
+                try:
+                    while True:
+                        datagrams_first.append(markers_sock.recv(65536))
+                except socket.timeout:
+                    pass
         t.join(60)
-    if robot.returncode != 0:
-        print(robot.stdout + robot.stderr)
-        return 1
+    for robot in robots:
+        if robot.returncode != 0:
+            print(robot.stdout + robot.stderr)
+            return 1
     if errors:
         print(f"host: {errors}")
         return 1
 
     failures = []
-    seen = set()
+    runs = [[]]  # the frame numbers of each run, in the order they came
+    first_run = []
     for f, read in paired:
         if f.line is None:
             failures.append(f"PTS {f.key}: no markers paired")
             continue
         n = f.line["frame"]
+        if runs[-1] and n <= runs[-1][-1]:
+            runs.append([])  # the restart
+        runs[-1].append(n)
+        if len(runs) == 1:
+            first_run.append(f)
         in_line = sorted(m["id"] for m in f.markers)
-        if n in seen or in_line != shown(n, ids) or read != in_line:
-            failures.append(f"frame {n}: line {in_line}, decoded frame {read}, shown {shown(n, ids)}")
-        seen.add(n)
-    if seen != set(range(FRAMES)):
-        failures.append(f"frames missing: {sorted(set(range(FRAMES)) - seen)}")
+        if in_line != shown(n, ids) or read != in_line:
+            failures.append(f"run {len(runs)} frame {n}: line {in_line}, decoded frame {read}, shown {shown(n, ids)}")
+    if runs != [list(range(FRAMES))] * RUNS:
+        failures.append(f"frame numbers by run: {runs}")
+    seen = set(runs[0])
 
-    # The markers alone, by frame number, against the lines in the video.
-    markers_sock.setblocking(False)
+    # The markers alone (the first run's), by frame number, against the
+    # lines in the video.
     by_frame = video.Pairer(max_waiting=FRAMES)
-    datagrams, longest = 0, 0
-    try:
-        while True:
-            data = markers_sock.recv(65536)
-            datagrams += 1
-            longest = max(longest, len(data))
-            by_frame.add_line(json.loads(data))
-    except BlockingIOError:
-        pass
+    datagrams, longest = len(datagrams_first), max((len(d) for d in datagrams_first), default=0)
+    for data in datagrams_first:
+        by_frame.add_line(json.loads(data))
     alone = []
-    for f, _ in paired:
+    for f in first_run:
         if f.line is not None:
             alone += by_frame.add_frame(f.line, f.line["frame"])
     alone += by_frame.flush()
@@ -171,7 +188,7 @@ def main():
 
     for line in failures:
         print(line)
-    print(f"{len(paired)} decoded frames paired, {len(seen)} frame numbers, {datagrams} marker datagrams "
+    print(f"{len(paired)} decoded frames paired in {len(runs)} runs, {len(seen)} frame numbers in the first, {datagrams} marker datagrams "
           f"(at most {longest} bytes), {same} frames the same alone")
     return 1 if failures else 0
 
