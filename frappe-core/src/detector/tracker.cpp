@@ -223,6 +223,7 @@ Tracker::Tracker(int coverFrames) : coverFrames_(std::max(1, coverFrames))
 {
 	tracks_.reserve(64);
 	next_.reserve(64);
+	predictions_.reserve(64);
 	regions_.reserve(64);
 	matched_.reserve(64);
 }
@@ -273,6 +274,7 @@ bool Tracker::plan(const ImageView &image, bool regionsPossible)
 	height_ = h;
 	const bool changed = sceneChanged(image);
 	regions_.clear();
+	predictions_.clear();
 	/* Too small a frame for regions to pay: its margins are most of it. */
 	const bool small = w < 4 * RegionFrontEnd::kAlign || h < 4 * RegionFrontEnd::kAlign;
 	if (!regionsPossible || newSize || changed || wholeNext_ || small || coverFrames_ <= 1) {
@@ -296,11 +298,24 @@ bool Tracker::plan(const ImageView &image, bool regionsPossible)
 		 * that leaves its region is found by a whole search. */
 		const float speed = std::hypot(centre(p).x - centre(t.now).x, centre(p).y - centre(t.now).y);
 		const float m = std::max(kMinRoom, kRoom * side(t.now)) + 0.5f * speed;
-		regions_.push_back(RegionFrontEnd::alignedRect(
-			{ static_cast<int>(std::floor(x0 - m)), static_cast<int>(std::floor(y0 - m)),
-			  static_cast<int>(std::ceil(x1 + m)) + 1, static_cast<int>(std::ceil(y1 + m)) + 1 },
-			w, h));
+		predictions_.push_back(
+			{ t.id, p,
+			  RegionFrontEnd::alignedRect(
+				  { static_cast<int>(std::floor(x0 - m)), static_cast<int>(std::floor(y0 - m)),
+				    static_cast<int>(std::ceil(x1 + m)) + 1, static_cast<int>(std::ceil(y1 + m)) + 1 },
+				  w, h) });
 	}
+	return true;
+}
+
+bool Tracker::placeRegions(std::span<const std::uint8_t> read)
+{
+	std::lock_guard<std::mutex> guard(lock_);
+	const int w = width_, h = height_;
+	regions_.clear();
+	for (std::size_t i = 0; i < predictions_.size(); ++i)
+		if (i >= read.size() || !read[i])
+			regions_.push_back(predictions_[i].rect);
 	/* One band of rows of the k, all of the frame every k frames. Its
 	 * boundaries move by half a band every other round, so that a marker
 	 * on the seam of two bands in one round is inside one in the next; the

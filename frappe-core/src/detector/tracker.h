@@ -86,12 +86,26 @@ public:
 	/// k of Config::track_cover_frames.
 	explicit Tracker(int coverFrames);
 
-	/// Decides what this frame's front end reads: false when the whole
-	/// frame (the first frame, a new size, a scene change, a lost marker,
-	/// or regions that would cover most of it), true when only regions(),
-	/// then run on the CPU by runRegions(). `regionsPossible`: whether the
-	/// detector's front end is the CPU's; otherwise every frame is whole.
+	/// Where a track predicts its marker on this frame, and the
+	/// rectangle its front end reads when it is not read there directly.
+	struct Prediction {
+		int id = -1;
+		std::array<Point2f, 4> corners{};
+		PixelRect rect;
+	};
+
+	/// Decides whether this frame is read whole: false when the whole
+	/// frame (the first frame, a new size, a scene change, a lost
+	/// marker), true when in parts: then predictions() holds the tracks'
+	/// predictions, and placeRegions() the parts. `regionsPossible`:
+	/// whether the detector's front end is the CPU's; otherwise every
+	/// frame is whole.
 	bool plan(const ImageView &image, bool regionsPossible);
+	std::span<const Prediction> predictions() const { return predictions_; }
+	/// The rectangles of the predictions not `read` at their prediction
+	/// (one flag each; CandidateReader::readTracked()), and this frame's
+	/// band. False when they would cover most of the frame: read it whole.
+	bool placeRegions(std::span<const std::uint8_t> read);
 	/// The rectangles plan() chose (aligned, merged).
 	std::span<const PixelRect> regions() const { return regions_; }
 	/// The CPU front end over regions() into `out`.
@@ -129,6 +143,7 @@ private:
 	std::mutex lock_;
 	std::vector<Track> tracks_, next_;
 	std::vector<PixelRect> regions_;
+	std::vector<Prediction> predictions_; /* plan()'s, for the front end's thread only */
 	RegionFrontEnd regionFrontEnd_;
 	/* The scene-change test's samples: a fixed grid, whatever the size. */
 	static constexpr int kSamplesX = 32, kSamplesY = 24;
