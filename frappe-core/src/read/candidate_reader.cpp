@@ -411,6 +411,12 @@ bool detail::CandidateReader::readTracked(const ImageView &image, const EdgeMap 
 {
 	if (dict->layout)
 		return false;
+	/* A prediction reaching out of the frame: the marker may be cut; its
+	 * region's trace decides. */
+	for (const Point2f &p : predicted)
+		if (!(p.x >= 1.0f && p.y >= 1.0f && p.x <= static_cast<float>(image.width - 2) &&
+		      p.y <= static_cast<float>(image.height - 2)))
+			return false;
 	trackQuads.assign(1, detail::Quad{});
 	detail::Quad &q = trackQuads[0];
 	q.corners = predicted;
