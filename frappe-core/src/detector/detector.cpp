@@ -257,7 +257,26 @@ void DetectorStages::frontEnd(Detector &detector, const ImageView &image, int sl
 	timer.lap(Stage::FrontEnd);
 	/* Track: the CPU front end over the regions the tracks predict and a
 	 * band of the rest, or the whole frame. */
-	const bool regions = d.tracker && d.tracker->plan(image, std::string_view(d.frontEnd->name()) == "cpu");
+	bool regions = d.tracker && d.tracker->plan(image, std::string_view(d.frontEnd->name()) == "cpu");
+	s.known.clear();
+	if (regions) {
+		/* Track: each marker first read where its track predicts it,
+		 * its corners refined on this frame; only the others' regions
+		 * go through the front end and the trace. */
+		const auto predictions = d.tracker->predictions();
+		d.readAtPrediction.assign(predictions.size(), 0);
+		for (std::size_t i = 0; i < predictions.size(); ++i) {
+			Marker m;
+			if (!d.trackReader.readTracked(image, s.edges, predictions[i].corners, predictions[i].id, m))
+				continue;
+			m.tracked = true;
+			s.known.push_back(m);
+			d.readAtPrediction[i] = 1;
+		}
+		regions = d.tracker->placeRegions(d.readAtPrediction);
+		if (!regions)
+			s.known.clear();
+	}
 	s.result.whole_frame = !regions;
 	s.result.bytes_read = static_cast<std::size_t>(image.width) * image.height;
 	if (regions) {

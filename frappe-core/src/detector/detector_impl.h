@@ -60,6 +60,9 @@ struct FRAPPE_HIDDEN Detector::Impl {
 		ImageView image; /* the frame, valid until its back end returns */
 		EdgeMap edges;
 		std::vector<detail::Quad> quads;
+		/* Mode::Track: the markers read at their tracks' predictions
+		 * before the front end (CandidateReader::readTracked()). */
+		std::vector<Marker> known;
 		Result result;
 	};
 	Slot slots[detail::DetectorStages::kSlots];
@@ -81,7 +84,16 @@ struct FRAPPE_HIDDEN Detector::Impl {
 
 	void checkImage(const ImageView &image) const;
 	void trace(Slot &slot);
-	void finish(const ImageView &image, Slot &slot) { reader.read(image, slot.edges, slot.quads, slot.result); }
+	/* Mode::Track's reads at the predictions, in the front end's stage:
+	 * state of their own, as the finish of another frame may run at
+	 * once (Pipeline's Overlap::Stages); per prediction whether it read. */
+	detail::CandidateReader trackReader{ config, dict, codes, policy, logPolicy, clipPolicy, params, warper };
+	std::vector<std::uint8_t> readAtPrediction;
+
+	void finish(const ImageView &image, Slot &slot)
+	{
+		reader.read(image, slot.edges, slot.quads, slot.result, slot.known);
+	}
 	Slot &slotAt(int slot) { return const_cast<Slot &>(static_cast<const Impl *>(this)->slotAt(slot)); }
 	const Slot &slotAt(int slot) const
 	{

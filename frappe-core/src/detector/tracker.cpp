@@ -128,6 +128,7 @@ bool insideFrame(const std::array<Point2f, 4> &c, int width, int height, float m
 RegionFrontEnd::RegionFrontEnd(const BandKernels &kernels) : cpu_(makeCpuFrontEnd(1, kernels))
 {
 	written_.reserve(64);
+	halfWritten_.reserve(72);
 }
 
 PixelRect RegionFrontEnd::alignedRect(PixelRect r, int width, int height)
@@ -139,60 +140,138 @@ PixelRect RegionFrontEnd::alignedRect(PixelRect r, int width, int height)
 	return r;
 }
 
-void RegionFrontEnd::run(const ImageView &image, std::span<const PixelRect> rects, const FrontEndParams &params,
-			 EdgeMap &out)
+/* Copies the half-resolution map `sub`, made from the frame's pixels from
+ * (sx, sy) on, into `out` over the half-resolution pixels of frame
+ * rectangle r. */
+void copyHalf(const TraceMap &sub, int sx, int sy, TraceMap &out, const PixelRect &r)
+{
+	if (sub.width == 0 || out.width == 0)
+		return;
+	const int x1 = std::min({ r.x1 / 2, out.width, sx / 2 + sub.width });
+	const int y1 = std::min({ r.y1 / 2, out.height, sy / 2 + sub.height });
+	copyRect(sub, sx / 2, sy / 2, out, r.x0 / 2, r.y0 / 2, x1, y1);
+}
+
+void RegionFrontEnd::run(const ImageView &image, std::span<const PixelRect> rects, std::span<const PixelRect> search,
+			 const FrontEndParams &params, EdgeMap &out)
 {
 	const int w = image.width, h = image.height;
 	const bool sameSize = out.width == w && out.height == h && out.scale == 1.0f;
+	const bool clearAll = dirtyAll_ || !sameSize || last_ != &out;
 	out.resize(w, h);
 	out.scale = 1.0f;
-	if (dirtyAll_ || !sameSize || last_ != &out) {
+	if (clearAll) {
 		std::fill(out.pixels.begin(), out.pixels.end(), 0);
+		/* A strip's maps at most the frame's: sized once, whatever
+		 * strips come. */
+		const std::size_t half = static_cast<std::size_t>(w / 2 + TraceMap::kTile) * (h / 2 + TraceMap::kTile);
+		for (TraceMap *m : { &subRegions_, &subShades_ }) {
+			m->pixels.reserve(half);
+			m->tiles.reserve(half / (TraceMap::kTile * TraceMap::kTile) + w + h);
+		}
 	} else {
 		/* Only what the last run wrote. */
 		for (const PixelRect &r : written_)
 			clearRect(out, r.x0, r.y0, r.x1, r.y1);
 	}
 	std::fill(out.tiles.begin(), out.tiles.end(), 0);
+	bool whole = false;
+	for (PixelRect r : search) {
+		r = alignedRect(r, w, h);
+		whole = whole || (r.x0 == 0 && r.y0 == 0 && r.x1 == w && r.y1 == h);
+	}
+	/* The region and shade maps, half resolution: the whole frame's, or
+	 * zero but where the rectangles and the search strips put theirs. */
+	const bool regions = makesRegionMap(w, h, params.region_contrast);
+	if (!whole) {
+		for (TraceMap *m : { &out.regions, &out.shades }) {
+			const bool made = regions && (m == &out.regions || params.makesShades());
+			const bool same = m->width == (made ? w / 2 : 0) && m->height == (made ? h / 2 : 0);
+			m->resize(made ? w / 2 : 0, made ? h / 2 : 0);
+			m->scale = 0.5f;
+			if (clearAll || !same || halfWhole_) {
+				std::fill(m->pixels.begin(), m->pixels.end(), 0);
+			} else {
+				for (const PixelRect &r : halfWritten_)
+					clearRect(*m, r.x0 / 2, r.y0 / 2, r.x1 / 2, r.y1 / 2);
+			}
+		}
+	}
 	dirtyAll_ = false;
 	last_ = &out;
+	halfWhole_ = whole;
 	written_.clear();
+	halfWritten_.clear();
 	bytesRead_ = 0;
-	/* The edge maps of the rectangles: their region maps are not made
-	 * (the whole frame's is, below). */
-	FrontEndParams edgesOnly = params;
-	edgesOnly.region_contrast = 0;
+	/* The rectangles' edges, with their region and shade maps unless the
+	 * whole frame's are made below. */
+	FrontEndParams rectParams = params;
+	if (whole)
+		rectParams.region_contrast = 0;
 	constexpr int T = TraceMap::kTile;
-	for (PixelRect r : rects) {
-		r = alignedRect(r, w, h);
-		if (r.empty())
-			continue;
-		/* The part read starts on a tile, so that the sub map's tiles
-		 * are the frame's. */
-		const PixelRect s{ std::max(0, alignDown(r.x0 - kMargin, T)), std::max(0, alignDown(r.y0 - kMargin, T)),
-				   std::min(w, r.x1 + kMargin), std::min(h, r.y1 + kMargin) };
-		const ImageView sub(image.row(s.y0) + s.x0, s.x1 - s.x0, s.y1 - s.y0, image.stride);
-		cpu_->run(sub, 1.0f, edgesOnly, sub_);
-		bytesRead_ += s.area();
+	/* Each part (aligned, not empty) with the pixels it reads: its
+	 * margin, from a tile's start, so that the sub map's tiles are the
+	 * frame's. */
+	auto eachPart = [&](std::span<const PixelRect> parts, auto &&use) {
+		for (PixelRect r : parts) {
+			r = alignedRect(r, w, h);
+			if (r.empty())
+				continue;
+			const PixelRect s{ std::max(0, alignDown(r.x0 - kMargin, T)),
+					   std::max(0, alignDown(r.y0 - kMargin, T)), std::min(w, r.x1 + kMargin),
+					   std::min(h, r.y1 + kMargin) };
+			bytesRead_ += s.area();
+			use(r, s, ImageView(image.row(s.y0) + s.x0, s.x1 - s.x0, s.y1 - s.y0, image.stride));
+		}
+	};
+	eachPart(rects, [&](const PixelRect &r, const PixelRect &s, const ImageView &sub) {
+		cpu_->run(sub, 1.0f, rectParams, sub_);
 		copyRect(sub_, s.x0, s.y0, out, r.x0, r.y0, r.x1, r.y1);
 		markRectTiles(&sub_, s.x0, s.y0, out, r.x0, r.y0, r.x1, r.y1);
+		if (!whole) {
+			copyHalf(sub_.regions, s.x0, s.y0, out.regions, r);
+			copyHalf(sub_.shades, s.x0, s.y0, out.shades, r);
+		}
 		written_.push_back(r);
+	});
+	if (whole) {
+		/* The whole frame's region map, one read of every pixel; the
+		 * shade map kept in the rectangles. */
+		regionMap(image, 1.0f, params, out.regions, out.shades, scratch_);
+		if (out.regions.width > 0)
+			bytesRead_ += static_cast<std::size_t>(w) * h;
+		keepOnlyRects(out.shades);
+		return;
 	}
-	/* The region and shade maps of the whole frame, exactly a whole run's:
-	 * at half resolution they cost a fraction of the edges, and they are
-	 * the search for new markers between the bands (a marker on a band's
-	 * seam, one that enters the frame) as well as the blur and light
-	 * paths of the rectangles. One read of every pixel. */
-	regionMap(image, 1.0f, params, out.regions, out.shades, scratch_);
-	if (out.regions.width > 0)
-		bytesRead_ += static_cast<std::size_t>(w) * h;
-	keepOnlyRects(out.shades);
+	halfWritten_ = written_;
+	if (!regions)
+		return;
+	/* The search strips: the region map only. */
+	eachPart(search, [&](const PixelRect &r, const PixelRect &s, const ImageView &sub) {
+		regionMap(sub, 1.0f, params, subRegions_, subShades_, scratch_);
+		copyHalf(subRegions_, s.x0, s.y0, out.regions, r);
+		halfWritten_.push_back(r);
+	});
+	markHalfTiles(out.regions, halfWritten_);
+	markHalfTiles(out.shades, written_);
+}
+
+/* The tiles of a half-resolution map that the rectangles put a pixel in
+ * (nothing is set outside them). */
+void RegionFrontEnd::markHalfTiles(TraceMap &m, std::span<const PixelRect> rects)
+{
+	if (m.width == 0)
+		return;
+	std::fill(m.tiles.begin(), m.tiles.end(), 0);
+	for (const PixelRect &r : rects)
+		markRectTiles(nullptr, 0, 0, m, r.x0 / 2, r.y0 / 2, std::min(m.width, r.x1 / 2),
+			      std::min(m.height, r.y1 / 2));
 }
 
 /* The shade map outside the rectangles is cleared: the lighting path for
- * the markers the rectangles hold (the tracked ones, the band's), while
- * the region map searches the rest of the frame. Traced whole, its
- * clutter cost as much as the region map's. */
+ * the markers the rectangles hold (the tracks' that did not read at their
+ * prediction, the band's). Traced whole, its clutter cost as much as the
+ * region map's. */
 void RegionFrontEnd::keepOnlyRects(TraceMap &m)
 {
 	if (m.width == 0)
@@ -214,16 +293,16 @@ void RegionFrontEnd::keepOnlyRects(TraceMap &m)
 		else
 			std::fill_n(p, m.width, 0);
 	}
-	std::fill(m.tiles.begin(), m.tiles.end(), 0);
-	for (const PixelRect &r : written_)
-		markRectTiles(nullptr, 0, 0, m, r.x0 / 2, r.y0 / 2, std::min(m.width, r.x1 / 2), std::min(m.height, r.y1 / 2));
+	markHalfTiles(m, written_);
 }
 
 Tracker::Tracker(int coverFrames) : coverFrames_(std::max(1, coverFrames))
 {
 	tracks_.reserve(64);
 	next_.reserve(64);
+	predictions_.reserve(64);
 	regions_.reserve(64);
+	strips_.reserve(4);
 	matched_.reserve(64);
 }
 
@@ -273,6 +352,19 @@ bool Tracker::plan(const ImageView &image, bool regionsPossible)
 	height_ = h;
 	const bool changed = sceneChanged(image);
 	regions_.clear();
+	predictions_.clear();
+	{
+		Point2f v{ 0.0f, 0.0f };
+		int n = 0;
+		for (const Track &t : tracks_)
+			if (t.moving && t.missed == 0) {
+				v.x += centre(t.now).x - centre(t.before).x;
+				v.y += centre(t.now).y - centre(t.before).y;
+				++n;
+			}
+		haveMotion_ = n > 0;
+		motion_ = n > 0 ? Point2f{ v.x / n, v.y / n } : Point2f{ 0.0f, 0.0f };
+	}
 	/* Too small a frame for regions to pay: its margins are most of it. */
 	const bool small = w < 4 * RegionFrontEnd::kAlign || h < 4 * RegionFrontEnd::kAlign;
 	if (!regionsPossible || newSize || changed || wholeNext_ || small || coverFrames_ <= 1) {
@@ -296,11 +388,24 @@ bool Tracker::plan(const ImageView &image, bool regionsPossible)
 		 * that leaves its region is found by a whole search. */
 		const float speed = std::hypot(centre(p).x - centre(t.now).x, centre(p).y - centre(t.now).y);
 		const float m = std::max(kMinRoom, kRoom * side(t.now)) + 0.5f * speed;
-		regions_.push_back(RegionFrontEnd::alignedRect(
-			{ static_cast<int>(std::floor(x0 - m)), static_cast<int>(std::floor(y0 - m)),
-			  static_cast<int>(std::ceil(x1 + m)) + 1, static_cast<int>(std::ceil(y1 + m)) + 1 },
-			w, h));
+		predictions_.push_back(
+			{ t.id, p,
+			  RegionFrontEnd::alignedRect(
+				  { static_cast<int>(std::floor(x0 - m)), static_cast<int>(std::floor(y0 - m)),
+				    static_cast<int>(std::ceil(x1 + m)) + 1, static_cast<int>(std::ceil(y1 + m)) + 1 },
+				  w, h) });
 	}
+	return true;
+}
+
+bool Tracker::placeRegions(std::span<const std::uint8_t> read)
+{
+	std::lock_guard<std::mutex> guard(lock_);
+	const int w = width_, h = height_;
+	regions_.clear();
+	for (std::size_t i = 0; i < predictions_.size(); ++i)
+		if (i >= read.size() || !read[i])
+			regions_.push_back(predictions_[i].rect);
 	/* One band of rows of the k, all of the frame every k frames. Its
 	 * boundaries move by half a band every other round, so that a marker
 	 * on the seam of two bands in one round is inside one in the next; the
@@ -316,9 +421,11 @@ bool Tracker::plan(const ImageView &image, bool regionsPossible)
 			return h;
 		return std::clamp(static_cast<int>(static_cast<long long>(h) * i / k) + shift, 0, h);
 	};
-	regions_.push_back(RegionFrontEnd::alignedRect(
-		{ 0, boundary(band) - RegionFrontEnd::kAlign, w, boundary(band + 1) + RegionFrontEnd::kAlign }, w, h));
+	const PixelRect bandRect = RegionFrontEnd::alignedRect(
+		{ 0, boundary(band) - RegionFrontEnd::kAlign, w, boundary(band + 1) + RegionFrontEnd::kAlign }, w, h);
+	regions_.push_back(bandRect);
 	mergeRects(regions_);
+	placeStrips();
 	std::size_t area = 0;
 	for (const PixelRect &r : regions_)
 		area += r.area();
@@ -326,14 +433,43 @@ bool Tracker::plan(const ImageView &image, bool regionsPossible)
 	 * margins read twice, nothing copied). */
 	if (area * 10 > static_cast<std::size_t>(w) * h * 7) {
 		regions_.clear();
+		strips_.clear();
 		return false;
 	}
 	return true;
 }
 
+/* Where a marker can enter the frame on this one: the region map over
+ * strips along the frame's edges, on the sides the tracks' mean motion
+ * brings new content in from, as wide as kStrip of the frame's larger side
+ * plus twice that motion; none on a still scene. Markers that appear
+ * elsewhere (nearer, sharper, uncovered) are the band's. With no moving
+ * track (none yet, or a frame in flight in a Pipeline), the whole
+ * frame's region map. */
+void Tracker::placeStrips()
+{
+	const int w = width_, h = height_;
+	strips_.clear();
+	if (!haveMotion_) {
+		strips_.push_back({ 0, 0, w, h });
+		return;
+	}
+	const float b = kStrip * static_cast<float>(std::max(w, h));
+	const int bx = static_cast<int>(b + 2.0f * std::abs(motion_.x));
+	const int by = static_cast<int>(b + 2.0f * std::abs(motion_.y));
+	if (motion_.x > kStill)
+		strips_.push_back({ 0, 0, bx, h });
+	if (motion_.x < -kStill)
+		strips_.push_back({ w - bx, 0, w, h });
+	if (motion_.y > kStill)
+		strips_.push_back({ 0, 0, w, by });
+	if (motion_.y < -kStill)
+		strips_.push_back({ 0, h - by, w, h });
+}
+
 void Tracker::runRegions(const ImageView &image, const FrontEndParams &params, EdgeMap &out)
 {
-	regionFrontEnd_.run(image, regions_, params, out);
+	regionFrontEnd_.run(image, regions_, strips_, params, out);
 }
 
 bool Tracker::update(std::vector<Marker> &markers, int width, int height, bool partial, bool mayRetry)

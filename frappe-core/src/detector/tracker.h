@@ -24,6 +24,7 @@ namespace frappe::detail {
 /// A rectangle of frame pixels, [x0, x1) x [y0, y1).
 struct PixelRect {
 	int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+	bool operator==(const PixelRect &) const = default;
 	bool empty() const { return x1 <= x0 || y1 <= y0; }
 	std::size_t area() const
 	{
@@ -35,10 +36,12 @@ struct PixelRect {
 /// frame: inside each rectangle (once aligned, alignedRect()) the edge map
 /// holds byte for byte what a run over the whole frame writes there (edges,
 /// corners), zero elsewhere, and its tile mask says which tiles hold an
-/// edge pixel. The region and shade maps (half resolution, a fraction of
-/// the cost) are the whole frame's, exactly. Each rectangle is read with a
-/// margin of kMargin pixels, which its filters need (smoothing, Sobel,
-/// non-maximum suppression, the structure tensor: 3 pixels).
+/// edge pixel. The region map (half resolution) is likewise exact inside
+/// the rectangles and the search strips, zero elsewhere, or the whole
+/// frame's; the shade map is exact inside the rectangles only. Each part
+/// is read with a margin of kMargin pixels, which its filters need
+/// (smoothing, Sobel, non-maximum suppression, the structure tensor: 3
+/// pixels; the region map's threshold tiles: 8).
 class RegionFrontEnd
 {
 public:
@@ -52,16 +55,20 @@ public:
 	/// `r` grown to kAlign and clipped to a width x height frame.
 	static PixelRect alignedRect(PixelRect r, int width, int height);
 
-	/// Fills `out` for `image`: the edge map of the rectangles (aligned,
-	/// alignedRect(); they may overlap) as a whole-frame run would, zero
-	/// elsewhere, and the whole frame's region and shade maps. Clears only
-	/// what its last run on `out` wrote (all of it after invalidate()).
-	/// Allocates nothing once it has run on a frame of this size.
-	void run(const ImageView &image, std::span<const PixelRect> rects, const FrontEndParams &params, EdgeMap &out);
+	/// Fills `out` for `image`: the edge, region and shade maps of the
+	/// rectangles (aligned, alignedRect(); they may overlap) as a
+	/// whole-frame run would, zero elsewhere, and the region map of the
+	/// `search` strips too, or of the whole frame when one of them is the
+	/// whole frame. Clears only what its last run on `out` wrote (all of it
+	/// after invalidate()). Allocates nothing once it has run on a frame of
+	/// this size.
+	void run(const ImageView &image, std::span<const PixelRect> rects, std::span<const PixelRect> search,
+		 const FrontEndParams &params, EdgeMap &out);
 	/// `out` was filled by some other front end: clear it whole next time.
 	void invalidate() { dirtyAll_ = true; }
-	/// Bytes of the frame the last run read: the rectangles with their
-	/// margins, and the whole frame once for the region map.
+	/// Bytes of the frame the last run read: the rectangles and the search
+	/// strips with their margins, or the whole frame once for the region
+	/// map.
 	std::size_t bytesRead() const { return bytesRead_; }
 
 private:
@@ -72,6 +79,10 @@ private:
 	RegionScratch scratch_;
 	std::vector<std::uint8_t> row_;
 	std::vector<PixelRect> written_; /* the rectangles of the last run, to clear */
+	std::vector<PixelRect> halfWritten_; /* where the last run wrote the region and shade maps */
+	bool halfWhole_ = false;             /* the last run made the whole frame's region map */
+	TraceMap subRegions_, subShades_;    /* a search strip's */
+	static void markHalfTiles(TraceMap &m, std::span<const PixelRect> rects);
 	bool dirtyAll_ = true;
 	const EdgeMap *last_ = nullptr; /* the map written_ is of (a Pipeline's slots take turns) */
 	std::size_t bytesRead_ = 0;
@@ -86,12 +97,28 @@ public:
 	/// k of Config::track_cover_frames.
 	explicit Tracker(int coverFrames);
 
-	/// Decides what this frame's front end reads: false when the whole
-	/// frame (the first frame, a new size, a scene change, a lost marker,
-	/// or regions that would cover most of it), true when only regions(),
-	/// then run on the CPU by runRegions(). `regionsPossible`: whether the
-	/// detector's front end is the CPU's; otherwise every frame is whole.
+	/// Where a track predicts its marker on this frame, and the
+	/// rectangle its front end reads when it is not read there directly.
+	struct Prediction {
+		int id = -1;
+		std::array<Point2f, 4> corners{};
+		PixelRect rect;
+	};
+
+	/// Decides whether this frame is read whole: false when the whole
+	/// frame (the first frame, a new size, a scene change, a lost
+	/// marker), true when in parts: then predictions() holds the tracks'
+	/// predictions, and placeRegions() the parts. `regionsPossible`:
+	/// whether the detector's front end is the CPU's; otherwise every
+	/// frame is whole.
 	bool plan(const ImageView &image, bool regionsPossible);
+	std::span<const Prediction> predictions() const { return predictions_; }
+	/// The rectangles of the predictions not `read` at their prediction
+	/// (one flag each; CandidateReader::readTracked()), this frame's band,
+	/// and the strips where the region map searches for markers entering
+	/// the frame. False when they would cover most of the frame: read it
+	/// whole.
+	bool placeRegions(std::span<const std::uint8_t> read);
 	/// The rectangles plan() chose (aligned, merged).
 	std::span<const PixelRect> regions() const { return regions_; }
 	/// The CPU front end over regions() into `out`.
@@ -129,6 +156,14 @@ private:
 	std::mutex lock_;
 	std::vector<Track> tracks_, next_;
 	std::vector<PixelRect> regions_;
+	std::vector<Prediction> predictions_; /* plan()'s, for the front end's thread only */
+	std::vector<PixelRect> strips_;       /* the region map's search strips (placeStrips()) */
+	/* The search strips: kStrip of the frame's larger side; a mean motion
+	 * under kStill pixels a frame along an axis brings nothing in. */
+	static constexpr float kStrip = 0.15f, kStill = 0.25f;
+	Point2f motion_{}; /* the moving tracks' mean motion, pixels a frame */
+	bool haveMotion_ = false;
+	void placeStrips();
 	RegionFrontEnd regionFrontEnd_;
 	/* The scene-change test's samples: a fixed grid, whatever the size. */
 	static constexpr int kSamplesX = 32, kSamplesY = 24;

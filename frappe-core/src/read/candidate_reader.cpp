@@ -166,8 +166,13 @@ bool detail::CandidateReader::skipCandidate(const detail::Quad &q, const std::ar
 {
 	const int bits = dict->bits;
 	const int traced = q.probeRead;
-	if (detail::surroundsMarker(tracedOutline, quadArea(tracedOutline), q.fromShade ? -1 : traced, bits, found,
-				    markerCentres))
+	const float area = quadArea(tracedOutline);
+	if (detail::surroundsMarker(tracedOutline, area, q.fromShade ? -1 : traced, bits, found, markerCentres))
+		return true;
+	/* A marker read before the trace (readTracked()): its own outline
+	 * too, which would only read as it again. */
+	if (knownCount > 0 &&
+	    detail::surroundsMarker(tracedOutline, area, -1, bits, std::span(found).first(knownCount), knownCentres))
 		return true;
 	/* The probe's read at the traced outline decides two things before
 	 * refinement. A frame with more white cells than twice what decode
@@ -350,11 +355,21 @@ bool detail::CandidateReader::readCandidate(const ImageView &image, Slot &slot, 
 	r.refined = r.inBatch ? batch.refined[k] != 0
 			      : q.probeRead < whiteFrame() &&
 					refineQuad(r.block.view, slot, q, std::max(search / ff, kSearch), r.f);
-	/* Read on grey levels; where that fails, once more on the log scale
-	 * (Tone), from the same refined corners: a marker under a shadow's
-	 * stripes or in a dim room; and where the first read's whites clipped,
-	 * on the exponential scale: an overexposed marker, whose blurred black
-	 * cells the midpoint below the ceiling reads white. */
+	const detail::MarkerRead read = readRefined(r, q, k, timer, slot.result);
+	if (!read.ok())
+		return false;
+	toMarker(q, r.f, r.block, read, m);
+	return true;
+}
+
+/* Read on grey levels; where that fails, once more on the log scale
+ * (Tone), from the same refined corners: a marker under a shadow's stripes
+ * or in a dim room; and where the first read's whites clipped, on the
+ * exponential scale: an overexposed marker, whose blurred black cells the
+ * midpoint below the ceiling reads white. */
+detail::MarkerRead detail::CandidateReader::readRefined(Reading &r, detail::Quad &q, std::size_t k, StageTimer &timer,
+							Result &result)
+{
 	const Reading refined = r;
 	const std::array<Point2f, 4> refinedCorners = q.corners;
 	auto readWith = [&](const detail::DecodePolicy &pol) {
@@ -381,10 +396,47 @@ bool detail::CandidateReader::readCandidate(const ImageView &image, Slot &slot, 
 		readAgain(logPolicy);
 	if (!read.ok() && clipped && !clipPolicy.tone.linear())
 		readAgain(clipPolicy);
-	slot.result.candidates += counted || r.counted;
-	if (!read.ok())
+	result.candidates += counted || r.counted;
+	return read;
+}
+
+/* Mode::Track: a marker read where its track predicts it, before any
+ * front end. Its corners are refined from the prediction at full
+ * resolution as finish() refines a traced outline (on the frame halved
+ * for large cells); every fallback read starts from the refined corners,
+ * never from the prediction itself. It must read as `id` with its corners
+ * within two searches of the predicted ones. */
+bool detail::CandidateReader::readTracked(const ImageView &image, const EdgeMap &edges,
+					  const std::array<Point2f, 4> &predicted, int id, Marker &m)
+{
+	if (dict->layout)
+		return false;
+	/* A prediction reaching out of the frame: the marker may be cut; its
+	 * region's trace decides. */
+	for (const Point2f &p : predicted)
+		if (!(p.x >= 1.0f && p.y >= 1.0f && p.x <= static_cast<float>(image.width - 2) &&
+		      p.y <= static_cast<float>(image.height - 2)))
+			return false;
+	trackQuads.assign(1, detail::Quad{});
+	detail::Quad &q = trackQuads[0];
+	q.corners = predicted;
+	trackResult.candidates = 0;
+	Slot slot{ edges, trackQuads, trackResult };
+	StageTimer timer(trackResult.times, Stage::Refine);
+	Reading r = placeCandidate(image, q, predicted);
+	r.inBatch = false;
+	if (!refineQuad(r.block.view, slot, q, kSearch, r.f))
+		return false;
+	r.refined = true;
+	r.outline = q.corners;
+	const detail::MarkerRead read = readRefined(r, q, 0, timer, trackResult);
+	if (!read.ok() || read.decoded.id != id)
 		return false;
 	toMarker(q, r.f, r.block, read, m);
+	const float bound = 2.0f * kSearch * static_cast<float>(r.f);
+	for (int i = 0; i < 4; ++i)
+		if (std::hypot(m.corners[i].x - predicted[i].x, m.corners[i].y - predicted[i].y) > bound)
+			return false;
 	return true;
 }
 
@@ -429,7 +481,15 @@ void detail::CandidateReader::finish(const ImageView &image, Slot &slot)
 	 * and again when replaced: at most two entries a candidate. Cells of
 	 * 32 px; a large candidate's box spans many, and then the grid visits
 	 * every entry instead. */
-	markerCentres.reset(2 * slot.quads.size(), 32.0f);
+	markerCentres.reset(2 * slot.quads.size() + slot.known.size(), 32.0f);
+	knownCentres.reset(slot.known.size(), 32.0f);
+	knownCount = slot.known.size();
+	for (const Marker &m : slot.known) {
+		const int at = static_cast<int>(res.markers.size());
+		res.markers.push_back(m);
+		markerCentres.add(at, 0, detail::quadCentre(m.corners));
+		knownCentres.add(at, 0, detail::quadCentre(m.corners));
+	}
 	if (warper && dict->layout)
 		refineAndWarpLayouts(image, slot, search);
 	else if (warper)

@@ -10,6 +10,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <vector>
 
 #include "frappe/candidate_warp.h"
@@ -64,11 +65,23 @@ public:
 	/* Reads the candidates `quads` (traced at edges.scale; moved to full
 	 * resolution and refined in place) of `image` into result.markers,
 	 * result.candidates and the read stages' times. */
-	void read(const ImageView &image, const EdgeMap &edges, std::vector<Quad> &quads, Result &result)
+	/* `known`: markers read before the trace (readTracked()), kept first;
+	 * the candidates that would only read as them again are skipped. */
+	void read(const ImageView &image, const EdgeMap &edges, std::vector<Quad> &quads, Result &result,
+		  std::span<const Marker> known = {})
 	{
-		Slot slot{ edges, quads, result };
+		Slot slot{ edges, quads, result, known };
 		finish(image, slot);
 	}
+
+	/* Mode::Track: reads the marker `id` where its track predicts it
+	 * (`predicted`, its corners in the marker's order), without a trace:
+	 * its corners refined on `image` from the prediction, then read as a
+	 * traced candidate is. False when refinement fails, it reads as
+	 * another id or none, or its corners moved more than two searches
+	 * from the prediction. Uses state of its own, not finish()'s. */
+	bool readTracked(const ImageView &image, const EdgeMap &edges, const std::array<Point2f, 4> &predicted, int id,
+			 Marker &m);
 
 private:
 	/* What finish() reads of the detector's frame. */
@@ -76,6 +89,7 @@ private:
 		const EdgeMap &edges;
 		std::vector<Quad> &quads;
 		Result &result;
+		std::span<const Marker> known = {};
 	};
 
 	const Config &config;
@@ -92,6 +106,11 @@ private:
 
 	PointGrid markerGrid;    /* dropNestedMarkers()'s */
 	PointGrid markerCentres; /* the frame's markers so far, for skipCandidate() */
+	PointGrid knownCentres;  /* the first knownCount of them, read before the trace */
+	std::size_t knownCount = 0;
+	/* readTracked()'s candidate and its counts (not the frame's). */
+	std::vector<Quad> trackQuads;
+	Result trackResult;
 	WarpedMarker warped;
 	/* Candidates with large cells are read on the frame halved into blocks
 	 * of f pixels (readBlock()): a patch around the candidate, or the whole
@@ -145,6 +164,7 @@ private:
 	/* Reading one candidate, in finish()'s order. */
 	bool readCandidate(const ImageView &image, Slot &slot, std::size_t k, float search, StageTimer &timer,
 			   Marker &m);
+	MarkerRead readRefined(Reading &r, Quad &q, std::size_t k, StageTimer &timer, Result &result);
 	bool skipCandidate(const Quad &q, const std::array<Point2f, 4> &tracedOutline,
 			   const std::vector<Marker> &found) const;
 	Reading placeCandidate(const ImageView &image, Quad &q, const std::array<Point2f, 4> &tracedOutline);

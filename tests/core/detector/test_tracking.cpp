@@ -109,29 +109,10 @@ TEST(RegionFrontEnd, BitIdenticalToTheWholeFrameInsideEachRegion)
 
 	RegionFrontEnd regions;
 	EdgeMap part;
-	/* Two runs on the same maps: the second must clear what the first
-	 * wrote outside its own regions. Regions at the frame's edges and
-	 * corners, unaligned, overlapping, and one inside another. */
-	const std::vector<std::vector<PixelRect>> runs = {
-		{ { 0, 0, 100, 70 }, { 300, 200, 420, 310 }, { 380, 250, 500, 330 }, { 600, 440, 645, 487 } },
-		{ { 13, 100, 645, 200 }, { 500, 300, 530, 333 }, { 0, 400, 90, 487 }, { 40, 120, 60, 150 } },
-	};
-	for (const auto &rects : runs) {
-		regions.run(img.view(), rects, params, part);
-		EXPECT_EQ(part.scale, 1.0f);
-		expectSameInside(whole, part, rects, w, h, 1, "edges");
-		/* The region map is the whole frame's; the shade map the
-		 * rectangles' only. */
-		EXPECT_EQ(part.regions.width, whole.regions.width);
-		EXPECT_EQ(part.regions.height, whole.regions.height);
-		EXPECT_EQ(part.regions.scale, whole.regions.scale);
-		EXPECT_EQ(part.regions.pixels, whole.regions.pixels);
-		EXPECT_EQ(part.regions.tiles, whole.regions.tiles);
-		EXPECT_EQ(part.shades.scale, whole.shades.scale);
-		expectSameInside(whole.shades, part.shades, rects, w, h, 2, "shades");
-		/* Each rectangle with its margin, from a tile's start; the
-		 * frame once for the region map. */
-		std::size_t read = static_cast<std::size_t>(w) * h;
+	const std::vector<PixelRect> wholeFrame = { { 0, 0, w, h } };
+	/* Each rectangle with its margin, from a tile's start. */
+	auto readOf = [&](const std::vector<PixelRect> &rects) {
+		std::size_t read = 0;
 		for (PixelRect r : rects) {
 			r = RegionFrontEnd::alignedRect(r, w, h);
 			const int m = RegionFrontEnd::kMargin;
@@ -139,16 +120,59 @@ TEST(RegionFrontEnd, BitIdenticalToTheWholeFrameInsideEachRegion)
 					   std::min(w, r.x1 + m), std::min(h, r.y1 + m) }
 					.area();
 		}
-		EXPECT_EQ(regions.bytesRead(), read);
+		return read;
+	};
+	/* Runs on the same maps, each after another that wrote elsewhere: it
+	 * must clear what the last one wrote outside its own regions.
+	 * Regions at the frame's edges and corners, unaligned, overlapping,
+	 * and one inside another; search strips along the frame's edges
+	 * (the region map only there), or the whole frame's region map. */
+	struct Run {
+		std::vector<PixelRect> rects, search;
+	};
+	const std::vector<Run> runs = {
+		{ { { 0, 0, 100, 70 }, { 300, 200, 420, 310 }, { 380, 250, 500, 330 }, { 600, 440, 645, 487 } },
+		  wholeFrame },
+		{ { { 13, 100, 645, 200 }, { 500, 300, 530, 333 }, { 0, 400, 90, 487 }, { 40, 120, 60, 150 } },
+		  { { 0, 0, 101, 487 }, { 0, 390, 645, 487 } } },
+		{ { { 0, 0, 100, 70 }, { 300, 200, 420, 310 } }, { { 547, 0, 645, 487 }, { 0, 0, 645, 77 } } },
+		{ { { 200, 150, 330, 260 } }, wholeFrame },
+		{ { { 200, 150, 330, 260 } }, {} },
+	};
+	for (const Run &run : runs) {
+		const bool wholeRegions = run.search == wholeFrame;
+		regions.run(img.view(), run.rects, run.search, params, part);
+		EXPECT_EQ(part.scale, 1.0f);
+		expectSameInside(whole, part, run.rects, w, h, 1, "edges");
+		EXPECT_EQ(part.regions.width, whole.regions.width);
+		EXPECT_EQ(part.regions.height, whole.regions.height);
+		EXPECT_EQ(part.regions.scale, whole.regions.scale);
+		EXPECT_EQ(part.shades.scale, whole.shades.scale);
+		if (wholeRegions) {
+			/* The region map the whole frame's. */
+			EXPECT_EQ(part.regions.pixels, whole.regions.pixels);
+			EXPECT_EQ(part.regions.tiles, whole.regions.tiles);
+		} else {
+			/* The region map the rectangles' and the strips'. */
+			std::vector<PixelRect> both = run.rects;
+			both.insert(both.end(), run.search.begin(), run.search.end());
+			expectSameInside(whole.regions, part.regions, both, w, h, 2, "regions");
+		}
+		/* The shade map the rectangles' only. */
+		expectSameInside(whole.shades, part.shades, run.rects, w, h, 2, "shades");
+		EXPECT_EQ(regions.bytesRead(),
+			  readOf(run.rects) + (wholeRegions ? static_cast<std::size_t>(w) * h : readOf(run.search)));
 	}
 	/* A region of the whole frame is the whole frame. */
-	const std::vector<PixelRect> all = { { 0, 0, w, h } };
-	regions.run(img.view(), all, params, part);
-	EXPECT_EQ(part.pixels, whole.pixels);
-	EXPECT_EQ(part.tiles, whole.tiles);
-	EXPECT_EQ(part.regions.pixels, whole.regions.pixels);
-	EXPECT_EQ(part.shades.pixels, whole.shades.pixels);
-	EXPECT_EQ(regions.bytesRead(), 2 * static_cast<std::size_t>(w) * h);
+	for (const std::vector<PixelRect> &search : { wholeFrame, std::vector<PixelRect>{} }) {
+		regions.run(img.view(), wholeFrame, search, params, part);
+		EXPECT_EQ(part.pixels, whole.pixels);
+		EXPECT_EQ(part.tiles, whole.tiles);
+		EXPECT_EQ(part.regions.pixels, whole.regions.pixels);
+		EXPECT_EQ(part.regions.tiles, whole.regions.tiles);
+		EXPECT_EQ(part.shades.pixels, whole.shades.pixels);
+		EXPECT_EQ(part.shades.tiles, whole.shades.tiles);
+	}
 }
 
 TEST(RegionFrontEnd, AlignsOutwardAndClips)
@@ -244,6 +268,35 @@ TEST(Tracking, FollowsMovingMarkersWithMeasuredCornersAndFindsANewOneWithinKFram
 	ASSERT_GE(newFoundAt, newFrom);
 	EXPECT_LT(newFoundAt - newFrom, cfg.track_cover_frames) << "found " << newFoundAt - newFrom << " frames late";
 	EXPECT_GE(partialFrames, 18) << "frames read in regions";
+}
+
+/* A marker that the scene's motion (3 px a frame to the right) brings in
+ * over the frame's left edge: the search strip on that side finds it on
+ * the frame NORMAL first does, wherever the band is. */
+TEST(Tracking, AMarkerEnteringAtTheEdgeIsFoundOnItsFirstWholeFrame)
+{
+	Config cfg;
+	Config trackCfg = cfg;
+	trackCfg.mode = Mode::Track;
+	Detector normal(cfg), track(trackCfg);
+	int normalAt = -1, trackAt = -1, partial = 0;
+	for (int f = 0; f < 30 && (normalAt < 0 || trackAt < 0); ++f) {
+		std::vector<Placed> s = sceneAt(f, false, 0);
+		s.push_back({ 150, squarePose(-45.0f + 3.0f * f, 250.0f + 1.0f * f, 56.0f, 5.0f, 12.0f) });
+		const Image img = movingFrame(f, s);
+		if (normalAt < 0 && findMarker(normal.detect(img.view()).markers, 150))
+			normalAt = f;
+		const Result &r = track.detect(img.view());
+		partial += r.whole_frame ? 0 : 1;
+		if (trackAt < 0 && findMarker(r.markers, 150)) {
+			trackAt = f;
+			EXPECT_FALSE(r.whole_frame) << "found by the search, not a whole frame";
+			EXPECT_FALSE(findMarker(r.markers, 150)->tracked);
+		}
+	}
+	ASSERT_GT(normalAt, 5);
+	EXPECT_EQ(trackAt, normalAt);
+	EXPECT_EQ(partial, trackAt);
 }
 
 TEST(Tracking, AMarkerThatJumpsIsFoundOnTheSameFrameByAWholeSearch)
