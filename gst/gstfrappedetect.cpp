@@ -363,7 +363,7 @@ static void finish(GstFrappeDetect *self, MappedFrame &f, const frappe::Result &
 	const double poseMs = static_cast<double>(g_get_monotonic_time() - t0) / 1000.0;
 
 	frappe::gst::attachMarkerMetas(f.buffer, GST_VIDEO_FRAME_WIDTH(&f.frame), GST_VIDEO_FRAME_HEIGHT(&f.frame),
-				       result, poses, dictName);
+				       result, poses, dictName, s.library.mode == frappe::Mode::Track);
 	if (f.writable && s.annotate && !result.markers.empty()) {
 		frappe::gst::bestPoses(poses, priv->bestPoses);
 		frappe::gst::annotateMarkers(&f.frame, result, priv->bestPoses, s.sizes, priv->camera.fitted());

@@ -19,9 +19,10 @@
 namespace frappe::gst {
 
 /* A GstFrappeMarkerMeta and a "fiducial" GstVideoRegionOfInterestMeta per
- * marker, on a writable buffer of a frame of width x height. */
+ * marker, on a writable buffer of a frame of width x height; `tracking`:
+ * the detector ran Mode::Track (the metas' tracking and tracked). */
 void attachMarkerMetas(GstBuffer *buffer, gint width, gint height, const Result &result, const Poses &poses,
-		       const char *dictionary);
+		       const char *dictionary, bool tracking);
 
 /* The `frappedetect` element message's structure; running and stream time
  * come from `segment` when it is in time. */
