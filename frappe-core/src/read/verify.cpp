@@ -318,7 +318,7 @@ MarkerRead readMarker(const ImageView &image, const std::array<Point2f, 4> &corn
 		 * that chance reads often must still sit on real cells, as judged
 		 * by samples a quarter cell from their edges. */
 		WarpedMarker quarters;
-		if (!warpMarker(image, corners, dict.bits, quarters, policy.tone)) {
+		if (!warpMarker(image, corners, dict.bits, quarters, policy.tone, policy.memo)) {
 			out.rejection = Rejection::CellsDisagree;
 			return out;
 		}
@@ -347,7 +347,7 @@ MarkerRead readCellCentres(const ImageView &image, const std::array<Point2f, 4> 
 {
 	const int bits = codes.dictionary().bits;
 	float reference = 0.0f;
-	if (!warpCellCentres(image, corners, bits, kSharpening, scratch, &reference, policy.tone))
+	if (!warpCellCentres(image, corners, bits, kSharpening, scratch, &reference, policy.tone, policy.memo))
 		return {};
 	const Binarised b = binarise(scratch, bits);
 	const float lo = b.threshold - 0.5f * b.contrast, hi = b.threshold + 0.5f * b.contrast;
