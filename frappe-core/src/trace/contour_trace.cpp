@@ -37,8 +37,6 @@ static_assert((kUnfollowed | kMarkFollowed) == kFollowed && (kFollowed | kMarkRi
 /* Neighbour offsets, counter-clockwise on screen starting at the right. */
 constexpr int kDx[8] = { 1, 1, 0, -1, -1, -1, 0, 1 };
 constexpr int kDy[8] = { 0, -1, -1, -1, 0, 1, 1, 1 };
-/* Where the walk's window of neighbour masks holds direction d's. */
-constexpr int kWindowByte[8] = { 4, 2, 1, 0, 3, 5, 6, 7 };
 
 /* xy steps per direction back (the move is the opposite direction). */
 constexpr std::int32_t kDxyBack[8] = { -kDx[0] - kDy[0] * 65536, -kDx[1] - kDy[1] * 65536,
@@ -286,7 +284,8 @@ void ContourTracer::buildStepTables(int w)
 				st.offset = static_cast<std::int16_t>(kDx[d] + kDy[d] * w);
 				st.back = static_cast<std::uint8_t>((d + 4) & 7);
 				st.mark = (e & 8) ? kMarkRightBg : kMarkFollowed;
-				st.shift = static_cast<std::uint8_t>(8 * kWindowByte[d]);
+				st.dxy = static_cast<std::uint32_t>(kDx[d]) +
+					 static_cast<std::uint32_t>(kDy[d]) * 65536u;
 			}
 		stepTable_.clear();
 		return;
@@ -677,25 +676,16 @@ void ContourTracer::follow(int x0, int y0, int fromDir, const TraceMap &edges)
 	const int d1 = (fromDir - std::countl_zero(turned)) & 7;
 	const std::uint8_t *const p1 = p0 + off[d1];
 	if (useMasks_) {
-		/* Each pixel's neighbourhood is one byte of masks_. The masks of
-		 * the current pixel's eight neighbours are loaded (three words)
-		 * while its step is looked up, so the next pixel's mask is a
-		 * shift of a register away when the table entry arrives: one
-		 * dependent load per step. */
+		/* Each pixel's neighbourhood is one byte of masks_: a step is
+		 * the table entry, then the next pixel's byte (two dependent
+		 * loads and some 25 instructions; gathering its eight
+		 * neighbours' bytes ahead of the entry took one load but 58). */
 		const std::uint8_t *const M = masks_.data();
 		const MaskStep *const mt = maskTable_.data();
 		const std::ptrdiff_t i0 = p0 - L, i1 = p1 - L;
-		/* Bytes: up-left, up, up-right, left, right, down-left, down,
-		 * down-right (kWindowByte). */
-		auto window = [M, w](std::ptrdiff_t at) {
-			const std::uint32_t r0 = load32(M + at - w - 1), r1 = load32(M + at - 1), r2 = load32(M + at + w - 1);
-			return static_cast<std::uint64_t>(r0 & 0xFFFFFFu) | static_cast<std::uint64_t>(r1 & 0xFFu) << 24 |
-			       static_cast<std::uint64_t>(r1 & 0xFF0000u) << 16 | static_cast<std::uint64_t>(r2 & 0xFFFFFFu) << 40;
-		};
 		std::ptrdiff_t i = i0;
 		unsigned back = static_cast<unsigned>(d1);
 		unsigned mask = M[i0];
-		std::uint64_t around = window(i0);
 		for (;;) {
 			const MaskStep st = mt[back << 8 | mask];
 			L[i] |= st.mark;
@@ -710,10 +700,9 @@ void ContourTracer::follow(int x0, int y0, int fromDir, const TraceMap &edges)
 			const std::ptrdiff_t next = i + st.offset;
 			if (i == i1 && next == i0) [[unlikely]]
 				break;
-			mask = static_cast<unsigned>(around >> st.shift) & 0xFFu;
-			around = window(next);
+			mask = M[next];
 			back = st.back;
-			xy += static_cast<std::uint32_t>(kDxyBack[back]);
+			xy += st.dxy;
 			i = next;
 		}
 		steps_ = static_cast<int>(out - points_.data());

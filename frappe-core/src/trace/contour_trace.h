@@ -124,7 +124,8 @@ private:
 	/// Suzuki's step 3.3 for this width, in one of two forms. On 64-bit
 	/// targets each edge pixel's eight neighbours are first gathered into
 	/// one byte of masks_ (a vectorised pass over the occupied tiles), and
-	/// the table is indexed by direction back and that byte. Elsewhere (the
+	/// the table is indexed by direction back and that byte, whose entry
+	/// says where the next byte is. Elsewhere (the
 	/// ARMv6 build, where that pass would cost more than it saves) the
 	/// neighbourhood is read from three label rows at every step, and
 	/// stepTable_ holds the move's pointer offset, the next direction back
@@ -133,7 +134,7 @@ private:
 		std::int16_t offset; ///< pointer offset of the move
 		std::uint8_t back;   ///< direction back from the pixel it reaches
 		std::uint8_t mark;   ///< label mark of the pixel it leaves
-		std::uint8_t shift;  ///< where the move's pixel is in the walk's window
+		std::uint32_t dxy;   ///< the move as x | y << 16 (wrapping)
 	};
 	bool useMasks_ = false;
 	std::vector<std::uint8_t> masks_;
