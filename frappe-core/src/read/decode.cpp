@@ -230,10 +230,16 @@ bool insetQuad(const ImageView &image, std::array<Point2f, 4> &corners, int bits
 	return true;
 }
 
-Binarised binarise(const WarpedMarker &w, int bits)
+namespace {
+
+/* binarise() with k samples a cell side; a constant K (the grids of
+ * warpMarker, 2, and of cell centres, 1) lets the cell means unroll: the
+ * same sums in the same order, so the same floats. */
+template<int K>
+Binarised binariseWith(const WarpedMarker &w, int bits, int kAny)
 {
 	const int cells = bits + 2;
-	const int k = std::max(1, w.side / cells); /* samples per cell side */
+	const int k = K > 0 ? K : kAny;
 	float lo = 1e9f, hi = -1e9f;
 	for (int y = k; y < (bits + 1) * k; ++y) {
 		for (int x = k; x < (bits + 1) * k; ++x) {
@@ -259,6 +265,18 @@ Binarised binarise(const WarpedMarker &w, int bits)
 		out.border_errors += mean(cells - 1, c) > thr;
 	}
 	return out;
+}
+
+} // namespace
+
+Binarised binarise(const WarpedMarker &w, int bits)
+{
+	const int k = std::max(1, w.side / (bits + 2)); /* samples per cell side */
+	if (k == kSamplesPerCell)
+		return binariseWith<kSamplesPerCell>(w, bits, k);
+	if (k == 1)
+		return binariseWith<1>(w, bits, k);
+	return binariseWith<0>(w, bits, k);
 }
 
 namespace {
