@@ -363,6 +363,7 @@ bool detail::CandidateReader::readCandidate(const ImageView &image, Slot &slot, 
 	warpMemo.clear();
 	DecodePolicy onGrey = policy, onLog = logPolicy, onClip = clipPolicy;
 	onGrey.memo = onLog.memo = onClip.memo = &warpMemo;
+	onGrey.decodes = onLog.decodes = onClip.decodes = &decodes;
 	auto readWith = [&](const detail::DecodePolicy &pol) {
 		sampleRefined(r, q, k, pol, timer);
 		if (!r.refined || r.b.border_errors >= whiteFrame())

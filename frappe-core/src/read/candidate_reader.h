@@ -93,7 +93,8 @@ private:
 	PointGrid markerGrid;    /* dropNestedMarkers()'s */
 	PointGrid markerCentres; /* the frame's markers so far, for skipCandidate() */
 	WarpedMarker warped;
-	WarpMemo warpMemo; /* one candidate's warps, for its later reads */
+	WarpMemo warpMemo;   /* one candidate's warps, for its later reads */
+	DecodeCache decodes; /* the read stage's last decodes */
 	/* Candidates with large cells are read on the frame halved into blocks
 	 * of f pixels (readBlock()): a patch around the candidate, or the whole
 	 * frame once the frame's patches would read more than it (then kept for

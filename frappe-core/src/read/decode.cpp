@@ -424,6 +424,21 @@ Decoded CodeBook::decode(std::uint64_t code, int maxHamming) const
 	return maxHamming > 0 ? frappe::detail::decode(*dict_, code, maxHamming) : Decoded{};
 }
 
+Decoded DecodeCache::decode(const CodeBook &codes, std::uint64_t code, int maxHamming)
+{
+	/* Fibonacci hashing of the code, the distance mixed in. */
+	const std::uint64_t key = code ^ static_cast<std::uint64_t>(static_cast<std::uint32_t>(maxHamming)) << 56;
+	Entry &e = entries_[static_cast<std::size_t>((key * 0x9E3779B97F4A7C15ull) >> 56)];
+	static_assert(kEntries == 256);
+	if (e.codes != &codes || e.code != code || e.maxHamming != maxHamming) {
+		e.codes = &codes;
+		e.code = code;
+		e.maxHamming = maxHamming;
+		e.decoded = codes.decode(code, maxHamming);
+	}
+	return e.decoded;
+}
+
 } // namespace frappe::detail
 
 namespace frappe {

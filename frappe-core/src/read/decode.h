@@ -179,6 +179,28 @@ private:
 	std::vector<std::uint8_t> plain_;
 };
 
+/// The last decodes of one stage of the detector: CodeBook::decode() is a
+/// function of the code and maxHamming alone, and a frame reads the same
+/// codes many times over (a candidate's reads on each Tone and at its cell
+/// centres; the probe's reads of a marker's nested outlines): two thirds of
+/// the scans of every codeword on synth/images repeat one of the last 64.
+/// Direct-mapped; one per stage (stages of different frames run at once).
+class DecodeCache {
+public:
+	/// codes.decode(code, maxHamming), from the cache when it holds it.
+	Decoded decode(const CodeBook &codes, std::uint64_t code, int maxHamming);
+
+private:
+	static constexpr int kEntries = 256;
+	struct Entry {
+		const CodeBook *codes = nullptr;
+		std::uint64_t code = 0;
+		int maxHamming = 0;
+		Decoded decoded;
+	};
+	std::array<Entry, kEntries> entries_{};
+};
+
 /// Whether an n x n code inside its black border is a plain shape: at most
 /// 0.6 of the black-white changes between neighbouring cells that random
 /// bits make on average (n (n + 1), the border's neighbours counted). A

@@ -293,7 +293,8 @@ MarkerRead readMarker(const ImageView &image, const std::array<Point2f, 4> &corn
 {
 	const Dictionary &dict = codes.dictionary();
 	MarkerRead out;
-	out.decoded = codes.decode(b.code, policy.maxTotal);
+	out.decoded = policy.decodes ? policy.decodes->decode(codes, b.code, policy.maxTotal)
+				     : codes.decode(b.code, policy.maxTotal);
 	if (out.decoded.id < 0)
 		return out;
 	if (!unambiguous(out.decoded, dict)) {

@@ -128,6 +128,9 @@ struct DecodePolicy {
 	/// Where the warps of this candidate's earlier reads are kept (none:
 	/// every warp samples the frame).
 	WarpMemo *memo = nullptr;
+	/// Where this stage's last decodes are kept (none: every code is
+	/// looked up).
+	DecodeCache *decodes = nullptr;
 };
 
 /// Why a candidate is not a marker.
