@@ -43,9 +43,6 @@ constexpr std::int32_t kDxyBack[8] = { -kDx[0] - kDy[0] * 65536, -kDx[1] - kDy[1
 				       -kDx[2] - kDy[2] * 65536, -kDx[3] - kDy[3] * 65536,
 				       -kDx[4] - kDy[4] * 65536, -kDx[5] - kDy[5] * 65536,
 				       -kDx[6] - kDy[6] * 65536, -kDx[7] - kDy[7] * 65536 };
-/* stepTable_ holds kDxyBack first, then the steps: the ARMv6 walk reaches
- * both from one base register. */
-constexpr std::size_t kStepTableAt = 8;
 
 /* Step 3.3 of Suzuki's algorithm as a table: for the direction `back` to the
  * previous border pixel and the mask of non-zero neighbours (bit d for
@@ -203,7 +200,7 @@ struct FollowAsm {
 	std::uint32_t xy;		  ///< 4: its coordinates, x | y << 16
 	std::uint32_t *out, *cout;	  ///< 8, 12: where its point and corner go
 	std::uint32_t s;		  ///< 16: in: the table row (back << 9); out: the entry
-	const std::int32_t *table;	  ///< 20: the step table (kDxyBack at table - 8)
+	const std::int32_t *table;        ///< 20: the step table (kDxyBack[b] at row b, index 0)
 	std::int32_t up, down;		  ///< 24, 28: -w - 1, w - 1
 	std::int32_t toEdge;		  ///< 32: edge map minus labels (bytes)
 	const std::uint8_t *p1;		  ///< 36
@@ -230,8 +227,7 @@ frappe_armv6_follow:
 .Lfw_step:
 	add     r1, r1, r5, asr #12     @ p = next
 	and     r5, r5, #0xE00          @ the next row: direction back
-	add     lr, r6, r5, lsr #7
-	ldr     lr, [lr, #-32]          @ kDxyBack[back]
+	ldr     lr, [r6, r5, lsl #2]    @ kDxyBack[back], at the row's index 0
 	add     r2, r2, lr
 .Lfw_body:
 	ldr     lr, [r1, r7]            @ row above, columns x-1 .. x+2
@@ -293,17 +289,20 @@ void ContourTracer::buildStepTables(int w)
 	/* kRowStep as (offset << 12) | back' << 9 | mark: the move's pointer
 	 * offset, the direction back from the pixel it reaches (which selects
 	 * the next row of the table), and the label mark of the pixel it
-	 * leaves. */
-	stepTable_.resize(kStepTableAt + 8 * 512);
-	std::copy(kDxyBack, kDxyBack + 8, stepTable_.begin());
+	 * leaves. A walked pixel's own label sets bit 4 of its index, so
+	 * indices 0 .. 15 are never looked up: index 0 of row b holds
+	 * kDxyBack[b] instead, which the ARMv6 walk reads from the row alone. */
+	stepTable_.resize(8 * 512);
 	for (int back = 0; back < 8; ++back)
 		for (int idx = 0; idx < 512; ++idx) {
 			const int e = kRowStep.entry[back][idx];
 			const int d = e & 7;
 			const auto offset = static_cast<std::uint32_t>(kDx[d] + kDy[d] * w);
-			stepTable_[kStepTableAt + static_cast<std::size_t>(back) * 512 + idx] = static_cast<std::int32_t>(
-				offset << 12 | static_cast<std::uint32_t>((d + 4) & 7) << 9 |
-				((e & 8) ? kMarkRightBg : kMarkFollowed));
+			stepTable_[static_cast<std::size_t>(back) * 512 + idx] =
+				idx == 0 ? kDxyBack[back]
+					 : static_cast<std::int32_t>(offset << 12 |
+								     static_cast<std::uint32_t>((d + 4) & 7) << 9 |
+								     ((e & 8) ? kMarkRightBg : kMarkFollowed));
 		}
 	maskTable_.clear();
 }
@@ -709,7 +708,7 @@ void ContourTracer::follow(int x0, int y0, int fromDir, const TraceMap &edges)
 		cornerCount_ = static_cast<int>(cornerOut - corners_.data());
 		return;
 	}
-	const std::int32_t *const table = stepTable_.data() + kStepTableAt;
+	const std::int32_t *const table = stepTable_.data();
 	const std::size_t maxSteps = 4 * labels_.size();
 	std::uint8_t *p = p0;
 	/* The table row for the direction back to the previous pixel. */
@@ -774,8 +773,17 @@ void ContourTracer::followV6(int x0, int y0, int fromDir, const TraceMap &edges)
 	const int d1 = (fromDir - std::countl_zero(turned)) & 7;
 	const std::uint8_t *const p1 = p0 + kDx[d1] + kDy[d1] * w;
 	const std::size_t maxSteps = 4 * labels_.size();
-	FollowAsm a{ p0, xy, out, cornerOut, static_cast<std::uint32_t>(d1) << 9, stepTable_.data() + kStepTableAt,
-		     static_cast<std::int32_t>(-w - 1), static_cast<std::int32_t>(w - 1), toEdge, p1, outEnd,
+	FollowAsm a{ p0,
+		     xy,
+		     out,
+		     cornerOut,
+		     static_cast<std::uint32_t>(d1) << 9,
+		     stepTable_.data(),
+		     static_cast<std::int32_t>(-w - 1),
+		     static_cast<std::int32_t>(w - 1),
+		     toEdge,
+		     p1,
+		     outEnd,
 		     0x00070707u };
 	/* The walk returns at p1 and when the points are full, after storing
 	 * the point; the rest of such a step is done here, as follow() does. */
