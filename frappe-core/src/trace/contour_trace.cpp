@@ -24,6 +24,7 @@
 #include <cstddef>
 #include <cstring>
 #include <span>
+#include <type_traits>
 
 namespace frappe::detail {
 
@@ -209,6 +210,9 @@ struct FollowAsm {
 };
 static_assert(offsetof(FollowAsm, mask) == 44);
 extern "C" void frappe_armv6_follow(FollowAsm *a);
+/* The same without the corner list (cout is left as it is): for maps
+ * without corner pixels. */
+extern "C" void frappe_armv6_follow_bare(FollowAsm *a);
 
 /* r1 p, r2 xy, r3 out, r4 cout, r5 row / entry, r6 table, r7 up, r8 down,
  * r9 toEdge, r10 p1, r11 outEnd, r12 mask; r0, lr temporaries. The index
@@ -218,18 +222,19 @@ __asm__(R"(
 	.text
 	.arm
 	.syntax unified
+	.macro FRAPPE_FOLLOW name, corners
 	.p2align 2
-	.type frappe_armv6_follow, %function
-frappe_armv6_follow:
+	.type \name, %function
+\name:
 	push    {r0, r4-r11, lr}
 	ldm     r0, {r1-r12}
-	b       .Lfw_body
-.Lfw_step:
+	b       .Lfw_body\@
+.Lfw_step\@:
 	add     r1, r1, r5, asr #12     @ p = next
 	and     r5, r5, #0xE00          @ the next row: direction back
 	ldr     lr, [r6, r5, lsl #2]    @ kDxyBack[back], at the row's index 0
 	add     r2, r2, lr
-.Lfw_body:
+.Lfw_body\@:
 	ldr     lr, [r1, r7]            @ row above, columns x-1 .. x+2
 	ldr     r0, [r1, #-1]
 	orr     lr, lr, r0, lsl #1
@@ -246,17 +251,23 @@ frappe_armv6_follow:
 	orr     r0, r0, lr
 	strb    r0, [r1]                @ mark the pixel
 	str     r2, [r3], #4            @ its point
+	.if \corners
 	str     r2, [r4]                @ and, kept if it is a corner,
 	ldrb    r0, [r1, r9]
 	and     r0, r0, #2
 	add     r4, r4, r0, lsl #1      @ its corner
+	.endif
 	cmp     r3, r11
 	cmpne   r1, r10
-	bne     .Lfw_step
+	bne     .Lfw_step\@
 	pop     {r0}
 	stm     r0, {r1-r5}
 	pop     {r4-r11, pc}
-	.size frappe_armv6_follow, .-frappe_armv6_follow
+	.size \name, .-\name
+	.endm
+	FRAPPE_FOLLOW frappe_armv6_follow, 1
+	FRAPPE_FOLLOW frappe_armv6_follow_bare, 0
+	.purgem FRAPPE_FOLLOW
 )"
 #if defined(__thumb__)
 	"\t.thumb\n"
@@ -343,7 +354,7 @@ void ContourTracer::trace(const TraceMap &edges, const TraceParams &params, std:
 			return;
 
 		++borders_;
-		follow(x, y, fromDir, edges);
+		follow(x, y, fromDir, edges, params.corners);
 		/* A marker outline is at least four sides of min_side pixels,
 		 * and spans at least min_side / sqrt(2) each way. */
 		if (static_cast<float>(steps_) < 2.8f * params.min_side)
@@ -608,11 +619,11 @@ void ContourTracer::clusterCorners()
 
 /* Follows one border from (x, y); (x, y) + kD[fromDir] is the background
  * pixel the scan came from. Keeps its pixels and, apart, its corner pixels. */
-void ContourTracer::follow(int x0, int y0, int fromDir, const TraceMap &edges)
+void ContourTracer::follow(int x0, int y0, int fromDir, const TraceMap &edges, bool corners)
 {
 #ifdef FRAPPE_HAVE_ARMV6_TRACE
 	if (!portableWalk_ && !useMasks_) {
-		followV6(x0, y0, fromDir, edges);
+		followV6(x0, y0, fromDir, edges, corners);
 		return;
 	}
 #endif
@@ -664,7 +675,7 @@ void ContourTracer::follow(int x0, int y0, int fromDir, const TraceMap &edges)
 		*p0 = kFollowedRightBg; /* isolated pixel */
 		*out++ = xy;
 		*cornerOut = xy;
-		cornerOut += isCorner(p0);
+		cornerOut += corners && isCorner(p0);
 		steps_ = 1;
 		cornerCount_ = static_cast<int>(cornerOut - corners_.data());
 		return;
@@ -682,28 +693,37 @@ void ContourTracer::follow(int x0, int y0, int fromDir, const TraceMap &edges)
 		const std::uint8_t *const M = masks_.data();
 		const MaskStep *const mt = maskTable_.data();
 		const std::ptrdiff_t i0 = p0 - L, i1 = p1 - L;
-		std::ptrdiff_t i = i0;
-		unsigned back = static_cast<unsigned>(d1);
-		unsigned mask = M[i0];
-		for (;;) {
-			const MaskStep st = mt[back << 8 | mask];
-			L[i] |= st.mark;
-			*out++ = xy;
-			*cornerOut = xy;
-			cornerOut += isCorner(L + i);
-			if (out == outEnd) [[unlikely]] {
-				if (points_.size() > 4 * labels_.size())
+		/* One loop with the corner test, one without. */
+		auto walk = [&](auto withCorners) {
+			std::ptrdiff_t i = i0;
+			unsigned back = static_cast<unsigned>(d1);
+			unsigned mask = M[i0];
+			for (;;) {
+				const MaskStep st = mt[back << 8 | mask];
+				L[i] |= st.mark;
+				*out++ = xy;
+				if constexpr (decltype(withCorners)::value) {
+					*cornerOut = xy;
+					cornerOut += isCorner(L + i);
+				}
+				if (out == outEnd) [[unlikely]] {
+					if (points_.size() > 4 * labels_.size())
+						break;
+					grow();
+				}
+				const std::ptrdiff_t next = i + st.offset;
+				if (i == i1 && next == i0) [[unlikely]]
 					break;
-				grow();
+				mask = M[next];
+				back = st.back;
+				xy += st.dxy;
+				i = next;
 			}
-			const std::ptrdiff_t next = i + st.offset;
-			if (i == i1 && next == i0) [[unlikely]]
-				break;
-			mask = M[next];
-			back = st.back;
-			xy += st.dxy;
-			i = next;
-		}
+		};
+		if (corners)
+			walk(std::true_type{});
+		else
+			walk(std::false_type{});
 		steps_ = static_cast<int>(out - points_.data());
 		cornerCount_ = static_cast<int>(cornerOut - corners_.data());
 		return;
@@ -722,7 +742,7 @@ void ContourTracer::follow(int x0, int y0, int fromDir, const TraceMap &edges)
 		*p |= static_cast<std::uint8_t>(step & kMarkRightBg);
 		*out++ = xy;
 		*cornerOut = xy;
-		cornerOut += isCorner(p);
+		cornerOut += corners && isCorner(p);
 		if (out == outEnd) [[unlikely]] {
 			if (points_.size() > maxSteps) /* only on a corrupt label image */
 				break;
@@ -745,7 +765,7 @@ void ContourTracer::follow(int x0, int y0, int fromDir, const TraceMap &edges)
  * the first move found from the neighbourhood index (kMaskOfIndex) rather
  * than eight byte tests, and no more set-up than the walk needs: a border
  * is 34 steps on average, so its set-up counts. */
-void ContourTracer::followV6(int x0, int y0, int fromDir, const TraceMap &edges)
+void ContourTracer::followV6(int x0, int y0, int fromDir, const TraceMap &edges, bool corners)
 {
 	std::uint8_t *const L = labels_.data();
 	const std::ptrdiff_t w = stride_;
@@ -764,7 +784,7 @@ void ContourTracer::followV6(int x0, int y0, int fromDir, const TraceMap &edges)
 		*p0 = kFollowedRightBg; /* isolated pixel */
 		*out++ = xy;
 		*cornerOut = xy;
-		cornerOut += (p0[toEdge] >> 1) & 1;
+		cornerOut += corners && (p0[toEdge] >> 1) & 1;
 		steps_ = 1;
 		cornerCount_ = static_cast<int>(cornerOut - corners_.data());
 		return;
@@ -788,7 +808,10 @@ void ContourTracer::followV6(int x0, int y0, int fromDir, const TraceMap &edges)
 	/* The walk returns at p1 and when the points are full, after storing
 	 * the point; the rest of such a step is done here, as follow() does. */
 	for (;;) {
-		frappe_armv6_follow(&a);
+		if (corners)
+			frappe_armv6_follow(&a);
+		else
+			frappe_armv6_follow_bare(&a);
 		if (a.out == outEnd) [[unlikely]] {
 			if (points_.size() > maxSteps)
 				break;

@@ -56,6 +56,10 @@ struct TraceParams {
 	/// through texture goes many times. Edge borders also double back
 	/// along open curves (twice the box), which the later checks reject.
 	float max_winding = 1e9f;
+	/// Whether the corner pixels (EdgeMap::kCorner) met along a border are
+	/// collected: region and shade maps hold none (kEdge alone marks a
+	/// pixel), and their walk then skips the test at every step.
+	bool corners = true;
 	/// Whether hole borders are followed too. Region borders need only the
 	/// outer ones: a dark region's outer border is the candidate; the
 	/// border of a light hole in it (a marker's white cells, the quiet zone
@@ -104,8 +108,8 @@ private:
 		int fx, fy;          ///< first member, the cluster's anchor
 	};
 	void buildStepTables(int w);
-	void follow(int x, int y, int fromDir, const TraceMap &edges);
-	void followV6(int x, int y, int fromDir, const TraceMap &edges); ///< ARMv6 builds only
+	void follow(int x, int y, int fromDir, const TraceMap &edges, bool corners);
+	void followV6(int x, int y, int fromDir, const TraceMap &edges, bool corners); ///< ARMv6 builds only
 	void clusterCorners();
 	/// The last border's bounding box spans `span` both ways, and its
 	/// length is at most maxWinding times the perimeter of the box.
