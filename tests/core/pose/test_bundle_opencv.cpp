@@ -88,7 +88,9 @@ TEST(BundleOpenCv, BoardPoseAgainstTruthAndEstimatePoseBoard)
 	const cv::Mat K = (cv::Mat_<double>(3, 3) << f, 0, cx, 0, f, cy, 0, 0, 1), D = cv::Mat::zeros(1, 5, CV_64F);
 	std::mt19937 rng(32);
 	std::uniform_real_distribution<double> u(0.0, 1.0);
-	Detector det(Config{ .dictionary = "6x6_250" });
+	Config cfg;
+	cfg.dictionary = "6x6_250";
+	Detector det(cfg);
 	const cv::Ptr<cv::aruco::DetectorParameters> params = cv::aruco::DetectorParameters::create();
 	Errors bundle, single, opencv;
 	int frames = 0, frames4 = 0;
