@@ -183,6 +183,7 @@
 
 #include "gstfrappedetect.h"
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <exception>
@@ -423,7 +424,14 @@ static void finish(GstFrappeDetect *self, MappedFrame &f, const frappe::Result &
 	frappe::gst::attachBundleMeta(f.buffer, bundle);
 	if (f.writable && s.annotate && !result.markers.empty()) {
 		frappe::gst::bestPoses(poses, priv->bestPoses);
-		frappe::gst::annotateMarkers(&f.frame, result, priv->bestPoses, s.sizes, priv->camera.fitted());
+		/* The bundle's axes as long as its largest marker's side. */
+		frappe::gst::BundleAxes axes;
+		if (bundle.pose) {
+			axes.pose = &bundle.pose->pose;
+			for (const frappe::BundleMarker &m : bundle.bundle->markers)
+				axes.axis = std::max(axes.axis, m.size);
+		}
+		frappe::gst::annotateMarkers(&f.frame, result, priv->bestPoses, s.sizes, priv->camera.fitted(), axes);
 	}
 
 	priv->bufferLog.copied(GST_ELEMENT(self), f.image, f.dmabufInput, result.copy_bytes, priv->poolOffered);

@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include <gst/check/gstharness.h>
@@ -115,21 +116,19 @@ std::vector<int> ids(const gint *v, guint n)
 	return std::vector<int>(v, v + n);
 }
 
-std::vector<double> doubles(const GstStructure *s, const char *field)
+/* A GstValueArray field of doubles or ints. */
+template<typename T>
+std::vector<T> values(const GstStructure *s, const char *field)
 {
-	std::vector<double> out;
+	std::vector<T> out;
 	const GValue *array = gst_structure_get_value(s, field);
-	for (guint i = 0; array && i < gst_value_array_get_size(array); ++i)
-		out.push_back(g_value_get_double(gst_value_array_get_value(array, i)));
-	return out;
-}
-
-std::vector<int> ints(const GstStructure *s, const char *field)
-{
-	std::vector<int> out;
-	const GValue *array = gst_structure_get_value(s, field);
-	for (guint i = 0; array && i < gst_value_array_get_size(array); ++i)
-		out.push_back(g_value_get_int(gst_value_array_get_value(array, i)));
+	for (guint i = 0; array && i < gst_value_array_get_size(array); ++i) {
+		const GValue *v = gst_value_array_get_value(array, i);
+		if constexpr (std::is_same_v<T, double>)
+			out.push_back(g_value_get_double(v));
+		else
+			out.push_back(g_value_get_int(v));
+	}
 	return out;
 }
 
@@ -236,13 +235,13 @@ TEST(Bundle, PoseInTheMetaTheMessageAndTheLine)
 	const GstStructure *s = messageBundle(f.t.bus, msg);
 	ASSERT_NE(s, nullptr);
 	EXPECT_STREQ(gst_structure_get_string(s, "name"), "test_board");
-	EXPECT_EQ(doubles(s, "rvec"), std::vector<double>(m->rvec, m->rvec + 3));
-	EXPECT_EQ(doubles(s, "tvec"), std::vector<double>(m->tvec, m->tvec + 3));
+	EXPECT_EQ(values<double>(s, "rvec"), std::vector<double>(m->rvec, m->rvec + 3));
+	EXPECT_EQ(values<double>(s, "tvec"), std::vector<double>(m->tvec, m->tvec + 3));
 	double error = 0.0;
 	EXPECT_TRUE(gst_structure_get_double(s, "reprojection-error", &error));
 	EXPECT_EQ(error, m->reprojection_error);
-	EXPECT_EQ(ints(s, "used"), ids(m->used, m->n_used));
-	EXPECT_EQ(ints(s, "rejected"), std::vector<int>{});
+	EXPECT_EQ(values<int>(s, "used"), ids(m->used, m->n_used));
+	EXPECT_EQ(values<int>(s, "rejected"), std::vector<int>{});
 	gst_message_unref(msg);
 
 	const std::string line = jsonLine(out);
@@ -310,7 +309,7 @@ TEST(Bundle, MovedMarkerIsAnOutlier)
 	GstMessage *msg = nullptr;
 	const GstStructure *s = messageBundle(f.t.bus, msg);
 	ASSERT_NE(s, nullptr);
-	EXPECT_EQ(ints(s, "rejected"), std::vector<int>{ 4 });
+	EXPECT_EQ(values<int>(s, "rejected"), std::vector<int>{ 4 });
 	gst_message_unref(msg);
 	EXPECT_NE(jsonLine(out).find("\"rejected\": [4]}"), std::string::npos);
 	gst_buffer_unref(out);
@@ -371,4 +370,37 @@ TEST(Bundle, SetWhilePlaying)
 	EXPECT_EQ(gst_buffer_get_frappe_bundle_meta(out), nullptr);
 	EXPECT_EQ(markerMetas(out).size(), 6u);
 	gst_buffer_unref(out);
+}
+
+/* annotate=true draws the bundle frame's axes: the frame differs from the
+ * one drawn without bundle-file, at the board's origin (its bottom-left
+ * corner, marker 3's), and only there and along the axes. */
+TEST(Bundle, AnnotateDrawsTheBundleAxes)
+{
+	const frappe::Bundle b = frappe::loadBundle(kBoardFile);
+	TempDir dir;
+	const std::string cam = dir.write("camera.yaml", calibration());
+	const auto drawn = [&](const std::string &extra) {
+		BusHarness t(("frappedetect annotate=true calibration-file=\"" + cam + "\"" + extra).c_str(), kSpec);
+		GstBuffer *out =
+			gst_harness_push_and_pull(t.h, makeFrame(kSpec, board(b, truth()), dict("aruco_mip_36h12")));
+		std::vector<guint8> luma(static_cast<std::size_t>(kSpec.width * kSpec.height));
+		gst_buffer_extract(out, 0, luma.data(), luma.size());
+		gst_buffer_unref(out);
+		return luma;
+	};
+	const auto without = drawn(""), with = drawn(" bundle-file=\"" + kBoardFile + "\"");
+	const auto origin = frappe::projectPoints(std::array<std::array<double, 3>, 1>{ { { 0.0, 0.0, 0.0 } } },
+						  truth(), camera())[0];
+	int changed = 0, nearOrigin = 0;
+	for (int y = 0; y < kSpec.height; ++y)
+		for (int x = 0; x < kSpec.width; ++x) {
+			const std::size_t i = static_cast<std::size_t>(y * kSpec.width + x);
+			if (with[i] == without[i])
+				continue;
+			++changed;
+			nearOrigin += std::hypot(x - origin.x, y - origin.y) < 6.0;
+		}
+	EXPECT_GT(changed, 100);
+	EXPECT_GT(nearOrigin, 10);
 }
