@@ -234,7 +234,9 @@ struct FrappeDetectPrivate {
 	frappe::gst::PoseCamera camera; /* active's, fitted to the caps */
 	frappe::gst::Poses poses;       /* the frame's, reused */
 	std::vector<std::optional<frappe::Pose>> bestPoses;
-	std::optional<frappe::BundlePose> bundlePose; /* the frame's, with bundle-file */
+	frappe::BundlePose bundlePose; /* the frame's, with bundle-file, when hasBundlePose */
+	bool hasBundlePose = false;
+	frappe::BundleScratch bundleScratch;          /* estimateBundlePose()'s memory, reused */
 	bool warnedBundleCamera = false;              /* a bundle without a camera, since the settings changed */
 	std::string dictionary;         /* the pipeline's dictionary name */
 	std::unique_ptr<frappe::Pipeline> pipeline;
@@ -377,14 +379,15 @@ static GstFlowReturn fail(GstFrappeDetect *self, MappedFrame &f, const char *why
 	return GST_FLOW_ERROR;
 }
 
-/* The bundle's pose from the frame's markers into priv->bundlePose, none
- * without bundle-file; a bundle without a camera (camera-matrix cleared
- * while playing) is one warning until the settings change. */
+/* The bundle's pose from the frame's markers into priv->bundlePose (no
+ * allocation once its vectors and the scratch have grown), none without
+ * bundle-file; a bundle without a camera (camera-matrix cleared while
+ * playing) is one warning until the settings change. */
 static void estimate_bundle_pose(GstFrappeDetect *self, const frappe::Result &result)
 {
 	FrappeDetectPrivate *priv = self->priv;
 	const Settings &s = priv->active;
-	priv->bundlePose.reset();
+	priv->hasBundlePose = false;
 	if (!s.bundle)
 		return;
 	const frappe::Camera *camera = priv->camera.camera();
@@ -397,7 +400,8 @@ static void estimate_bundle_pose(GstFrappeDetect *self, const frappe::Result &re
 		return;
 	}
 	try {
-		priv->bundlePose = frappe::estimateBundlePose(*s.bundle, result.markers, *camera);
+		priv->hasBundlePose = frappe::estimateBundlePose(*s.bundle, result.markers, *camera, priv->bundlePose,
+								 priv->bundleScratch);
 	} catch (const std::exception &e) {
 		/* Not reached: the camera was checked when set. */
 		GST_WARNING_OBJECT(self, "bundle %s: %s", s.bundle->name.c_str(), e.what());
@@ -417,7 +421,7 @@ static void finish(GstFrappeDetect *self, MappedFrame &f, const frappe::Result &
 	frappe::gst::estimatePoses(result.markers, s.sizes, priv->camera.camera(), priv->poses);
 	estimate_bundle_pose(self, result);
 	const double poseMs = static_cast<double>(g_get_monotonic_time() - t0) / 1000.0;
-	const frappe::gst::BundleOutput bundle{ s.bundle.get(), priv->bundlePose ? &*priv->bundlePose : nullptr };
+	const frappe::gst::BundleOutput bundle{ s.bundle.get(), priv->hasBundlePose ? &priv->bundlePose : nullptr };
 
 	frappe::gst::attachMarkerMetas(f.buffer, GST_VIDEO_FRAME_WIDTH(&f.frame), GST_VIDEO_FRAME_HEIGHT(&f.frame),
 				       result, poses, dictName);
