@@ -236,8 +236,8 @@ struct FrappeDetectPrivate {
 	std::vector<std::optional<frappe::Pose>> bestPoses;
 	frappe::BundlePose bundlePose; /* the frame's, with bundle-file, when hasBundlePose */
 	bool hasBundlePose = false;
-	frappe::BundleScratch bundleScratch;          /* estimateBundlePose()'s memory, reused */
-	bool warnedBundleCamera = false;              /* a bundle without a camera, since the settings changed */
+	frappe::BundleScratch bundleScratch; /* estimateBundlePose()'s memory, reused */
+	bool warnedBundleCamera = false;     /* a bundle without a camera, since the settings changed */
 	std::string dictionary;         /* the pipeline's dictionary name */
 	std::unique_ptr<frappe::Pipeline> pipeline;
 	Overlap overlap = Overlap::None; /* the pipeline's */
