@@ -424,7 +424,7 @@ static void finish(GstFrappeDetect *self, MappedFrame &f, const frappe::Result &
 	const frappe::gst::BundleOutput bundle{ s.bundle.get(), priv->hasBundlePose ? &priv->bundlePose : nullptr };
 
 	frappe::gst::attachMarkerMetas(f.buffer, GST_VIDEO_FRAME_WIDTH(&f.frame), GST_VIDEO_FRAME_HEIGHT(&f.frame),
-				       result, poses, dictName);
+				       result, poses, dictName, s.library.mode == frappe::Mode::Track);
 	frappe::gst::attachBundleMeta(f.buffer, bundle);
 	if (f.writable && s.annotate && !result.markers.empty()) {
 		frappe::gst::bestPoses(poses, priv->bestPoses);

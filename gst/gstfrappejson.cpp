@@ -70,7 +70,8 @@
  * * `markers`: in the order of their metas, with the fields of
  *   #GstFrappeMarkerMeta (frappe/marker_record.h's list); `rvec`, `tvec`
  *   and the two reprojection errors only when the pose is known, `tracked`
- *   never (frappedetect's message has it). Numbers are written with the
+ *   only when frappedetect ran with mode=track (as frappe-detect writes
+ *   it). Numbers are written with the
  *   digits that give back the meta's value exactly (float corners, double
  *   poses) unless #GstFrappeJson:precision says fewer; a value that is not
  *   finite (an alternative error of infinity: there was no other solution)

@@ -117,7 +117,7 @@ GstStructure *markerStructure(const Marker &m, const std::optional<frappe::Marke
 } /* namespace */
 
 void attachMarkerMetas(GstBuffer *buffer, gint width, gint height, const Result &result, const Poses &poses,
-		       const char *dictionary)
+		       const char *dictionary, bool tracking)
 {
 	for (std::size_t i = 0; i < result.markers.size(); ++i) {
 		const Marker &m = result.markers[i];
@@ -134,8 +134,11 @@ void attachMarkerMetas(GstBuffer *buffer, gint width, gint height, const Result 
 		}
 		GstFrappeMarkerMeta *meta = gst_buffer_add_frappe_marker_meta(buffer, m.id, dictionary, corners,
 									      static_cast<guint>(m.hamming));
-		if (meta)
+		if (meta) {
 			meta->margin = m.margin;
+			meta->tracking = tracking;
+			meta->tracked = tracking && m.tracked;
+		}
 		if (meta && poses[i]) {
 			meta->has_pose = TRUE;
 			for (int k = 0; k < 3; ++k) {

@@ -20,9 +20,10 @@
 namespace frappe::gst {
 
 /* A GstFrappeMarkerMeta and a "fiducial" GstVideoRegionOfInterestMeta per
- * marker, on a writable buffer of a frame of width x height. */
+ * marker, on a writable buffer of a frame of width x height; `tracking`:
+ * the detector ran Mode::Track (the metas' tracking and tracked). */
 void attachMarkerMetas(GstBuffer *buffer, gint width, gint height, const Result &result, const Poses &poses,
-		       const char *dictionary);
+		       const char *dictionary, bool tracking);
 
 /* A frame's bundle pose: both set when bundle-file is and the bundle gave a
  * pose, else pose nullptr (no meta, no message field). */

@@ -75,6 +75,8 @@ GList *gst_frappe_buffer_get_markers(GstBuffer *buffer)
 		std::memcpy(marker->tvec, m->tvec, sizeof(marker->tvec));
 		marker->reprojection_error = m->reprojection_error;
 		marker->alternative_reprojection_error = m->alternative_reprojection_error;
+		marker->tracking = m->tracking;
+		marker->tracked = m->tracked;
 		/* Prepend then reverse: the list in meta order, in linear time. */
 		markers = g_list_prepend(markers, marker);
 	}

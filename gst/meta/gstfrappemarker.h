@@ -32,6 +32,9 @@ G_BEGIN_DECLS
  * @reprojection_error: RMS reprojection error of the pose, in pixels
  * @alternative_reprojection_error: the same for the planar pose's other
  *   solution (infinity when there was one)
+ * @tracking: whether frappedetect ran with mode=track on its frame. Since: 0.3
+ * @tracked: with @tracking, whether the marker continued a track of the
+ *   last frames. Since: 0.3
  *
  * One marker of a buffer, copied out of its #GstFrappeMarkerMeta (see
  * there for the frames and conventions): a boxed type, so that bindings
@@ -51,6 +54,10 @@ typedef struct {
 	gdouble tvec[3];
 	gdouble reprojection_error;
 	gdouble alternative_reprojection_error;
+
+	/* Since 0.3; appended: the library allocates every GstFrappeMarker. */
+	gboolean tracking;
+	gboolean tracked;
 } GstFrappeMarker;
 
 GST_FRAPPE_META_API GType gst_frappe_marker_get_type(void);

@@ -23,6 +23,7 @@ struct MetaRecord {
 	Marker marker;
 	MarkerPose pose;
 	bool hasPose = false;
+	bool tracking = false;
 	const char *dictionary = "";
 
 	explicit MetaRecord(const GstFrappeMarkerMeta &m)
@@ -32,6 +33,8 @@ struct MetaRecord {
 			marker.corners[k] = { m.corners[2 * k], m.corners[2 * k + 1] };
 		marker.hamming = static_cast<int>(m.hamming);
 		marker.margin = m.margin;
+		marker.tracked = m.tracked;
+		tracking = m.tracking;
 		hasPose = m.has_pose;
 		for (std::size_t k = 0; k < 3; ++k) {
 			pose.pose.rvec[k] = m.rvec[k];
@@ -42,7 +45,7 @@ struct MetaRecord {
 		dictionary = m.dictionary ? m.dictionary : "";
 	}
 
-	MarkerRecord record() const { return { &marker, dictionary, hasPose ? &pose : nullptr }; }
+	MarkerRecord record() const { return { &marker, dictionary, hasPose ? &pose : nullptr, tracking }; }
 };
 
 } // namespace frappe::gst

@@ -29,7 +29,18 @@ static gboolean frappe_marker_meta_init(GstMeta *meta, gpointer, GstBuffer *)
 	m->reprojection_error = 0.0;
 	m->alternative_reprojection_error = 0.0;
 	m->margin = 0.0f;
+	m->tracking = FALSE;
+	m->tracked = FALSE;
 	return TRUE;
+}
+
+/* Every field of src after the GstMeta header: a new field is copied with
+ * the others, never listed here. */
+static void copyFields(GstFrappeMarkerMeta *m, const GstFrappeMarkerMeta *src)
+{
+	const GstMeta head = m->meta;
+	*m = *src;
+	m->meta = head;
 }
 
 static gboolean frappe_marker_meta_transform(GstBuffer *dest, GstMeta *meta, GstBuffer *,
@@ -42,12 +53,7 @@ static gboolean frappe_marker_meta_transform(GstBuffer *dest, GstMeta *meta, Gst
 			dest, src->id, src->dictionary, src->corners, src->hamming);
 		if (!m)
 			return FALSE;
-		m->has_pose = src->has_pose;
-		std::memcpy(m->rvec, src->rvec, sizeof(m->rvec));
-		std::memcpy(m->tvec, src->tvec, sizeof(m->tvec));
-		m->reprojection_error = src->reprojection_error;
-		m->alternative_reprojection_error = src->alternative_reprojection_error;
-		m->margin = src->margin;
+		copyFields(m, src);
 		return TRUE;
 	}
 
@@ -66,13 +72,12 @@ static gboolean frappe_marker_meta_transform(GstBuffer *dest, GstMeta *meta, Gst
 		if (!m)
 			return FALSE;
 		/* The pose is in metres in the camera frame: scaling the image does
-		 * not move the marker. The reprojection error is in pixels. */
-		m->has_pose = src->has_pose;
-		std::memcpy(m->rvec, src->rvec, sizeof(m->rvec));
-		std::memcpy(m->tvec, src->tvec, sizeof(m->tvec));
+		 * not move the marker. The corners and the reprojection errors are
+		 * in pixels. */
+		copyFields(m, src);
+		std::memcpy(m->corners, corners, sizeof(m->corners));
 		m->reprojection_error = src->reprojection_error * (sx + sy) / 2.0;
 		m->alternative_reprojection_error = src->alternative_reprojection_error * (sx + sy) / 2.0;
-		m->margin = src->margin;
 		return TRUE;
 	}
 

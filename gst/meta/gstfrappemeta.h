@@ -48,6 +48,11 @@ G_BEGIN_DECLS
  *   between black and white, as a fraction of half the black-white
  *   contrast (frappe::Marker::margin). Near 0, some cell was nearly a coin
  *   toss; filter on it to trade misses for certainty.
+ * @tracking: whether frappedetect ran with mode=track on this frame (then
+ *   @tracked says how this marker was found). Since: 0.3
+ * @tracked: with @tracking, %TRUE when the marker continued a track of
+ *   the last frames (read where they predicted it), %FALSE when it was
+ *   found afresh; %FALSE without @tracking. Since: 0.3
  *
  * One marker found by frappedetect. A buffer carries one meta per marker;
  * iterate them with gst_buffer_iterate_meta_filtered() and
@@ -79,6 +84,9 @@ typedef struct {
 	gdouble alternative_reprojection_error;
 
 	gfloat margin;
+	/* Since 0.3; appended, so that 0.2's fields keep their offsets. */
+	gboolean tracking;
+	gboolean tracked;
 } GstFrappeMarkerMeta;
 
 /**

@@ -78,13 +78,16 @@ class Pose:
 class Marker:
     """One marker of a frame: corners in pixels (top-left, top-right,
     bottom-right, bottom-left of the black border, the marker upright),
-    `pose` None when the robot knows no camera or marker size."""
+    `pose` None when the robot knows no camera or marker size; `tracked`
+    None unless the robot runs mode=track, then whether the marker continued
+    a track of the last frames (False: found afresh)."""
     id: int
     dictionary: str
     corners: List[Tuple[float, float]]
     hamming: Optional[int] = None
     margin: Optional[float] = None
     pose: Optional[Pose] = None
+    tracked: Optional[bool] = None
 
     @property
     def center(self) -> Tuple[float, float]:
@@ -164,7 +167,7 @@ def _marker(m: dict) -> Marker:
                     m.get("alternative_reprojection_error"))
     return Marker(id=int(m["id"]), dictionary=m.get("dictionary", ""),
                   corners=[(float(x), float(y)) for x, y in m["corners"]], hamming=m.get("hamming"),
-                  margin=m.get("margin"), pose=pose)
+                  margin=m.get("margin"), pose=pose, tracked=m.get("tracked"))
 
 
 def _bundle(b: Optional[dict]) -> Optional[BundlePose]:

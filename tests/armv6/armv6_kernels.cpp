@@ -201,18 +201,20 @@ private:
 
 /* The tracer with the ARMv6 walk and with the portable one: the same
  * quads, bit for bit, and as many borders; as an edge map and as a region
- * map is traced, each with and without a probe. */
+ * map is traced, each with and without a probe, and with and without the
+ * corner pixels (the walk without them, frappe_armv6_follow_bare). */
 void compareTracers(const TraceMap &map, const char *what)
 {
 	if (map.width < 3 || map.height < 3)
 		return;
-	for (int kind = 0; kind < 4; ++kind) {
+	for (int kind = 0; kind < 8; ++kind) {
 		TraceParams params;
 		if (kind & 1) {
 			params.min_clusters = 0;
 			params.max_winding = 2.0f;
 			params.min_side = 4.0f;
 		}
+		params.corners = (kind & 4) == 0;
 		ContourTracer asmWalk, portable;
 		portable.usePortableWalk(true);
 		EveryOtherProbe probe1, probe2;

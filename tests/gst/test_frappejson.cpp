@@ -270,6 +270,62 @@ TEST(Json, AppsinkGetsOneLinePerFrame)
 	gst_object_unref(pipeline);
 }
 
+/* mode=track: each marker meta says the frame was tracked and whether the
+ * marker continued a track (from the second frame of the same markers on),
+ * and frappejson writes `tracked` from them; without mode=track there is no
+ * `tracked` anywhere. */
+TEST(Json, TrackedOnlyInTrackMode)
+{
+	constexpr int kFrames = 4;
+	for (const bool track : { true, false }) {
+		GstElement *pipeline =
+			runPipeline(std::string("appsrc name=src ! frappedetect") + (track ? " mode=track" : "") +
+					    " ! tee name=t t. ! queue ! appsink name=metas sync=false "
+					    "max-buffers=100 t. ! queue ! frappejson max-bytes=0 ! "
+					    "appsink name=lines sync=false max-buffers=100",
+				    kFrames);
+		GstElement *metas = gst_bin_get_by_name(GST_BIN(pipeline), "metas");
+		GstElement *lines = gst_bin_get_by_name(GST_BIN(pipeline), "lines");
+		for (int i = 0; i < kFrames; ++i) {
+			GstSample *sample = gst_app_sink_try_pull_sample(GST_APP_SINK(metas), 10 * GST_SECOND);
+			ASSERT_NE(sample, nullptr) << "frame " << i;
+			int n = 0;
+			gpointer state = nullptr;
+			GstMeta *meta;
+			while ((meta = gst_buffer_iterate_meta_filtered(gst_sample_get_buffer(sample), &state,
+									GST_FRAPPE_MARKER_META_API_TYPE))) {
+				const auto *m = reinterpret_cast<const GstFrappeMarkerMeta *>(meta);
+				EXPECT_EQ(m->tracking, track) << "frame " << i;
+				EXPECT_EQ(m->tracked, track && i > 0) << "frame " << i << " id " << m->id;
+				++n;
+			}
+			EXPECT_EQ(n, 2) << "frame " << i;
+			gst_sample_unref(sample);
+
+			sample = gst_app_sink_try_pull_sample(GST_APP_SINK(lines), 10 * GST_SECOND);
+			ASSERT_NE(sample, nullptr) << "line " << i;
+			const std::string line = text(gst_sample_get_buffer(sample));
+			const std::string want = track ? (i > 0 ? "\"tracked\": true" : "\"tracked\": false") : "";
+			for (const char *id : { "\"id\": 7, ", "\"id\": 42, " }) {
+				const std::size_t at = line.find(id);
+				ASSERT_NE(at, std::string::npos) << line;
+				const std::size_t end = line.find('}', at);
+				const std::string marker = line.substr(at, end - at);
+				if (track) {
+					EXPECT_NE(marker.find(want), std::string::npos) << marker;
+				} else {
+					EXPECT_EQ(marker.find("tracked"), std::string::npos) << marker;
+				}
+			}
+			gst_sample_unref(sample);
+		}
+		gst_object_unref(metas);
+		gst_object_unref(lines);
+		gst_element_set_state(pipeline, GST_STATE_NULL);
+		gst_object_unref(pipeline);
+	}
+}
+
 /* udpsink sends each line as one datagram. */
 TEST(Json, UdpsinkSendsOneDatagramPerLine)
 {

@@ -208,8 +208,9 @@ TEST(Refused, WhileStoppedFailsTheNextStart)
 			g_param_spec_get_blurb(g_object_class_find_property(G_OBJECT_GET_CLASS(d), r.property.c_str()));
 		for (const std::string &words : { r.property + "=\"", std::string("refused: "), std::string(blurb) })
 			EXPECT_NE(e.text.find(words), std::string::npos) << words << " in " << e.text;
-		if (r.bad[0] != '<')
+		if (r.bad[0] != '<') {
 			EXPECT_NE(e.text.find("=\"" + r.bad + "\""), std::string::npos) << e.text;
+		}
 		gst_element_set_state(pipeline, GST_STATE_NULL);
 
 		/* Set right: it starts, and plays to the end. */

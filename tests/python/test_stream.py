@@ -121,6 +121,14 @@ def test_the_old_line_form_is_one_frame_a_line_numbered_by_arrival():
     assert frames[0].width is None and r.stats.lost == 0
 
 
+def test_tracked_is_read_when_the_robot_tracks_and_none_otherwise():
+    r = stream.Reassembler()
+    found, tracked, plain = marker(1, pose=False), marker(2, pose=False), marker(3, pose=False)
+    found["tracked"], tracked["tracked"] = False, True
+    frames = feed(r, [json.dumps({"pts": 0, "markers": [found, tracked, plain]})])
+    assert [m.tracked for m in frames[0].markers] == [False, True, None]
+
+
 def test_a_bad_line_is_an_error_that_says_so():
     r = stream.Reassembler()
     for bad in ["not json", "[1, 2]", '{"frame": 1}', '{"frame": 1, "part": 3, "parts": 2, "markers": []}']:

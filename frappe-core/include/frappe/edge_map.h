@@ -6,6 +6,7 @@
 #include "frappe/export.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -64,14 +65,16 @@ struct FrontEndParams {
 	/// The shade map's threshold for tile extremes lo and hi that pass the
 	/// contrast test: the least r with (r + 4)^2 >= (lo + 4)(hi + 4), so
 	/// that r is dark exactly when (r + 4)^2 < (lo + 4)(hi + 4).
+	/// (p >= 16, so r = ceil(sqrt(p)) - 4 >= 0.)
 	static int shadeThreshold(int lo, int hi)
 	{
 		const int p = (lo + kShadeFloor) * (hi + kShadeFloor);
-		int r = 0;
-		for (int bit = 256; bit > 0; bit >>= 1) /* the greatest r with (r + 4)^2 < p, plus one */
-			if ((r + bit + kShadeFloor) * (r + bit + kShadeFloor) < p)
-				r += bit;
-		return (r + kShadeFloor) * (r + kShadeFloor) < p ? r + 1 : r;
+		/* A float square root of p (exact below 2^24) is within one of
+		 * floor(sqrt(p)); the integer tests make it exact. */
+		int s = static_cast<int>(std::sqrt(static_cast<float>(p)));
+		s -= s * s > p;
+		s += (s + 1) * (s + 1) <= p;
+		return (s * s < p ? s + 1 : s) - kShadeFloor;
 	}
 };
 

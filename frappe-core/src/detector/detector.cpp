@@ -38,8 +38,10 @@ using detail::toFullResolution;
 class TracedMarkerProbe final : public detail::MarkerProbe
 {
 public:
-	TracedMarkerProbe(const ImageView &image, float scale, const detail::CodeBook &codes, int maxHamming)
-		: image_(image), scale_(scale), codes_(codes), dict_(codes.dictionary()), maxHamming_(maxHamming)
+	TracedMarkerProbe(const ImageView &image, float scale, const detail::CodeBook &codes, int maxHamming,
+			  detail::DecodeCache &decodes)
+		: image_(image), scale_(scale), codes_(codes), dict_(codes.dictionary()), maxHamming_(maxHamming),
+		  decodes_(decodes)
 	{
 	}
 	/* Notes in quad.probeRead how many border cells read white at the
@@ -66,11 +68,11 @@ public:
 		quad.probeReadable = detail::readable(b, dict_.bits);
 		if (!quad.probeReadable)
 			return false;
-		if (codes_.decode(b.code, 0).id >= 0)
+		if (decodes_.decode(codes_, b.code, 0).id >= 0)
 			return true;
 		/* Not sealed, but ranked before clutter when a frame has more
 		 * candidates than it may read (capCandidates()). */
-		quad.probeNearCode = maxHamming_ > 0 && codes_.decode(b.code, maxHamming_).id >= 0;
+		quad.probeNearCode = maxHamming_ > 0 && decodes_.decode(codes_, b.code, maxHamming_).id >= 0;
 		return false;
 	}
 
@@ -80,6 +82,7 @@ private:
 	const detail::CodeBook &codes_;
 	const Dictionary &dict_;
 	int maxHamming_;
+	detail::DecodeCache &decodes_;
 	detail::WarpedMarker cellCentres_;
 };
 
@@ -128,7 +131,7 @@ void Detector::Impl::trace(Slot &slot)
 	tp.cluster_radius = config.corner_cluster_radius;
 	tp.min_side = std::max(4.0f, config.min_marker_side * scale);
 	tp.border_margin = 1.0f;
-	TracedMarkerProbe probe(slot.image, scale, *codes, maxHamming);
+	TracedMarkerProbe probe(slot.image, scale, *codes, maxHamming, traceDecodes);
 	tracer.trace(edges, tp, quads, &probe);
 	/* Region borders have no corner pixels: every closed one is fitted
 	 * from its outline. Their quads join the edge ones in the edge map's
@@ -141,8 +144,9 @@ void Detector::Impl::trace(Slot &slot)
 		rtp.min_clusters = 0;
 		rtp.max_winding = 2.0f;
 		rtp.holes = false;
+		rtp.corners = false; /* kEdge alone marks a region pixel */
 		rtp.min_side = std::max(4.0f, config.min_marker_side * regions->scale);
-		TracedMarkerProbe regionProbe(slot.image, regions->scale, *codes, maxHamming);
+		TracedMarkerProbe regionProbe(slot.image, regions->scale, *codes, maxHamming, traceDecodes);
 		regionTracer.trace(*regions, rtp, regionQuads, &regionProbe);
 		const float toEdges = scale / regions->scale;
 		for (detail::Quad q : regionQuads) {

@@ -73,6 +73,7 @@ struct FRAPPE_HIDDEN Detector::Impl {
 	detail::ContourTracer regionTracer;
 	std::vector<detail::Quad> regionQuads;
 	detail::PointGrid quadGrid;          /* removeDuplicateQuads()'s, in trace() */
+	detail::DecodeCache traceDecodes;    /* the marker probes' decodes, in trace() */
 	detail::RegionScratch regionScratch; /* for a front end without a region map */
 	/* For a front end without a shade map: the frame it traced, scaled, and
 	 * the region map made beside the shades (not used). */

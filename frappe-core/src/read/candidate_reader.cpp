@@ -245,7 +245,7 @@ void detail::CandidateReader::sampleRefined(Reading &r, const detail::Quad &q, s
 			r.samples = &warped;
 		}
 	} else {
-		r.refined = detail::warpMarker(r.block.view, q.corners, dict->bits, warped, pol.tone);
+		r.refined = detail::warpMarker(r.block.view, q.corners, dict->bits, warped, pol.tone, pol.memo);
 	}
 	timer.lap(Stage::Decode);
 	if (r.refined)
@@ -263,7 +263,8 @@ void detail::CandidateReader::readInset(Reading &r, detail::Quad &q, const detai
 		r.inset = detail::insetCorners(r.block.view, r.insetCorners, dict->bits) ? 1 : -1;
 	}
 	q.corners = r.inset > 0 ? r.insetCorners : r.outline;
-	const bool inset = r.inset > 0 && detail::warpMarker(r.block.view, q.corners, dict->bits, warped, pol.tone);
+	const bool inset =
+		r.inset > 0 && detail::warpMarker(r.block.view, q.corners, dict->bits, warped, pol.tone, pol.memo);
 	r.readable = inset && bigEnough(q.corners, r.minSide);
 	if (!r.readable)
 		return;
@@ -301,7 +302,7 @@ detail::MarkerRead detail::CandidateReader::decodeCandidate(const Reading &r, de
 	if (!read.ok() && r.refined && r.b.border_errors < whiteFrame()) {
 		/* Refinement can pull a blurred marker's sides onto its code's
 		 * edges; the traced outline may still read. */
-		if (detail::warpMarker(img, r.outline, bits, warped, pol.tone)) {
+		if (detail::warpMarker(img, r.outline, bits, warped, pol.tone, pol.memo)) {
 			const detail::Binarised bt = detail::binarise(warped, bits);
 			if (detail::readable(bt, bits)) {
 				read = detail::readMarker(img, r.outline, *codes, pol, warped, bt);
@@ -372,6 +373,12 @@ detail::MarkerRead detail::CandidateReader::readRefined(Reading &r, detail::Quad
 {
 	const Reading refined = r;
 	const std::array<Point2f, 4> refinedCorners = q.corners;
+	/* Each read warps the corners the one before it did (a tone applies
+	 * after the warp): the later ones copy its samples. */
+	warpMemo.clear();
+	DecodePolicy onGrey = policy, onLog = logPolicy, onClip = clipPolicy;
+	onGrey.memo = onLog.memo = onClip.memo = &warpMemo;
+	onGrey.decodes = onLog.decodes = onClip.decodes = &decodes;
 	auto readWith = [&](const detail::DecodePolicy &pol) {
 		sampleRefined(r, q, k, pol, timer);
 		if (!r.refined || r.b.border_errors >= whiteFrame())
@@ -379,7 +386,7 @@ detail::MarkerRead detail::CandidateReader::readRefined(Reading &r, detail::Quad
 		timer.lap(Stage::Decode);
 		return decodeCandidate(r, q, pol);
 	};
-	detail::MarkerRead read = readWith(policy);
+	detail::MarkerRead read = readWith(onGrey);
 	const bool counted = r.counted;
 	/* Whites at the sensor's ceiling in what the first read sampled. */
 	const bool clipped = !read.ok() && r.samples && clipsWhite(*r.samples);
@@ -392,10 +399,10 @@ detail::MarkerRead detail::CandidateReader::readRefined(Reading &r, detail::Quad
 		q.corners = refinedCorners;
 		read = readWith(pol);
 	};
-	if (!read.ok() && !logPolicy.tone.linear())
-		readAgain(logPolicy);
-	if (!read.ok() && clipped && !clipPolicy.tone.linear())
-		readAgain(clipPolicy);
+	if (!read.ok() && !onLog.tone.linear())
+		readAgain(onLog);
+	if (!read.ok() && clipped && !onClip.tone.linear())
+		readAgain(onClip);
 	result.candidates += counted || r.counted;
 	return read;
 }

@@ -112,6 +112,8 @@ private:
 	std::vector<Quad> trackQuads;
 	Result trackResult;
 	WarpedMarker warped;
+	WarpMemo warpMemo;   /* one candidate's warps, for its later reads */
+	DecodeCache decodes; /* the read stage's last decodes */
 	/* Candidates with large cells are read on the frame halved into blocks
 	 * of f pixels (readBlock()): a patch around the candidate, or the whole
 	 * frame once the frame's patches would read more than it (then kept for

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <cstring>
 
 #include "frappe/homography.h"
 #include "corner_refine.h"
@@ -67,10 +68,42 @@ void Tone::fillTable(float *out256) const
 		out256[g] = expScale > 0.0f ? apply(static_cast<float>(g)) : logSample(static_cast<float>(g), k, norm);
 }
 
-bool warpMarker(const ImageView &image, const std::array<Point2f, 4> &corners, int bits,
-		WarpedMarker &out, Tone tone)
+bool WarpMemo::warp(const ImageView &image, const std::array<Point2f, 4> &corners, int side, bool fine,
+		    WarpedMarker &out)
 {
-	if (!warpToGrid(image, corners, (bits + 2) * kSamplesPerCell, out))
+	for (int i = 0; i < used_; ++i) {
+		const Entry &e = entries_[static_cast<std::size_t>(i)];
+		/* Corners compared as bits: the same floats, the same warp. */
+		if (e.side == side && e.fine == fine && e.image.data == image.data && e.image.width == image.width &&
+		    e.image.height == image.height && e.image.stride == image.stride &&
+		    std::memcmp(e.corners.data(), corners.data(), sizeof corners) == 0) {
+			if (e.ok) {
+				out.side = e.samples.side;
+				std::copy_n(e.samples.samples.begin(), side * side, out.samples.begin());
+			}
+			return e.ok;
+		}
+	}
+	Entry &e = entries_[static_cast<std::size_t>(next_)];
+	next_ = (next_ + 1) % kEntries;
+	used_ = std::min(used_ + 1, kEntries);
+	e.image = image;
+	e.corners = corners;
+	e.side = side;
+	e.fine = fine;
+	e.ok = warpToGrid(image, corners, side, e.samples, fine);
+	if (e.ok) {
+		out.side = e.samples.side;
+		std::copy_n(e.samples.samples.begin(), side * side, out.samples.begin());
+	}
+	return e.ok;
+}
+
+bool warpMarker(const ImageView &image, const std::array<Point2f, 4> &corners, int bits, WarpedMarker &out, Tone tone,
+		WarpMemo *memo)
+{
+	const int side = (bits + 2) * kSamplesPerCell;
+	if (!(memo ? memo->warp(image, corners, side, false, out) : warpToGrid(image, corners, side, out)))
 		return false;
 	tone.apply(out);
 	return true;
@@ -126,7 +159,7 @@ bool warpToGridScalar(const ImageView &image, const std::array<Point2f, 4> &corn
 }
 
 bool warpCellCentres(const ImageView &image, const std::array<Point2f, 4> &corners, int bits, float sharpening,
-		     WarpedMarker &out, float *reference, Tone tone)
+		     WarpedMarker &out, float *reference, Tone tone, WarpMemo *memo)
 {
 	const auto H = Homography::fromUnitSquare(corners);
 	if (!H)
@@ -138,7 +171,7 @@ bool warpCellCentres(const ImageView &image, const std::array<Point2f, 4> &corne
 	const std::array<Point2f, 4> grown = { H->map(-m, -m), H->map(1 + m, -m), H->map(1 + m, 1 + m),
 					       H->map(-m, 1 + m) };
 	WarpedMarker grid;
-	if (!warpToGrid(image, grown, side, grid, true))
+	if (!(memo ? memo->warp(image, grown, side, true, grid) : warpToGrid(image, grown, side, grid, true)))
 		return false;
 	tone.apply(grid);
 	out.side = cells;
@@ -197,10 +230,16 @@ bool insetQuad(const ImageView &image, std::array<Point2f, 4> &corners, int bits
 	return true;
 }
 
-Binarised binarise(const WarpedMarker &w, int bits)
+namespace {
+
+/* binarise() with k samples a cell side; a constant K (the grids of
+ * warpMarker, 2, and of cell centres, 1) lets the cell means unroll: the
+ * same sums in the same order, so the same floats. */
+template<int K>
+Binarised binariseWith(const WarpedMarker &w, int bits, int kAny)
 {
 	const int cells = bits + 2;
-	const int k = std::max(1, w.side / cells); /* samples per cell side */
+	const int k = K > 0 ? K : kAny;
 	float lo = 1e9f, hi = -1e9f;
 	for (int y = k; y < (bits + 1) * k; ++y) {
 		for (int x = k; x < (bits + 1) * k; ++x) {
@@ -226,6 +265,18 @@ Binarised binarise(const WarpedMarker &w, int bits)
 		out.border_errors += mean(cells - 1, c) > thr;
 	}
 	return out;
+}
+
+} // namespace
+
+Binarised binarise(const WarpedMarker &w, int bits)
+{
+	const int k = std::max(1, w.side / (bits + 2)); /* samples per cell side */
+	if (k == kSamplesPerCell)
+		return binariseWith<kSamplesPerCell>(w, bits, k);
+	if (k == 1)
+		return binariseWith<1>(w, bits, k);
+	return binariseWith<0>(w, bits, k);
 }
 
 namespace {
@@ -371,6 +422,21 @@ Decoded CodeBook::decode(std::uint64_t code, int maxHamming) const
 	if (exact.id >= 0)
 		return exact;
 	return maxHamming > 0 ? frappe::detail::decode(*dict_, code, maxHamming) : Decoded{};
+}
+
+Decoded DecodeCache::decode(const CodeBook &codes, std::uint64_t code, int maxHamming)
+{
+	/* Fibonacci hashing of the code, the distance mixed in. */
+	const std::uint64_t key = code ^ static_cast<std::uint64_t>(static_cast<std::uint32_t>(maxHamming)) << 56;
+	Entry &e = entries_[static_cast<std::size_t>((key * 0x9E3779B97F4A7C15ull) >> 56)];
+	static_assert(kEntries == 256);
+	if (e.codes != &codes || e.code != code || e.maxHamming != maxHamming) {
+		e.codes = &codes;
+		e.code = code;
+		e.maxHamming = maxHamming;
+		e.decoded = codes.decode(code, maxHamming);
+	}
+	return e.decoded;
 }
 
 } // namespace frappe::detail

@@ -66,11 +66,38 @@ bool warpToGrid(const ImageView &image, const std::array<Point2f, 4> &corners, i
 bool warpToGridScalar(const ImageView &image, const std::array<Point2f, 4> &corners, int side, WarpedMarker &out,
 		      bool fine = false);
 
+/// The grey-level grids one candidate's reads have warped: a read on another
+/// Tone (the log scale, the exponential one) warps the same corners again,
+/// and a tone applies to the samples after the warp, so it takes a copy
+/// instead of sampling the frame again (the same samples to the bit).
+/// Holds the last kEntries warps; clear() before each candidate (the frame
+/// under the same pointer changes between frames).
+class WarpMemo {
+public:
+	void clear() { used_ = 0; }
+	/// warpToGrid(image, corners, side, out, fine), from the memo when it
+	/// made these very arguments' samples before.
+	bool warp(const ImageView &image, const std::array<Point2f, 4> &corners, int side, bool fine,
+		  WarpedMarker &out);
+
+private:
+	static constexpr int kEntries = 6;
+	struct Entry {
+		ImageView image;
+		std::array<Point2f, 4> corners;
+		int side = 0;
+		bool fine = false, ok = false;
+		WarpedMarker samples;
+	};
+	std::array<Entry, kEntries> entries_;
+	int used_ = 0, next_ = 0;
+};
+
 /// Warps the quad (clockwise, corners[0] mapped to the grid's top-left) into
 /// the sample grid of a marker with `bits` bits a side. False when the quad
-/// is degenerate.
-bool warpMarker(const ImageView &image, const std::array<Point2f, 4> &corners, int bits,
-		WarpedMarker &out, Tone tone = {});
+/// is degenerate. With a memo, a warp it holds is copied from it.
+bool warpMarker(const ImageView &image, const std::array<Point2f, 4> &corners, int bits, WarpedMarker &out,
+		Tone tone = {}, WarpMemo *memo = nullptr);
 
 /// Treats `corners` as the outline of a one-cell quiet zone: moves them one
 /// cell inwards and re-measures the sides there. False when the inner
@@ -93,7 +120,7 @@ bool insetQuad(const ImageView &image, std::array<Point2f, 4> &corners, int bits
 /// the grey level halfway between the mean of the border cells and that of
 /// the ring outside them. False when the quad is degenerate.
 bool warpCellCentres(const ImageView &image, const std::array<Point2f, 4> &corners, int bits, float sharpening,
-		     WarpedMarker &out, float *reference = nullptr, Tone tone = {});
+		     WarpedMarker &out, float *reference = nullptr, Tone tone = {}, WarpMemo *memo = nullptr);
 
 /// The bits of a warped marker, read as in the dictionary files with the
 /// grid's top-left cell first.
@@ -150,6 +177,28 @@ private:
 	const Dictionary *dict_;
 	std::vector<std::pair<std::uint64_t, int>> sorted_; ///< (code, id), by code
 	std::vector<std::uint8_t> plain_;
+};
+
+/// The last decodes of one stage of the detector: CodeBook::decode() is a
+/// function of the code and maxHamming alone, and a frame reads the same
+/// codes many times over (a candidate's reads on each Tone and at its cell
+/// centres; the probe's reads of a marker's nested outlines): two thirds of
+/// the scans of every codeword on synth/images repeat one of the last 64.
+/// Direct-mapped; one per stage (stages of different frames run at once).
+class DecodeCache {
+public:
+	/// codes.decode(code, maxHamming), from the cache when it holds it.
+	Decoded decode(const CodeBook &codes, std::uint64_t code, int maxHamming);
+
+private:
+	static constexpr int kEntries = 256;
+	struct Entry {
+		const CodeBook *codes = nullptr;
+		std::uint64_t code = 0;
+		int maxHamming = 0;
+		Decoded decoded;
+	};
+	std::array<Entry, kEntries> entries_{};
 };
 
 /// Whether an n x n code inside its black border is a plain shape: at most

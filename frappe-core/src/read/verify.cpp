@@ -293,7 +293,8 @@ MarkerRead readMarker(const ImageView &image, const std::array<Point2f, 4> &corn
 {
 	const Dictionary &dict = codes.dictionary();
 	MarkerRead out;
-	out.decoded = codes.decode(b.code, policy.maxTotal);
+	out.decoded = policy.decodes ? policy.decodes->decode(codes, b.code, policy.maxTotal)
+				     : codes.decode(b.code, policy.maxTotal);
 	if (out.decoded.id < 0)
 		return out;
 	if (!unambiguous(out.decoded, dict)) {
@@ -318,7 +319,7 @@ MarkerRead readMarker(const ImageView &image, const std::array<Point2f, 4> &corn
 		 * that chance reads often must still sit on real cells, as judged
 		 * by samples a quarter cell from their edges. */
 		WarpedMarker quarters;
-		if (!warpMarker(image, corners, dict.bits, quarters, policy.tone)) {
+		if (!warpMarker(image, corners, dict.bits, quarters, policy.tone, policy.memo)) {
 			out.rejection = Rejection::CellsDisagree;
 			return out;
 		}
@@ -347,7 +348,7 @@ MarkerRead readCellCentres(const ImageView &image, const std::array<Point2f, 4> 
 {
 	const int bits = codes.dictionary().bits;
 	float reference = 0.0f;
-	if (!warpCellCentres(image, corners, bits, kSharpening, scratch, &reference, policy.tone))
+	if (!warpCellCentres(image, corners, bits, kSharpening, scratch, &reference, policy.tone, policy.memo))
 		return {};
 	const Binarised b = binarise(scratch, bits);
 	const float lo = b.threshold - 0.5f * b.contrast, hi = b.threshold + 0.5f * b.contrast;

@@ -125,6 +125,12 @@ struct DecodePolicy {
 	int maxTotal = 0;         ///< bits corrected in all, weak reads included
 	float weakMargin = 0.0f;  ///< a code cell's margin below this is a weak read
 	Tone tone;                ///< the scale samples are read on
+	/// Where the warps of this candidate's earlier reads are kept (none:
+	/// every warp samples the frame).
+	WarpMemo *memo = nullptr;
+	/// Where this stage's last decodes are kept (none: every code is
+	/// looked up).
+	DecodeCache *decodes = nullptr;
 };
 
 /// Why a candidate is not a marker.

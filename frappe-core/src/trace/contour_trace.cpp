@@ -24,6 +24,7 @@
 #include <cstddef>
 #include <cstring>
 #include <span>
+#include <type_traits>
 
 namespace frappe::detail {
 
@@ -37,17 +38,12 @@ static_assert((kUnfollowed | kMarkFollowed) == kFollowed && (kFollowed | kMarkRi
 /* Neighbour offsets, counter-clockwise on screen starting at the right. */
 constexpr int kDx[8] = { 1, 1, 0, -1, -1, -1, 0, 1 };
 constexpr int kDy[8] = { 0, -1, -1, -1, 0, 1, 1, 1 };
-/* Where the walk's window of neighbour masks holds direction d's. */
-constexpr int kWindowByte[8] = { 4, 2, 1, 0, 3, 5, 6, 7 };
 
 /* xy steps per direction back (the move is the opposite direction). */
 constexpr std::int32_t kDxyBack[8] = { -kDx[0] - kDy[0] * 65536, -kDx[1] - kDy[1] * 65536,
 				       -kDx[2] - kDy[2] * 65536, -kDx[3] - kDy[3] * 65536,
 				       -kDx[4] - kDy[4] * 65536, -kDx[5] - kDy[5] * 65536,
 				       -kDx[6] - kDy[6] * 65536, -kDx[7] - kDy[7] * 65536 };
-/* stepTable_ holds kDxyBack first, then the steps: the ARMv6 walk reaches
- * both from one base register. */
-constexpr std::size_t kStepTableAt = 8;
 
 /* Step 3.3 of Suzuki's algorithm as a table: for the direction `back` to the
  * previous border pixel and the mask of non-zero neighbours (bit d for
@@ -205,7 +201,7 @@ struct FollowAsm {
 	std::uint32_t xy;		  ///< 4: its coordinates, x | y << 16
 	std::uint32_t *out, *cout;	  ///< 8, 12: where its point and corner go
 	std::uint32_t s;		  ///< 16: in: the table row (back << 9); out: the entry
-	const std::int32_t *table;	  ///< 20: the step table (kDxyBack at table - 8)
+	const std::int32_t *table;        ///< 20: the step table (kDxyBack[b] at row b, index 0)
 	std::int32_t up, down;		  ///< 24, 28: -w - 1, w - 1
 	std::int32_t toEdge;		  ///< 32: edge map minus labels (bytes)
 	const std::uint8_t *p1;		  ///< 36
@@ -214,6 +210,9 @@ struct FollowAsm {
 };
 static_assert(offsetof(FollowAsm, mask) == 44);
 extern "C" void frappe_armv6_follow(FollowAsm *a);
+/* The same without the corner list (cout is left as it is): for maps
+ * without corner pixels. */
+extern "C" void frappe_armv6_follow_bare(FollowAsm *a);
 
 /* r1 p, r2 xy, r3 out, r4 cout, r5 row / entry, r6 table, r7 up, r8 down,
  * r9 toEdge, r10 p1, r11 outEnd, r12 mask; r0, lr temporaries. The index
@@ -223,19 +222,19 @@ __asm__(R"(
 	.text
 	.arm
 	.syntax unified
+	.macro FRAPPE_FOLLOW name, corners
 	.p2align 2
-	.type frappe_armv6_follow, %function
-frappe_armv6_follow:
+	.type \name, %function
+\name:
 	push    {r0, r4-r11, lr}
 	ldm     r0, {r1-r12}
-	b       .Lfw_body
-.Lfw_step:
+	b       .Lfw_body\@
+.Lfw_step\@:
 	add     r1, r1, r5, asr #12     @ p = next
 	and     r5, r5, #0xE00          @ the next row: direction back
-	add     lr, r6, r5, lsr #7
-	ldr     lr, [lr, #-32]          @ kDxyBack[back]
+	ldr     lr, [r6, r5, lsl #2]    @ kDxyBack[back], at the row's index 0
 	add     r2, r2, lr
-.Lfw_body:
+.Lfw_body\@:
 	ldr     lr, [r1, r7]            @ row above, columns x-1 .. x+2
 	ldr     r0, [r1, #-1]
 	orr     lr, lr, r0, lsl #1
@@ -252,17 +251,23 @@ frappe_armv6_follow:
 	orr     r0, r0, lr
 	strb    r0, [r1]                @ mark the pixel
 	str     r2, [r3], #4            @ its point
+	.if \corners
 	str     r2, [r4]                @ and, kept if it is a corner,
 	ldrb    r0, [r1, r9]
 	and     r0, r0, #2
 	add     r4, r4, r0, lsl #1      @ its corner
+	.endif
 	cmp     r3, r11
 	cmpne   r1, r10
-	bne     .Lfw_step
+	bne     .Lfw_step\@
 	pop     {r0}
 	stm     r0, {r1-r5}
 	pop     {r4-r11, pc}
-	.size frappe_armv6_follow, .-frappe_armv6_follow
+	.size \name, .-\name
+	.endm
+	FRAPPE_FOLLOW frappe_armv6_follow, 1
+	FRAPPE_FOLLOW frappe_armv6_follow_bare, 0
+	.purgem FRAPPE_FOLLOW
 )"
 #if defined(__thumb__)
 	"\t.thumb\n"
@@ -286,7 +291,8 @@ void ContourTracer::buildStepTables(int w)
 				st.offset = static_cast<std::int16_t>(kDx[d] + kDy[d] * w);
 				st.back = static_cast<std::uint8_t>((d + 4) & 7);
 				st.mark = (e & 8) ? kMarkRightBg : kMarkFollowed;
-				st.shift = static_cast<std::uint8_t>(8 * kWindowByte[d]);
+				st.dxy = static_cast<std::uint32_t>(kDx[d]) +
+					 static_cast<std::uint32_t>(kDy[d]) * 65536u;
 			}
 		stepTable_.clear();
 		return;
@@ -294,17 +300,20 @@ void ContourTracer::buildStepTables(int w)
 	/* kRowStep as (offset << 12) | back' << 9 | mark: the move's pointer
 	 * offset, the direction back from the pixel it reaches (which selects
 	 * the next row of the table), and the label mark of the pixel it
-	 * leaves. */
-	stepTable_.resize(kStepTableAt + 8 * 512);
-	std::copy(kDxyBack, kDxyBack + 8, stepTable_.begin());
+	 * leaves. A walked pixel's own label sets bit 4 of its index, so
+	 * indices 0 .. 15 are never looked up: index 0 of row b holds
+	 * kDxyBack[b] instead, which the ARMv6 walk reads from the row alone. */
+	stepTable_.resize(8 * 512);
 	for (int back = 0; back < 8; ++back)
 		for (int idx = 0; idx < 512; ++idx) {
 			const int e = kRowStep.entry[back][idx];
 			const int d = e & 7;
 			const auto offset = static_cast<std::uint32_t>(kDx[d] + kDy[d] * w);
-			stepTable_[kStepTableAt + static_cast<std::size_t>(back) * 512 + idx] = static_cast<std::int32_t>(
-				offset << 12 | static_cast<std::uint32_t>((d + 4) & 7) << 9 |
-				((e & 8) ? kMarkRightBg : kMarkFollowed));
+			stepTable_[static_cast<std::size_t>(back) * 512 + idx] =
+				idx == 0 ? kDxyBack[back]
+					 : static_cast<std::int32_t>(offset << 12 |
+								     static_cast<std::uint32_t>((d + 4) & 7) << 9 |
+								     ((e & 8) ? kMarkRightBg : kMarkFollowed));
 		}
 	maskTable_.clear();
 }
@@ -345,7 +354,7 @@ void ContourTracer::trace(const TraceMap &edges, const TraceParams &params, std:
 			return;
 
 		++borders_;
-		follow(x, y, fromDir, edges);
+		follow(x, y, fromDir, edges, params.corners);
 		/* A marker outline is at least four sides of min_side pixels,
 		 * and spans at least min_side / sqrt(2) each way. */
 		if (static_cast<float>(steps_) < 2.8f * params.min_side)
@@ -610,11 +619,11 @@ void ContourTracer::clusterCorners()
 
 /* Follows one border from (x, y); (x, y) + kD[fromDir] is the background
  * pixel the scan came from. Keeps its pixels and, apart, its corner pixels. */
-void ContourTracer::follow(int x0, int y0, int fromDir, const TraceMap &edges)
+void ContourTracer::follow(int x0, int y0, int fromDir, const TraceMap &edges, bool corners)
 {
 #ifdef FRAPPE_HAVE_ARMV6_TRACE
 	if (!portableWalk_ && !useMasks_) {
-		followV6(x0, y0, fromDir, edges);
+		followV6(x0, y0, fromDir, edges, corners);
 		return;
 	}
 #endif
@@ -666,7 +675,7 @@ void ContourTracer::follow(int x0, int y0, int fromDir, const TraceMap &edges)
 		*p0 = kFollowedRightBg; /* isolated pixel */
 		*out++ = xy;
 		*cornerOut = xy;
-		cornerOut += isCorner(p0);
+		cornerOut += corners && isCorner(p0);
 		steps_ = 1;
 		cornerCount_ = static_cast<int>(cornerOut - corners_.data());
 		return;
@@ -677,50 +686,49 @@ void ContourTracer::follow(int x0, int y0, int fromDir, const TraceMap &edges)
 	const int d1 = (fromDir - std::countl_zero(turned)) & 7;
 	const std::uint8_t *const p1 = p0 + off[d1];
 	if (useMasks_) {
-		/* Each pixel's neighbourhood is one byte of masks_. The masks of
-		 * the current pixel's eight neighbours are loaded (three words)
-		 * while its step is looked up, so the next pixel's mask is a
-		 * shift of a register away when the table entry arrives: one
-		 * dependent load per step. */
+		/* Each pixel's neighbourhood is one byte of masks_: a step is
+		 * the table entry, then the next pixel's byte (two dependent
+		 * loads and some 25 instructions; gathering its eight
+		 * neighbours' bytes ahead of the entry took one load but 58). */
 		const std::uint8_t *const M = masks_.data();
 		const MaskStep *const mt = maskTable_.data();
 		const std::ptrdiff_t i0 = p0 - L, i1 = p1 - L;
-		/* Bytes: up-left, up, up-right, left, right, down-left, down,
-		 * down-right (kWindowByte). */
-		auto window = [M, w](std::ptrdiff_t at) {
-			const std::uint32_t r0 = load32(M + at - w - 1), r1 = load32(M + at - 1), r2 = load32(M + at + w - 1);
-			return static_cast<std::uint64_t>(r0 & 0xFFFFFFu) | static_cast<std::uint64_t>(r1 & 0xFFu) << 24 |
-			       static_cast<std::uint64_t>(r1 & 0xFF0000u) << 16 | static_cast<std::uint64_t>(r2 & 0xFFFFFFu) << 40;
-		};
-		std::ptrdiff_t i = i0;
-		unsigned back = static_cast<unsigned>(d1);
-		unsigned mask = M[i0];
-		std::uint64_t around = window(i0);
-		for (;;) {
-			const MaskStep st = mt[back << 8 | mask];
-			L[i] |= st.mark;
-			*out++ = xy;
-			*cornerOut = xy;
-			cornerOut += isCorner(L + i);
-			if (out == outEnd) [[unlikely]] {
-				if (points_.size() > 4 * labels_.size())
+		/* One loop with the corner test, one without. */
+		auto walk = [&](auto withCorners) {
+			std::ptrdiff_t i = i0;
+			unsigned back = static_cast<unsigned>(d1);
+			unsigned mask = M[i0];
+			for (;;) {
+				const MaskStep st = mt[back << 8 | mask];
+				L[i] |= st.mark;
+				*out++ = xy;
+				if constexpr (decltype(withCorners)::value) {
+					*cornerOut = xy;
+					cornerOut += isCorner(L + i);
+				}
+				if (out == outEnd) [[unlikely]] {
+					if (points_.size() > 4 * labels_.size())
+						break;
+					grow();
+				}
+				const std::ptrdiff_t next = i + st.offset;
+				if (i == i1 && next == i0) [[unlikely]]
 					break;
-				grow();
+				mask = M[next];
+				back = st.back;
+				xy += st.dxy;
+				i = next;
 			}
-			const std::ptrdiff_t next = i + st.offset;
-			if (i == i1 && next == i0) [[unlikely]]
-				break;
-			mask = static_cast<unsigned>(around >> st.shift) & 0xFFu;
-			around = window(next);
-			back = st.back;
-			xy += static_cast<std::uint32_t>(kDxyBack[back]);
-			i = next;
-		}
+		};
+		if (corners)
+			walk(std::true_type{});
+		else
+			walk(std::false_type{});
 		steps_ = static_cast<int>(out - points_.data());
 		cornerCount_ = static_cast<int>(cornerOut - corners_.data());
 		return;
 	}
-	const std::int32_t *const table = stepTable_.data() + kStepTableAt;
+	const std::int32_t *const table = stepTable_.data();
 	const std::size_t maxSteps = 4 * labels_.size();
 	std::uint8_t *p = p0;
 	/* The table row for the direction back to the previous pixel. */
@@ -734,7 +742,7 @@ void ContourTracer::follow(int x0, int y0, int fromDir, const TraceMap &edges)
 		*p |= static_cast<std::uint8_t>(step & kMarkRightBg);
 		*out++ = xy;
 		*cornerOut = xy;
-		cornerOut += isCorner(p);
+		cornerOut += corners && isCorner(p);
 		if (out == outEnd) [[unlikely]] {
 			if (points_.size() > maxSteps) /* only on a corrupt label image */
 				break;
@@ -757,7 +765,7 @@ void ContourTracer::follow(int x0, int y0, int fromDir, const TraceMap &edges)
  * the first move found from the neighbourhood index (kMaskOfIndex) rather
  * than eight byte tests, and no more set-up than the walk needs: a border
  * is 34 steps on average, so its set-up counts. */
-void ContourTracer::followV6(int x0, int y0, int fromDir, const TraceMap &edges)
+void ContourTracer::followV6(int x0, int y0, int fromDir, const TraceMap &edges, bool corners)
 {
 	std::uint8_t *const L = labels_.data();
 	const std::ptrdiff_t w = stride_;
@@ -776,7 +784,7 @@ void ContourTracer::followV6(int x0, int y0, int fromDir, const TraceMap &edges)
 		*p0 = kFollowedRightBg; /* isolated pixel */
 		*out++ = xy;
 		*cornerOut = xy;
-		cornerOut += (p0[toEdge] >> 1) & 1;
+		cornerOut += corners && (p0[toEdge] >> 1) & 1;
 		steps_ = 1;
 		cornerCount_ = static_cast<int>(cornerOut - corners_.data());
 		return;
@@ -785,13 +793,25 @@ void ContourTracer::followV6(int x0, int y0, int fromDir, const TraceMap &edges)
 	const int d1 = (fromDir - std::countl_zero(turned)) & 7;
 	const std::uint8_t *const p1 = p0 + kDx[d1] + kDy[d1] * w;
 	const std::size_t maxSteps = 4 * labels_.size();
-	FollowAsm a{ p0, xy, out, cornerOut, static_cast<std::uint32_t>(d1) << 9, stepTable_.data() + kStepTableAt,
-		     static_cast<std::int32_t>(-w - 1), static_cast<std::int32_t>(w - 1), toEdge, p1, outEnd,
+	FollowAsm a{ p0,
+		     xy,
+		     out,
+		     cornerOut,
+		     static_cast<std::uint32_t>(d1) << 9,
+		     stepTable_.data(),
+		     static_cast<std::int32_t>(-w - 1),
+		     static_cast<std::int32_t>(w - 1),
+		     toEdge,
+		     p1,
+		     outEnd,
 		     0x00070707u };
 	/* The walk returns at p1 and when the points are full, after storing
 	 * the point; the rest of such a step is done here, as follow() does. */
 	for (;;) {
-		frappe_armv6_follow(&a);
+		if (corners)
+			frappe_armv6_follow(&a);
+		else
+			frappe_armv6_follow_bare(&a);
 		if (a.out == outEnd) [[unlikely]] {
 			if (points_.size() > maxSteps)
 				break;

@@ -56,6 +56,10 @@ struct TraceParams {
 	/// through texture goes many times. Edge borders also double back
 	/// along open curves (twice the box), which the later checks reject.
 	float max_winding = 1e9f;
+	/// Whether the corner pixels (EdgeMap::kCorner) met along a border are
+	/// collected: region and shade maps hold none (kEdge alone marks a
+	/// pixel), and their walk then skips the test at every step.
+	bool corners = true;
 	/// Whether hole borders are followed too. Region borders need only the
 	/// outer ones: a dark region's outer border is the candidate; the
 	/// border of a light hole in it (a marker's white cells, the quiet zone
@@ -104,8 +108,8 @@ private:
 		int fx, fy;          ///< first member, the cluster's anchor
 	};
 	void buildStepTables(int w);
-	void follow(int x, int y, int fromDir, const TraceMap &edges);
-	void followV6(int x, int y, int fromDir, const TraceMap &edges); ///< ARMv6 builds only
+	void follow(int x, int y, int fromDir, const TraceMap &edges, bool corners);
+	void followV6(int x, int y, int fromDir, const TraceMap &edges, bool corners); ///< ARMv6 builds only
 	void clusterCorners();
 	/// The last border's bounding box spans `span` both ways, and its
 	/// length is at most maxWinding times the perimeter of the box.
@@ -124,7 +128,8 @@ private:
 	/// Suzuki's step 3.3 for this width, in one of two forms. On 64-bit
 	/// targets each edge pixel's eight neighbours are first gathered into
 	/// one byte of masks_ (a vectorised pass over the occupied tiles), and
-	/// the table is indexed by direction back and that byte. Elsewhere (the
+	/// the table is indexed by direction back and that byte, whose entry
+	/// says where the next byte is. Elsewhere (the
 	/// ARMv6 build, where that pass would cost more than it saves) the
 	/// neighbourhood is read from three label rows at every step, and
 	/// stepTable_ holds the move's pointer offset, the next direction back
@@ -133,7 +138,7 @@ private:
 		std::int16_t offset; ///< pointer offset of the move
 		std::uint8_t back;   ///< direction back from the pixel it reaches
 		std::uint8_t mark;   ///< label mark of the pixel it leaves
-		std::uint8_t shift;  ///< where the move's pixel is in the walk's window
+		std::uint32_t dxy;   ///< the move as x | y << 16 (wrapping)
 	};
 	bool useMasks_ = false;
 	std::vector<std::uint8_t> masks_;

@@ -172,20 +172,53 @@ __attribute__((optimize("omit-frame-pointer"))) OutlineExtremes outlineExtremesV
 	const std::size_t i2 = static_cast<std::size_t>(best - pts);
 	e.i2 = i2;
 	const u32 ed = ssub16(pts[i2], p0);
+	/* The farthest on either side of the diagonal, four points a step
+	 * by LDM; as for i2, each is kept as the address of its point. A
+	 * cross product above most (>= 0) is never below least (<= 0): two
+	 * independent tests are the scalar form's if / else. */
 	std::int32_t most = 0, least = 0;
-	std::size_t i1 = 0, i3 = 0;
-	for (std::size_t i = 0; i < n; ++i) {
-		const std::int32_t c = __smusdx(static_cast<int16x2_t>(ed), static_cast<int16x2_t>(ssub16(pts[i], p0)));
+	const std::uint32_t *b1 = pts, *b3 = pts;
+	if (end4 != pts) {
+		const std::uint32_t *p = pts;
+		u32 t;
+		__asm__(".syntax unified\n\t"
+			"1:\n\t"
+			"ldmia   %[p]!, {%[q0], %[q1], %[q2], %[q3]}\n\t"
+#define FRAPPE_ACROSS(Q, OFF)                                                                                          \
+	"ssub16  %[t], %[" Q                                                                                           \
+	"], %[p0]\n\t"                                                                                                 \
+	"smusdx  %[t], %[ed], %[t]\n\t"                                                                                \
+	"cmp     %[t], %[most]\n\t"                                                                                    \
+	"itt     gt\n\t"                                                                                               \
+	"movgt   %[most], %[t]\n\t"                                                                                    \
+	"subgt   %[b1], %[p], #" OFF                                                                                   \
+	"\n\t"                                                                                                         \
+	"cmp     %[t], %[least]\n\t"                                                                                   \
+	"itt     lt\n\t"                                                                                               \
+	"movlt   %[least], %[t]\n\t"                                                                                   \
+	"sublt   %[b3], %[p], #" OFF "\n\t"
+			FRAPPE_ACROSS("q0", "16") FRAPPE_ACROSS("q1", "12") FRAPPE_ACROSS("q2", "8")
+				FRAPPE_ACROSS("q3", "4")
+#undef FRAPPE_ACROSS
+					"cmp     %[p], %[end]\n\t"
+					"bne     1b"
+			: [p] "+r"(p), [most] "+r"(most), [least] "+r"(least), [b1] "+r"(b1), [b3] "+r"(b3),
+			  [t] "=&r"(t), [q0] "=&r"(q0), [q1] "=&r"(q1), [q2] "=&r"(q2), [q3] "=&r"(q3)
+			: [end] "r"(end4), [p0] "r"(p0), [ed] "r"(ed)
+			: "cc", "memory");
+	}
+	for (const std::uint32_t *p = end4; p != pts + n; ++p) {
+		const std::int32_t c = __smusdx(static_cast<int16x2_t>(ed), static_cast<int16x2_t>(ssub16(*p, p0)));
 		if (c > most) {
 			most = c;
-			i1 = i;
+			b1 = p;
 		} else if (c < least) {
 			least = c;
-			i3 = i;
+			b3 = p;
 		}
 	}
-	e.i1 = i1;
-	e.i3 = i3;
+	e.i1 = static_cast<std::size_t>(b1 - pts);
+	e.i3 = static_cast<std::size_t>(b3 - pts);
 	e.most = most;
 	e.least = least;
 	return e;

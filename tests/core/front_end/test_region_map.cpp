@@ -194,6 +194,28 @@ TEST(RegionMap, FollowsTheDocumentedRuleAtOddSizesAndStrides)
 	});
 }
 
+/* The shade map's threshold is its definition, the least r with (r + 4)^2 >=
+ * (lo + 4)(hi + 4), for every pair of tile extremes. */
+TEST(RegionMap, ShadeThresholdIsTheLeastRootForEveryPair)
+{
+	int wrong = 0;
+	for (int lo = 0; lo < 256; ++lo)
+		for (int hi = 0; hi < 256; ++hi) {
+			const int p = (lo + 4) * (hi + 4);
+			int want = 0;
+			while ((want + 4) * (want + 4) < p)
+				++want;
+			const int got = FrontEndParams::shadeThreshold(lo, hi);
+			if (got != want && ++wrong <= 5)
+				ADD_FAILURE() << "lo " << lo << " hi " << hi << ": " << got << ", want " << want;
+		}
+	EXPECT_EQ(wrong, 0);
+	/* The extremes: a black tile, a white one. */
+	EXPECT_EQ(FrontEndParams::shadeThreshold(0, 0), 0);
+	EXPECT_EQ(FrontEndParams::shadeThreshold(255, 255), 255);
+	EXPECT_EQ(FrontEndParams::shadeThreshold(0, 255), 29); /* 32^2 = 1024 < 1036 <= 33^2 = (29 + 4)^2 */
+}
+
 /* The CPU front end makes the map's 2x2 means in its bands, as it reads the
  * frame: the same map as regionMap() at every size and stride, with one band
  * or several, and of the scaled frame when it scales. */

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -598,6 +599,44 @@ TEST(ContourTrace, BothWalksGiveTheSameQuads)
 			EXPECT_EQ(qa[k].corners[i].x, qb[k].corners[i].x);
 			EXPECT_EQ(qa[k].corners[i].y, qb[k].corners[i].y);
 		}
+}
+
+/* TraceParams::corners = false (region and shade maps) walks as if the map
+ * had no corner pixels: the same borders and quads as the map with its
+ * kCorner bits cleared, in both walks (narrow: the masks' on 64-bit targets;
+ * wide: the rows'). */
+TEST(ContourTrace, WithoutCornersTheMapsCornerPixelsAreIgnored)
+{
+	for (const int w : { 320, 33000 }) {
+		EdgeMap em = emptyMap(w, 200);
+		ring(em, 20, 20, 80, 84);
+		ring(em, 87, 20, 140, 84);
+		std::mt19937 rng(5);
+		for (int k = 0; k < 2500; ++k) {
+			const int x = 10 + static_cast<int>(rng() % 280), y = 120 + static_cast<int>(rng() % 70);
+			set(em, x, y, (rng() % 5 == 0) ? EdgeMap::kEdge | EdgeMap::kCorner : EdgeMap::kEdge);
+		}
+		ring(em, 150, 100, 230, 185);
+		EdgeMap plain = em;
+		for (std::uint8_t &p : plain.pixels)
+			p &= EdgeMap::kEdge;
+		TraceParams params; /* as the region maps are traced */
+		params.min_clusters = 0;
+		params.max_winding = 2.0f;
+		params.holes = false;
+		ContourTracer a, b;
+		std::vector<Quad> qa, qb;
+		params.corners = false;
+		a.trace(em, params, qa);
+		params.corners = true;
+		b.trace(plain, params, qb);
+		EXPECT_EQ(a.bordersFollowed(), b.bordersFollowed()) << w;
+		ASSERT_EQ(qa.size(), qb.size()) << w;
+		EXPECT_GE(qa.size(), 3u) << w; /* the three rings' outer borders at least */
+		for (std::size_t k = 0; k < qa.size(); ++k)
+			EXPECT_EQ(std::memcmp(qa[k].corners.data(), qb[k].corners.data(), sizeof qa[k].corners), 0)
+				<< w;
+	}
 }
 
 namespace {
