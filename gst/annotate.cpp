@@ -154,9 +154,10 @@ Label placeLabel(const std::array<Point2f, 4> &corners, std::string_view text, i
 }
 
 void annotateMarkers(GstVideoFrame *frame, const Result &result, const std::vector<std::optional<Pose>> &poses,
-		     const MarkerSizes &sizes, const Camera &camera)
+		     const MarkerSizes &sizes, const Camera &camera, const BundleAxes &bundle)
 {
 	Canvas canvas(frame);
+	double largest = 0.0; /* the largest marker's side, pixels */
 	for (std::size_t i = 0; i < result.markers.size(); ++i) {
 		const Marker &m = result.markers[i];
 		const double side = meanSide(m.corners);
@@ -181,7 +182,10 @@ void annotateMarkers(GstVideoFrame *frame, const Result &result, const std::vect
 
 		if (i < poses.size() && poses[i] && sizes(m.id) > 0.0)
 			drawAxes(canvas, *poses[i], sizes(m.id), camera, side);
+		largest = std::max(largest, side);
 	}
+	if (bundle.pose)
+		drawAxes(canvas, *bundle.pose, 2.0 * bundle.axis, camera, largest);
 
 	/* Labels last: over the axes of any neighbour. */
 	for (const Marker &m : result.markers) {

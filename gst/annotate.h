@@ -53,11 +53,19 @@ struct Label {
 Label placeLabel(const std::array<Point2f, 4> &corners, std::string_view text, int frameWidth, int frameHeight,
 		 Yuv ink, std::span<const Marker> avoid = {});
 
+/// A bundle's pose to draw: its frame's axes, `axis` metres long.
+struct BundleAxes {
+	const Pose *pose = nullptr;
+	double axis = 0.0;
+};
+
 /// Draws the frame's markers: outlines, first corners, ids and, where
 /// `poses` has one and `sizes` a positive side for the id, the axes (x red,
-/// y green, z blue, half a side long) projected through `camera`. Ids are
-/// yellow on colour formats, white on GRAY8, outlined in black.
+/// y green, z blue, half a side long) projected through `camera`; with
+/// `bundle.pose`, the bundle frame's axes too (as thick as the largest
+/// marker's). Ids are yellow on colour formats, white on GRAY8, outlined in
+/// black.
 void annotateMarkers(GstVideoFrame *frame, const Result &result, const std::vector<std::optional<Pose>> &poses,
-		     const MarkerSizes &sizes, const Camera &camera);
+		     const MarkerSizes &sizes, const Camera &camera, const BundleAxes &bundle = {});
 
 } // namespace frappe::gst

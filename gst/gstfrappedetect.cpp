@@ -45,6 +45,12 @@
  *   translation in metres), `reprojection-error` (double, RMS pixels) and
  *   `alternative-reprojection-error` (double: the error of the other planar
  *   solution; close to `reprojection-error` when the pose is ambiguous).
+ * * `bundle` (GstStructure `bundle`), only with #GstFrappeDetect:bundle-file
+ *   when the bundle gave a pose: `name` (string), `rvec`, `tvec`
+ *   (GstValueArray of 3 doubles: bundle frame to camera frame, metres),
+ *   `reprojection-error` (double, RMS pixels over the corners used), `used`
+ *   and `rejected` (GstValueArray of ints: the ids that made the pose and
+ *   those seen but left out as outliers), the #GstFrappeBundleMeta's values.
  *
  * The detector's properties are the library's settings table
  * (frappe/settings.h, docs/settings.md): one per frappe::Config field, named
@@ -71,9 +77,21 @@
  * of OpenCV aruco: origin at the marker centre, x right, y up, z out of the
  * marker towards the camera.
  *
+ * Bundles: #GstFrappeDetect:bundle-file names a rigid set of markers with
+ * known 3D corners (a grid board, apriltag_ros's tags.yaml bundle;
+ * frappe/bundle.h). Each frame where markers of it are seen gets one pose
+ * from all of them (frappe::estimateBundlePose: every agreeing corner
+ * through the lens model, a marker whose corners disagree rejected) as a
+ * #GstFrappeBundleMeta (gstfrappebundlemeta.h; at most one a buffer, none
+ * when the bundle is not seen), the message's `bundle` structure and
+ * frappejson's `"bundle"` object. The bundle gives its markers' sizes
+ * (marker-size is for the single poses); the camera is the pose's
+ * (calibration-file or camera-matrix, fitted to the caps): a bundle-file
+ * without one fails the start, as a file that cannot be read does.
+ *
  * A value the element refuses (an unknown dictionary or mode, a malformed
  * marker-sizes, a camera-matrix of other than 9 numbers, a distortion of
- * another count, a file it cannot read) set while the element is stopped,
+ * another count, a file it cannot read, a bundle-file without a camera) set while the element is stopped,
  * as on a gst-launch-1.0 line, makes its next state change fail with an
  * element error (GST_RESOURCE_ERROR_SETTINGS) naming the property, the
  * value, why and what the property takes: gst-launch-1.0 prints it and
@@ -155,15 +173,23 @@
  *     frappedetect dictionary=apriltag_36h11 marker-size=0.1 \
  *     calibration-file=camera.yaml ! frappejson ! fdsink
  * ]| Poses of AprilTag markers of 10 cm seen by a camera, as JSON lines.
+ * |[
+ * gst-launch-1.0 -m libcamerasrc ! video/x-raw,format=NV12,width=640,height=480 ! \
+ *     frappedetect dictionary=6x6_250 calibration-file=camera.yaml \
+ *     bundle-file=board.yaml ! fakesink
+ * ]| One pose of a board of markers (board.yaml: `board: grid`, `rows: 3`,
+ * `cols: 4`, `size: 0.05`, `gap: 0.01`) a frame, in the messages' `bundle`.
  */
 
 #include "gstfrappedetect.h"
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <exception>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <gst/video/video.h>
@@ -208,6 +234,10 @@ struct FrappeDetectPrivate {
 	frappe::gst::PoseCamera camera; /* active's, fitted to the caps */
 	frappe::gst::Poses poses;       /* the frame's, reused */
 	std::vector<std::optional<frappe::Pose>> bestPoses;
+	frappe::BundlePose bundlePose; /* the frame's, with bundle-file, when hasBundlePose */
+	bool hasBundlePose = false;
+	frappe::BundleScratch bundleScratch; /* estimateBundlePose()'s memory, reused */
+	bool warnedBundleCamera = false;     /* a bundle without a camera, since the settings changed */
 	std::string dictionary;         /* the pipeline's dictionary name */
 	std::unique_ptr<frappe::Pipeline> pipeline;
 	Overlap overlap = Overlap::None; /* the pipeline's */
@@ -349,6 +379,35 @@ static GstFlowReturn fail(GstFrappeDetect *self, MappedFrame &f, const char *why
 	return GST_FLOW_ERROR;
 }
 
+/* The bundle's pose from the frame's markers into priv->bundlePose (no
+ * allocation once its vectors and the scratch have grown), none without
+ * bundle-file; a bundle without a camera (camera-matrix cleared while
+ * playing) is one warning until the settings change. */
+static void estimate_bundle_pose(GstFrappeDetect *self, const frappe::Result &result)
+{
+	FrappeDetectPrivate *priv = self->priv;
+	const Settings &s = priv->active;
+	priv->hasBundlePose = false;
+	if (!s.bundle)
+		return;
+	const frappe::Camera *camera = priv->camera.camera();
+	if (!camera) {
+		/* A calibration of another aspect ratio has warned already. */
+		if (!s.poseCamera() && !std::exchange(priv->warnedBundleCamera, true))
+			GST_ELEMENT_WARNING(self, RESOURCE, SETTINGS,
+					    ("bundle-file is set but there is no camera: no bundle pose"),
+					    ("set calibration-file or camera-matrix"));
+		return;
+	}
+	try {
+		priv->hasBundlePose = frappe::estimateBundlePose(*s.bundle, result.markers, *camera, priv->bundlePose,
+								 priv->bundleScratch);
+	} catch (const std::exception &e) {
+		/* Not reached: the camera was checked when set. */
+		GST_WARNING_OBJECT(self, "bundle %s: %s", s.bundle->name.c_str(), e.what());
+	}
+}
+
 /* Attaches metas, draws, posts the message and releases the frame; the
  * buffer goes to the output list. */
 static void finish(GstFrappeDetect *self, MappedFrame &f, const frappe::Result &result)
@@ -360,21 +419,31 @@ static void finish(GstFrappeDetect *self, MappedFrame &f, const frappe::Result &
 
 	const gint64 t0 = g_get_monotonic_time();
 	frappe::gst::estimatePoses(result.markers, s.sizes, priv->camera.camera(), priv->poses);
+	estimate_bundle_pose(self, result);
 	const double poseMs = static_cast<double>(g_get_monotonic_time() - t0) / 1000.0;
+	const frappe::gst::BundleOutput bundle{ s.bundle.get(), priv->hasBundlePose ? &priv->bundlePose : nullptr };
 
 	frappe::gst::attachMarkerMetas(f.buffer, GST_VIDEO_FRAME_WIDTH(&f.frame), GST_VIDEO_FRAME_HEIGHT(&f.frame),
 				       result, poses, dictName, s.library.mode == frappe::Mode::Track);
+	frappe::gst::attachBundleMeta(f.buffer, bundle);
 	if (f.writable && s.annotate && !result.markers.empty()) {
 		frappe::gst::bestPoses(poses, priv->bestPoses);
-		frappe::gst::annotateMarkers(&f.frame, result, priv->bestPoses, s.sizes, priv->camera.fitted());
+		/* The bundle's axes as long as its largest marker's side. */
+		frappe::gst::BundleAxes axes;
+		if (bundle.pose) {
+			axes.pose = &bundle.pose->pose;
+			for (const frappe::BundleMarker &m : bundle.bundle->markers)
+				axes.axis = std::max(axes.axis, m.size);
+		}
+		frappe::gst::annotateMarkers(&f.frame, result, priv->bestPoses, s.sizes, priv->camera.fitted(), axes);
 	}
 
 	priv->bufferLog.copied(GST_ELEMENT(self), f.image, f.dmabufInput, result.copy_bytes, priv->poolOffered);
 	GstBuffer *buffer = f.release();
 
 	if (s.postMessages) {
-		GstStructure *msg = frappe::gst::frameMessage(buffer, GST_BASE_TRANSFORM(self)->segment, result,
-							      poses, dictName);
+		GstStructure *msg = frappe::gst::frameMessage(buffer, GST_BASE_TRANSFORM(self)->segment, result, poses,
+							      dictName, bundle);
 		gst_element_post_message(GST_ELEMENT(self), gst_message_new_element(GST_OBJECT(self), msg));
 	}
 
@@ -483,6 +552,7 @@ static GstFlowReturn apply_settings(GstFrappeDetect *self)
 		ret = finish_held(self);
 	const bool newCamera = next.cameraGeneration != priv->active.cameraGeneration;
 	priv->active = next;
+	priv->warnedBundleCamera = false;
 	if (newCamera) {
 		const GstVideoInfo *info = &GST_VIDEO_FILTER(self)->in_info;
 		priv->camera.fit(GST_ELEMENT(self), priv->active.poseCamera(), GST_VIDEO_INFO_WIDTH(info),

@@ -27,6 +27,8 @@
  *  "running_time": 1366666666, "width": 640, "height": 480,
  *  "frame_id": "camera", "capture_time": 1780393200123456789,
  *  "capture_clock": "pipeline",
+ *  "bundle": {"name": "grid", "rvec": [rx, ry, rz], "tvec": [tx, ty, tz],
+ *   "reprojection_error": 0.12, "used": [0, 1, 2, 4], "rejected": [3]},
  *  "markers": [{"id": 7, "dictionary": "aruco_mip_36h12",
  *   "corners": [[x0, y0], [x1, y1], [x2, y2], [x3, y3]], "hamming": 0,
  *   "margin": 0.93, "rvec": [rx, ry, rz], "tvec": [tx, ty, tz],
@@ -60,6 +62,11 @@
  *   the frame was captured, as the source timestamped it. `null` for both
  *   when neither is known (no reference meta and no clock or no running
  *   time).
+ * * `bundle`: only when the buffer has a #GstFrappeBundleMeta
+ *   (frappedetect's bundle-file, the bundle seen): its `name`, `rvec`,
+ *   `tvec` (bundle frame to camera frame), `reprojection_error` (RMS
+ *   pixels), the ids `used` and `rejected` (outliers). A frame field: every
+ *   part repeats it, so any part that arrives gives the pose.
  * * `markers`: in the order of their metas, with the fields of
  *   #GstFrappeMarkerMeta (frappe/marker_record.h's list); `rvec`, `tvec`
  *   and the two reprojection errors only when the pose is known, `tracked`
@@ -123,6 +130,7 @@
 
 #include <algorithm>
 #include <charconv>
+#include <cmath>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -175,6 +183,7 @@ struct FrappeJsonPrivate {
 	std::string markers;             /* the frame's markers, one after another */
 	std::vector<std::size_t> ends;   /* where each ends in `markers` */
 	std::vector<std::size_t> parts;  /* the first marker of each part, then the count */
+	std::string bundle;              /* the frame's bundle object, "" for none */
 	std::string line;                /* a part's line */
 	std::vector<GstBuffer *> output; /* the parts waiting for generate_output */
 };
@@ -213,11 +222,19 @@ struct FrameHeader {
 	std::string_view frameId;
 	std::optional<gint64> captureTime; /* ns since the Unix epoch */
 	const char *captureClock = nullptr;
+	std::string_view bundle; /* the bundle's JSON object, empty for none */
+};
+
+/* A value written as it is (a JSON object); the key is left out when
+ * there is none. */
+struct RawJson {
+	std::string_view text;
 };
 
 /* The line's frame fields, in their order: the one list of the keys
  * (docs/streaming.md, "The marker line"). f(key, value) with value an
- * optional integer or an optional string, null when empty. */
+ * optional integer or an optional string, null when empty, or an optional
+ * RawJson, left out when empty. */
 template<typename F>
 void forEachFrameField(const FrameHeader &h, F &&f)
 {
@@ -234,6 +251,7 @@ void forEachFrameField(const FrameHeader &h, F &&f)
 	f("frame_id", Text(h.frameId));
 	f("capture_time", h.captureTime);
 	f("capture_clock", h.captureClock ? Text(h.captureClock) : Text());
+	f("bundle", h.bundle.empty() ? std::optional<RawJson>() : std::optional<RawJson>(RawJson{ h.bundle }));
 }
 
 /* The frame's fields, then `"markers": [`, which the caller fills and
@@ -242,12 +260,19 @@ void appendHeader(std::string &out, const FrameHeader &h)
 {
 	out += '{';
 	forEachFrameField(h, [&](std::string_view key, const auto &value) {
+		using T = std::remove_cvref_t<decltype(*value)>;
+		if constexpr (std::is_same_v<T, RawJson>) {
+			if (!value)
+				return;
+		}
 		out += '"';
 		out += key;
 		out += "\": ";
 		if (!value) {
 			out += "null";
-		} else if constexpr (std::is_same_v<std::remove_cvref_t<decltype(*value)>, std::string_view>) {
+		} else if constexpr (std::is_same_v<T, RawJson>) {
+			out += value->text;
+		} else if constexpr (std::is_same_v<T, std::string_view>) {
 			frappe::appendJsonString(out, *value);
 		} else {
 			char text[24];
@@ -298,6 +323,61 @@ void captureTime(GstElement *element, GstBuffer *buffer, GstClockTime runningTim
 		return;
 	h.captureTime = real - (static_cast<gint64>(now) - static_cast<gint64>(base + runningTime));
 	h.captureClock = "pipeline";
+}
+
+/* A double as the markers' numbers are written (frappe/marker_record.h):
+ * the shortest exact text, or `digits` significant digits; null when not
+ * finite. */
+void appendNumber(std::string &out, double v, int digits)
+{
+	if (!std::isfinite(v)) {
+		out += "null";
+		return;
+	}
+	char text[48];
+	const auto r = digits > 0 ? std::to_chars(text, text + sizeof(text), v, std::chars_format::general, digits)
+				  : std::to_chars(text, text + sizeof(text), v);
+	out.append(text, r.ptr);
+}
+
+template<typename T>
+void appendArray(std::string &out, const T *v, guint n, int digits)
+{
+	out += '[';
+	for (guint i = 0; i < n; ++i) {
+		if (i)
+			out += ", ";
+		if constexpr (std::is_floating_point_v<T>) {
+			appendNumber(out, v[i], digits);
+		} else {
+			char text[16];
+			out.append(text, std::to_chars(text, text + sizeof(text), v[i]).ptr);
+		}
+	}
+	out += ']';
+}
+
+/* The buffer's GstFrappeBundleMeta as the line's "bundle" object into
+ * `out`, empty when the buffer has none: the meta's fields, in its order. */
+void formatBundle(std::string &out, GstBuffer *buffer, int digits)
+{
+	out.clear();
+	const GstFrappeBundleMeta *b = gst_buffer_get_frappe_bundle_meta(buffer);
+	if (!b)
+		return;
+	out += "{\"name\": ";
+	frappe::appendJsonString(out, b->name ? b->name : "");
+	out += ", \"rvec\": ";
+	appendArray(out, b->rvec, 3, digits);
+	out += ", \"tvec\": ";
+	appendArray(out, b->tvec, 3, digits);
+	out += ", \"reprojection_error\": ";
+	appendNumber(out, b->reprojection_error, digits);
+	out += ", \"used\": ";
+	appendArray(out, b->used, b->n_used, digits);
+	out += ", \"rejected\": ";
+	appendArray(out, b->rejected, b->n_rejected, digits);
+	out += '}';
 }
 
 /* The buffer's markers into priv->markers, where each ends into
@@ -450,6 +530,8 @@ static GstFlowReturn format_buffer(GstFrappeJson *self, GstBuffer *input)
 	h.height = priv->height;
 	h.frameId = frameId;
 	captureTime(GST_ELEMENT(self), input, h.runningTime, h);
+	formatBundle(priv->bundle, input, style.digits);
+	h.bundle = priv->bundle;
 
 	formatMarkers(*priv, input, style);
 	/* The longest header: part and parts at most the marker count. */

@@ -80,6 +80,31 @@ void addMarkerFields(GstStructure *s, const frappe::MarkerRecord &r, bool arrays
 	});
 }
 
+void addIntArray(GstStructure *s, const char *field, const std::vector<int> &v)
+{
+	GValue array = G_VALUE_INIT;
+	gst_value_array_init(&array, static_cast<guint>(v.size()));
+	for (int x : v) {
+		GValue item = G_VALUE_INIT;
+		g_value_init(&item, G_TYPE_INT);
+		g_value_set_int(&item, x);
+		gst_value_array_append_and_take_value(&array, &item);
+	}
+	gst_structure_take_value(s, field, &array);
+}
+
+/* The message's bundle: the meta's fields (GstFrappeBundleMeta). */
+GstStructure *bundleStructure(const frappe::Bundle &b, const frappe::BundlePose &p)
+{
+	GstStructure *s = gst_structure_new("bundle", "name", G_TYPE_STRING, b.name.c_str(), nullptr);
+	addDoubleArray(s, "rvec", p.pose.rvec.data(), 3);
+	addDoubleArray(s, "tvec", p.pose.tvec.data(), 3);
+	gst_structure_set(s, "reprojection-error", G_TYPE_DOUBLE, p.pose.error, nullptr);
+	addIntArray(s, "used", p.used);
+	addIntArray(s, "rejected", p.rejected);
+	return s;
+}
+
 /* The message's marker: every field of the library's list. */
 GstStructure *markerStructure(const Marker &m, const std::optional<frappe::MarkerPose> &pose,
 			      const char *dictionary)
@@ -141,8 +166,18 @@ void attachMarkerMetas(GstBuffer *buffer, gint width, gint height, const Result 
 	}
 }
 
-GstStructure *frameMessage(GstBuffer *buffer, const GstSegment &segment, const Result &result,
-			   const Poses &poses, const char *dictionary)
+void attachBundleMeta(GstBuffer *buffer, const BundleOutput &bundle)
+{
+	if (!bundle.pose)
+		return;
+	const frappe::BundlePose &p = *bundle.pose;
+	gst_buffer_add_frappe_bundle_meta(buffer, bundle.bundle->name.c_str(), p.pose.rvec.data(), p.pose.tvec.data(),
+					  p.pose.error, p.used.data(), static_cast<guint>(p.used.size()),
+					  p.rejected.data(), static_cast<guint>(p.rejected.size()));
+}
+
+GstStructure *frameMessage(GstBuffer *buffer, const GstSegment &segment, const Result &result, const Poses &poses,
+			   const char *dictionary, const BundleOutput &bundle)
 {
 	GValue list = G_VALUE_INIT;
 	g_value_init(&list, GST_TYPE_LIST);
@@ -163,6 +198,12 @@ GstStructure *frameMessage(GstBuffer *buffer, const GstSegment &segment, const R
 					      G_TYPE_UINT64, stream, "running-time", G_TYPE_UINT64, running,
 					      "duration", G_TYPE_UINT64, GST_BUFFER_DURATION(buffer), nullptr);
 	gst_structure_take_value(msg, "markers", &list);
+	if (bundle.pose) {
+		GValue item = G_VALUE_INIT;
+		g_value_init(&item, GST_TYPE_STRUCTURE);
+		g_value_take_boxed(&item, bundleStructure(*bundle.bundle, *bundle.pose));
+		gst_structure_take_value(msg, "bundle", &item);
+	}
 	return msg;
 }
 

@@ -12,6 +12,7 @@
 
 #include <gst/gst.h>
 
+#include <frappe/bundle.h>
 #include <frappe/detector.h>
 
 #include "gstfrappecamera.h"
@@ -24,10 +25,21 @@ namespace frappe::gst {
 void attachMarkerMetas(GstBuffer *buffer, gint width, gint height, const Result &result, const Poses &poses,
 		       const char *dictionary, bool tracking);
 
+/* A frame's bundle pose: both set when bundle-file is and the bundle gave a
+ * pose, else pose nullptr (no meta, no message field). */
+struct BundleOutput {
+	const frappe::Bundle *bundle = nullptr;
+	const frappe::BundlePose *pose = nullptr;
+};
+
+/* A GstFrappeBundleMeta on a writable buffer when `bundle` has a pose. */
+void attachBundleMeta(GstBuffer *buffer, const BundleOutput &bundle);
+
 /* The `frappedetect` element message's structure; running and stream time
- * come from `segment` when it is in time. */
-GstStructure *frameMessage(GstBuffer *buffer, const GstSegment &segment, const Result &result,
-			   const Poses &poses, const char *dictionary);
+ * come from `segment` when it is in time; a `bundle` structure when
+ * `bundle` has a pose. */
+GstStructure *frameMessage(GstBuffer *buffer, const GstSegment &segment, const Result &result, const Poses &poses,
+			   const char *dictionary, const BundleOutput &bundle = {});
 
 /* The `stats` property's structure for the last frame; `copied-bytes`
  * is what the backend copied of it before reading (0: read in place),

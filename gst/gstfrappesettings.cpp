@@ -140,11 +140,25 @@ std::shared_ptr<const frappe::Dictionary> readDictionaryFile(const std::string &
 	}
 }
 
+std::shared_ptr<const frappe::Bundle> readBundleFile(const std::string &path, std::string &error)
+{
+	try {
+		return std::make_shared<const frappe::Bundle>(frappe::loadBundle(path));
+	} catch (const std::exception &e) {
+		error = e.what();
+		return nullptr;
+	}
+}
+
+/* What a bundle-file without a camera is refused with. */
+constexpr const char *kBundleNeedsCamera = "a bundle's pose needs the camera: set calibration-file or camera-matrix";
+
 /* A file property's value, read when the element is running. */
 struct FileValue {
 	std::string path;
 	std::optional<frappe::Camera> calibration;
 	std::shared_ptr<const frappe::Dictionary> dictionary;
+	std::shared_ptr<const frappe::Bundle> bundle;
 };
 
 /* Outside the object lock (a dictionary may take a while to check):
@@ -158,6 +172,8 @@ bool readFileProperty(guint propId, const GValue *value, bool running, FileValue
 	std::string error;
 	if (propId == PROP_CALIBRATION_FILE)
 		out.calibration = readCalibrationFile(out.path, error);
+	else if (propId == PROP_BUNDLE_FILE)
+		out.bundle = readBundleFile(out.path, error);
 	else
 		out.dictionary = readDictionaryFile(out.path, error);
 	if (error.empty())
@@ -286,6 +302,32 @@ void installProperties(GObjectClass *gobject_class)
 		g_param_spec_string("dictionary-file", "Dictionary file",
 				    "A dictionary of your own (frappe's text format or OpenCV aruco YAML); when set, "
 				    "used instead of dictionary",
+				    nullptr, live));
+	/**
+	 * GstFrappeDetect:bundle-file:
+	 *
+	 * A bundle (a board, a rigid set of markers with known 3D corners,
+	 * frappe/bundle.h): apriltag_ros's tags.yaml (its first tag_bundles
+	 * entry) or a grid board (`board: grid`, `rows`, `cols`, `size`, `gap`
+	 * in metres, optional `first_id`, `name`). Each frame where markers of
+	 * the bundle are seen gets one pose from all of them
+	 * (frappe::estimateBundlePose) as a #GstFrappeBundleMeta, a `bundle`
+	 * structure in the element message and a `"bundle"` object in
+	 * frappejson's line. The bundle gives its markers' sizes: marker-size is
+	 * not needed for it. Needs the camera (calibration-file or
+	 * camera-matrix): without one the element does not start. Read at
+	 * start; set while playing it is read at once, and a file that cannot be
+	 * used is a warning and the previous bundle is kept, as for
+	 * calibration-file. NULL or "" for none.
+	 *
+	 * Since: 0.3
+	 */
+	g_object_class_install_property(
+		gobject_class, PROP_BUNDLE_FILE,
+		g_param_spec_string("bundle-file", "Bundle file",
+				    "A bundle of markers for one pose from all of them: apriltag_ros tags.yaml "
+				    "(tag_bundles) or a grid board (board: grid, rows, cols, size, gap in metres); "
+				    "needs calibration-file or camera-matrix",
 				    nullptr, live));
 	g_object_class_install_property(
 		gobject_class, PROP_STATS,
@@ -466,7 +508,7 @@ bool setProperty(GstElement *element, Settings &props, const bool &running, Refu
 		 const GValue *value)
 {
 	std::string why;
-	if (propId == PROP_CALIBRATION_FILE || propId == PROP_DICTIONARY_FILE) {
+	if (propId == PROP_CALIBRATION_FILE || propId == PROP_DICTIONARY_FILE || propId == PROP_BUNDLE_FILE) {
 		GST_OBJECT_LOCK(element);
 		const bool read = running;
 		GST_OBJECT_UNLOCK(element);
@@ -477,6 +519,9 @@ bool setProperty(GstElement *element, Settings &props, const bool &running, Refu
 				props.calibrationFile = file.path;
 				props.calibration = file.calibration;
 				++props.cameraGeneration;
+			} else if (propId == PROP_BUNDLE_FILE) {
+				props.bundleFile = file.path;
+				props.bundle = file.bundle;
 			} else {
 				props.dictionaryFile = file.path;
 				props.customDictionary = file.dictionary;
@@ -533,20 +578,28 @@ bool startSettings(GstElement *element, Settings &props, bool &running)
 	/* Running first: a file set from now on is read when set. */
 	GST_OBJECT_LOCK(element);
 	running = true;
-	const std::string calibrationFile = props.calibrationFile, dictionaryFile = props.dictionaryFile;
+	const std::string calibrationFile = props.calibrationFile, dictionaryFile = props.dictionaryFile,
+			  bundleFile = props.bundleFile;
+	const bool cameraMatrix = props.camera.valid();
 	GST_OBJECT_UNLOCK(element);
 
 	std::string error;
 	std::optional<frappe::Camera> calibration;
 	std::shared_ptr<const frappe::Dictionary> dictionary;
+	std::shared_ptr<const frappe::Bundle> bundle;
+	const auto refuse = [&](guint propId, const std::string &file) {
+		GST_ELEMENT_ERROR(element, RESOURCE, SETTINGS, ("%s", refusal(element, propId, file, error).c_str()),
+				  (nullptr));
+	};
 	if (!calibrationFile.empty() && !(calibration = readCalibrationFile(calibrationFile, error))) {
-		GST_ELEMENT_ERROR(element, RESOURCE, SETTINGS,
-				  ("%s", refusal(element, PROP_CALIBRATION_FILE, calibrationFile, error).c_str()),
-				  (nullptr));
+		refuse(PROP_CALIBRATION_FILE, calibrationFile);
 	} else if (!dictionaryFile.empty() && !(dictionary = readDictionaryFile(dictionaryFile, error))) {
-		GST_ELEMENT_ERROR(element, RESOURCE, SETTINGS,
-				  ("%s", refusal(element, PROP_DICTIONARY_FILE, dictionaryFile, error).c_str()),
-				  (nullptr));
+		refuse(PROP_DICTIONARY_FILE, dictionaryFile);
+	} else if (!bundleFile.empty() && !(bundle = readBundleFile(bundleFile, error))) {
+		refuse(PROP_BUNDLE_FILE, bundleFile);
+	} else if (bundle && !calibration && !cameraMatrix) {
+		error = kBundleNeedsCamera;
+		refuse(PROP_BUNDLE_FILE, bundleFile);
 	}
 
 	GST_OBJECT_LOCK(element);
@@ -560,6 +613,8 @@ bool startSettings(GstElement *element, Settings &props, bool &running)
 		}
 		if (dictionary && props.dictionaryFile == dictionaryFile)
 			props.customDictionary = dictionary;
+		if (bundle && props.bundleFile == bundleFile)
+			props.bundle = bundle;
 		++props.generation;
 	}
 	GST_OBJECT_UNLOCK(element);
@@ -646,6 +701,7 @@ bool getProperty(const Settings &p, guint propId, GValue *value)
 	case PROP_DICTIONARY_FILE:
 		g_value_set_string(value, p.dictionaryFile.empty() ? nullptr : p.dictionaryFile.c_str());
 		break;
+	case PROP_BUNDLE_FILE: g_value_set_string(value, p.bundleFile.empty() ? nullptr : p.bundleFile.c_str()); break;
 	case PROP_CAMERA_MATRIX:
 		if (p.camera.valid())
 			getDoubleArray(value, p.camera.matrix.data(), 9);

@@ -14,6 +14,7 @@
 
 #include <gst/gst.h>
 
+#include <frappe/bundle.h>
 #include <frappe/camera.h>
 #include <frappe/config.h>
 #include <frappe/pipeline.h>
@@ -40,6 +41,7 @@ enum Property {
 	PROP_DICTIONARY_FILE,
 	PROP_STATS,
 	PROP_OVERLAP,
+	PROP_BUNDLE_FILE,
 	PROP_SETTING_0,
 };
 
@@ -62,6 +64,8 @@ struct Settings {
 	std::optional<frappe::Camera> calibration; /* read from it: at start, or when set while running */
 	std::string dictionaryFile;    /* dictionary-file, "" for none */
 	std::shared_ptr<const frappe::Dictionary> customDictionary; /* read from it, as the calibration */
+	std::string bundleFile;                                     /* bundle-file, "" for none */
+	std::shared_ptr<const frappe::Bundle> bundle;               /* read from it, as the calibration */
 
 	/* Bumped by every property set: the element copies the settings only
 	 * when it changed (no copy, no allocation per frame). */
@@ -100,9 +104,9 @@ using Refusals = std::map<guint, std::string>;
  * lock around it; false for an id that is not a setting. A value that
  * cannot be used is refused with a GST_ELEMENT_WARNING and the previous
  * one kept; when not `running` it also goes into `refused` (under the
- * lock). The files of calibration-file and dictionary-file are read
- * (outside the lock) when `running` (read under the lock) is set, else at
- * start by startSettings(). */
+ * lock). The files of calibration-file, dictionary-file and bundle-file
+ * are read (outside the lock) when `running` (read under the lock) is set,
+ * else at start by startSettings(). */
 bool setProperty(GstElement *element, Settings &props, const bool &running, Refusals &refused, guint propId,
 		 const GValue *value);
 
@@ -113,9 +117,11 @@ bool failRefused(GstElement *element, const Refusals &refused);
 /* Gets a property of `s` (not PROP_STATS); false for an unknown id. */
 bool getProperty(const Settings &s, guint propId, GValue *value);
 
-/* At start: reads the files that calibration-file and dictionary-file
- * name into `props` and sets `running`. A file that cannot be used is a
- * GST_ELEMENT_ERROR naming the property, the file and why, and false. */
+/* At start: reads the files that calibration-file, dictionary-file and
+ * bundle-file name into `props` and sets `running`. A file that cannot be
+ * used, or a bundle-file without a camera (calibration-file or
+ * camera-matrix) for its pose, is a GST_ELEMENT_ERROR naming the
+ * property, the file and why, and false. */
 bool startSettings(GstElement *element, Settings &props, bool &running);
 
 /* Puts the front end `backend` names into the pipeline's detectors: an

@@ -8,17 +8,12 @@
 
 #include <gst/video/video.h>
 
+#include "gstfrappemeta-internal.h"
+
 GType gst_frappe_marker_meta_api_get_type(void)
 {
 	static GType type = 0;
-	static const gchar *tags[] = { GST_META_TAG_VIDEO_STR, GST_META_TAG_VIDEO_SIZE_STR,
-				       GST_META_TAG_VIDEO_ORIENTATION_STR, nullptr };
-
-	if (g_once_init_enter(&type)) {
-		GType t = gst_meta_api_type_register("GstFrappeMarkerMetaAPI", tags);
-		g_once_init_leave(&type, t);
-	}
-	return type;
+	return frappe::gstmeta::registerApi(type, "GstFrappeMarkerMetaAPI");
 }
 
 static gboolean frappe_marker_meta_init(GstMeta *meta, gpointer, GstBuffer *)
@@ -63,13 +58,9 @@ static gboolean frappe_marker_meta_transform(GstBuffer *dest, GstMeta *meta, Gst
 	}
 
 	if (GST_VIDEO_META_TRANSFORM_IS_SCALE(type)) {
-		const auto *trans = static_cast<const GstVideoMetaTransform *>(data);
-		const gint inW = GST_VIDEO_INFO_WIDTH(trans->in_info);
-		const gint inH = GST_VIDEO_INFO_HEIGHT(trans->in_info);
-		if (inW <= 0 || inH <= 0)
+		gdouble sx = 1.0, sy = 1.0;
+		if (!frappe::gstmeta::scaleFactors(data, sx, sy))
 			return FALSE;
-		const gdouble sx = static_cast<gdouble>(GST_VIDEO_INFO_WIDTH(trans->out_info)) / inW;
-		const gdouble sy = static_cast<gdouble>(GST_VIDEO_INFO_HEIGHT(trans->out_info)) / inH;
 		gfloat corners[8];
 		/* Pixel centres sit at integers: scale about the image's corner. */
 		for (int i = 0; i < 4; ++i) {

@@ -2,7 +2,8 @@
  *
  * gstfrappemeta.h: the per-marker metadata that frappedetect attaches to
  * the buffers it detects on, for applications (link with pkg-config
- * gstfrappemeta). Bindings read it through gstfrappemarker.h (GObject
+ * gstfrappemeta); a bundle's pose is in gstfrappebundlemeta.h, included
+ * here. Bindings read the markers through gstfrappemarker.h (GObject
  * introspection namespace GstFrappe, typelib GstFrappe-1.0).
  */
 #pragma once
@@ -11,6 +12,7 @@
 
 #include "gstfrappemeta-export.h"
 
+#include "gstfrappebundlemeta.h"
 #include "gstfrappemarker.h"
 
 G_BEGIN_DECLS

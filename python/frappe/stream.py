@@ -49,7 +49,7 @@ import time
 from dataclasses import dataclass, field
 from typing import Iterator, List, Optional, Tuple
 
-__all__ = ["Pose", "Marker", "Frame", "Stats", "Reassembler", "Receiver", "udp", "tcp", "open_url",
+__all__ = ["Pose", "Marker", "BundlePose", "Frame", "Stats", "Reassembler", "Receiver", "udp", "tcp", "open_url",
            "parse_line"]
 
 #: How far back (frames) a frame number may be and still be a late part rather
@@ -97,12 +97,35 @@ class Marker:
 
 
 @dataclass
+class BundlePose:
+    """One pose from every marker of a bundle seen in the frame (the robot's
+    `bundle-file`: a board, apriltag_ros's bundle): the bundle frame in the
+    camera frame (`rvec` a Rodrigues rotation, `tvec` its origin, metres),
+    the RMS reprojection error over the corners `used` (pixels), the ids
+    whose corners made it and the ids `rejected` as outliers (a marker
+    moved, a wrong read)."""
+    name: str
+    rvec: Tuple[float, float, float]
+    tvec: Tuple[float, float, float]
+    reprojection_error: Optional[float]
+    used: List[int]
+    rejected: List[int]
+
+    @property
+    def distance(self) -> float:
+        """Metres from the camera to the bundle frame's origin."""
+        return math.sqrt(sum(v * v for v in self.tvec))
+
+
+@dataclass
 class Frame:
     """One camera frame's markers. Times in nanoseconds: `pts` and
     `running_time` of the robot's pipeline, `capture_time` since the Unix
     epoch with `capture_clock` "reference" (the source's own clock) or
     "pipeline" (the pipeline clock's estimate); None when the line has none.
-    `received` is the host's time.time() when the frame was delivered."""
+    `bundle` the bundle's pose, None when the robot has no bundle-file or
+    did not see it. `received` is the host's time.time() when the frame was
+    delivered."""
     number: int
     markers: List[Marker]
     pts: Optional[int] = None
@@ -115,6 +138,7 @@ class Frame:
     complete: bool = True
     parts: int = 1
     received: float = 0.0
+    bundle: Optional[BundlePose] = None
 
 
 @dataclass
@@ -146,14 +170,23 @@ def _marker(m: dict) -> Marker:
                   margin=m.get("margin"), pose=pose, tracked=m.get("tracked"))
 
 
+def _bundle(b: Optional[dict]) -> Optional[BundlePose]:
+    if b is None:
+        return None
+    return BundlePose(name=b.get("name", ""), rvec=_floats(b["rvec"]), tvec=_floats(b["tvec"]),
+                      reprojection_error=b.get("reprojection_error"), used=[int(i) for i in b.get("used", [])],
+                      rejected=[int(i) for i in b.get("rejected", [])])
+
+
 def parse_line(line) -> dict:
-    """One line (bytes or str) as a dict with the markers typed; ValueError
-    when it is not a marker line. The old form without `frame` gets
-    frame None, part 1 of 1."""
+    """One line (bytes or str) as a dict with the markers and the bundle
+    (None when the line has none) typed; ValueError when it is not a marker
+    line. The old form without `frame` gets frame None, part 1 of 1."""
     obj = json.loads(line)
     if not isinstance(obj, dict) or not isinstance(obj.get("markers"), list):
         raise ValueError("not a marker line (no \"markers\" list)")
     obj["markers"] = [_marker(m) for m in obj["markers"]]
+    obj["bundle"] = _bundle(obj.get("bundle"))
     obj.setdefault("frame", None)
     part, parts = int(obj.get("part", 1)), int(obj.get("parts", 1))
     if not 1 <= part <= parts:
@@ -175,7 +208,8 @@ class _Pending:
         return Frame(number=number, markers=markers, pts=h.get("pts"), running_time=h.get("running_time"),
                      capture_time=h.get("capture_time"), capture_clock=h.get("capture_clock"),
                      width=h.get("width"), height=h.get("height"), frame_id=h.get("frame_id"),
-                     complete=len(self.parts) == h["parts"], parts=h["parts"], received=time.time())
+                     complete=len(self.parts) == h["parts"], parts=h["parts"], received=time.time(),
+                     bundle=h.get("bundle"))
 
 
 class Reassembler:

@@ -56,6 +56,12 @@ class Paired:
     def markers(self):
         return self.line["markers"] if self.line else []
 
+    @property
+    def bundle(self):
+        """The line's bundle pose (a dict: name, rvec, tvec,
+        reprojection_error, used, rejected), None without one."""
+        return self.line.get("bundle") if self.line else None
+
     def __repr__(self):
         n = len(self.line["markers"]) if self.line else None
         return f"Paired(key={self.key}, frame={self.line and self.line['frame']}, markers={n})"

@@ -59,6 +59,18 @@ def main():
     check(p.orphans == 20 - 8, f"orphans {p.orphans}")
     check(p.flush() == [], "nothing waits")
 
+    # The bundle, a frame field in every part, stays in the merged line.
+    bundle = {"name": "board", "rvec": [0.1, 0.2, 0.3], "tvec": [0.0, 0.0, 1.0], "reprojection_error": 0.1,
+              "used": [1, 2], "rejected": []}
+    p.add_frame("image40", 40)
+    p.add_line(dict(line(40, 2, 2, [2]), bundle=bundle))
+    out = p.add_line(dict(line(40, 1, 2, [1]), bundle=bundle))
+    check([(o.key, o.bundle, [m["id"] for m in o.markers]) for o in out] == [(40, bundle, [1, 2])],
+          f"frame 40 with its bundle: {out}")
+    p.add_frame("image41", 41)
+    out = p.add_line(line(41, 1, 1, []))
+    check([(o.key, o.bundle) for o in out] == [(41, None)], f"frame 41 without: {out}")
+
     # By any key: the demuxed PTS.
     p = video.Pairer()
     p.add_line(line(7, 1, 1, [42]), key=123456)

@@ -19,17 +19,20 @@ def marker(i, pose=True):
     return m
 
 
-def frame_lines(number, markers, parts=1, pts=None):
+def frame_lines(number, markers, parts=1, pts=None, bundle=None):
     """The lines of one frame: its markers split in order over `parts` lines,
-    each with the whole header."""
+    each with the whole header (and `bundle`, a frame field, when given)."""
     pts = number * 33_333_333 if pts is None else pts
     chunks = [markers[k * len(markers) // parts:(k + 1) * len(markers) // parts] for k in range(parts)]
     out = []
     for k, chunk in enumerate(chunks, 1):
-        out.append(json.dumps({
-            "frame": number, "part": k, "parts": parts, "pts": pts, "running_time": pts, "width": 640,
-            "height": 480, "frame_id": "camera", "capture_time": 1_700_000_000_000_000_000 + pts,
-            "capture_clock": "pipeline", "markers": chunk}) + "\n")
+        line = {"frame": number, "part": k, "parts": parts, "pts": pts, "running_time": pts, "width": 640,
+                "height": 480, "frame_id": "camera", "capture_time": 1_700_000_000_000_000_000 + pts,
+                "capture_clock": "pipeline"}
+        if bundle is not None:
+            line["bundle"] = bundle
+        line["markers"] = chunk
+        out.append(json.dumps(line) + "\n")
     return out
 
 

@@ -41,6 +41,23 @@ def test_parts_in_any_order_make_one_frame_with_markers_in_order():
     assert r.stats == stream.Stats(frames=1)
 
 
+BUNDLE = {"name": "board", "rvec": [-2.7, 0.0, 0.6], "tvec": [-0.05, 0.04, 0.55], "reprojection_error": 0.05,
+          "used": [0, 1, 2, 3, 5], "rejected": [4]}
+
+
+def test_the_bundle_pose_of_any_part_is_typed_and_a_frame_without_has_none():
+    r = stream.Reassembler()
+    lines = frame_lines(7, [marker(i) for i in range(6)], parts=2, bundle=BUNDLE) + frame_lines(8, [marker(0)])
+    frames = feed(r, [lines[1], lines[0], lines[2]])
+    assert [f.number for f in frames] == [7, 8]
+    b = frames[0].bundle
+    assert b == stream.BundlePose("board", (-2.7, 0.0, 0.6), (-0.05, 0.04, 0.55), 0.05, [0, 1, 2, 3, 5], [4])
+    assert b.distance == pytest.approx((0.05 ** 2 + 0.04 ** 2 + 0.55 ** 2) ** 0.5)
+    assert [m.id for m in frames[0].markers] == list(range(6))
+    assert frames[1].bundle is None
+    assert stream.parse_line(json.dumps(dict(json.loads(lines[2]), bundle=None)))["bundle"] is None
+
+
 def test_a_frame_missing_a_part_is_lost_or_delivered_flagged():
     lines = frame_lines(0, [marker(0)]) + frame_lines(1, [marker(i) for i in range(6)], parts=3)[:2] + \
         frame_lines(2, [marker(9)])

@@ -15,6 +15,7 @@
 #include "frappe/export.h"
 
 #include <array>
+#include <memory>
 #include <optional>
 #include <span>
 #include <string>
@@ -85,5 +86,29 @@ struct FRAPPE_EXPORT BundlePose {
 /// Camera::validate().
 FRAPPE_EXPORT std::optional<BundlePose> estimateBundlePose(const Bundle &bundle, std::span<const Marker> markers,
 							   const Camera &camera);
+
+/// estimateBundlePose()'s working memory, for a caller that poses a bundle
+/// every frame (the GStreamer element): kept between calls, its vectors
+/// keep their capacity, so once they have grown to the most markers seen a
+/// pose allocates nothing. One per thread.
+class FRAPPE_EXPORT BundleScratch {
+public:
+	BundleScratch();
+	~BundleScratch();
+	BundleScratch(BundleScratch &&) noexcept;
+	BundleScratch &operator=(BundleScratch &&) noexcept;
+	struct Impl; ///< the library's
+	Impl &impl() { return *impl_; }
+
+private:
+	std::unique_ptr<Impl> impl_;
+};
+
+/// The same pose into `out` (its vectors' capacity reused) with `scratch`'s
+/// memory: true with a pose, false where the other returns std::nullopt
+/// (`out` then holds no pose: its vectors are empty but for `rejected`).
+/// The same results, to the bit.
+FRAPPE_EXPORT bool estimateBundlePose(const Bundle &bundle, std::span<const Marker> markers, const Camera &camera,
+				      BundlePose &out, BundleScratch &scratch);
 
 } // namespace frappe

@@ -221,11 +221,25 @@ double squaredError(const Rigid &T, const Seen &s, const Lens &lens)
 	return detail::squaredReprojection(T.R, T.t, s.model, s.image, lens);
 }
 
-/* Every corner of `seen` refined together (rigid_fit.h). */
-void refine(Rigid &T, std::span<Seen *const> seen, const Lens &lens)
-{
-	std::vector<Vector3d> model;
+} // namespace
+
+/* What a pose needs besides its result, kept by BundleScratch. */
+struct BundleScratch::Impl {
+	std::vector<Seen> seen;
+	std::vector<Seen *> used;
+	std::vector<Vector3d> model; /* refine()'s corners */
 	std::vector<Point2f> image;
+};
+
+namespace {
+
+/* Every corner of `seen` refined together (rigid_fit.h), gathered into
+ * `model` and `image`. */
+void refine(Rigid &T, std::span<Seen *const> seen, const Lens &lens, std::vector<Vector3d> &model,
+	    std::vector<Point2f> &image)
+{
+	model.clear();
+	image.clear();
 	for (const Seen *s : seen) {
 		model.insert(model.end(), s->model.begin(), s->model.end());
 		image.insert(image.end(), s->image.begin(), s->image.end());
@@ -287,13 +301,32 @@ Bundle loadBundle(const std::string &path)
 	return parseBundle(f.text, path);
 }
 
+BundleScratch::BundleScratch() : impl_(std::make_unique<Impl>())
+{}
+BundleScratch::~BundleScratch() = default;
+BundleScratch::BundleScratch(BundleScratch &&) noexcept = default;
+BundleScratch &BundleScratch::operator=(BundleScratch &&) noexcept = default;
+
 std::optional<BundlePose> estimateBundlePose(const Bundle &bundle, std::span<const Marker> markers,
 					     const Camera &camera)
 {
+	BundleScratch scratch;
+	BundlePose out;
+	if (!estimateBundlePose(bundle, markers, camera, out, scratch))
+		return std::nullopt;
+	return out;
+}
+
+bool estimateBundlePose(const Bundle &bundle, std::span<const Marker> markers, const Camera &camera, BundlePose &out,
+			BundleScratch &scratch)
+{
 	camera.validate();
 	const Lens lens(camera);
-	BundlePose out;
-	std::vector<Seen> seen;
+	out.pose = {};
+	out.used.clear();
+	out.rejected.clear();
+	std::vector<Seen> &seen = scratch.impl().seen;
+	seen.clear();
 	for (const Marker &m : markers) {
 		const BundleMarker *b = bundle.find(m.id);
 		if (!b)
@@ -322,7 +355,7 @@ std::optional<BundlePose> estimateBundlePose(const Bundle &bundle, std::span<con
 		seen.push_back(s);
 	}
 	if (seen.empty())
-		return std::nullopt;
+		return false;
 
 	/* Starting points: each marker's two poses, carried to the bundle's
 	 * frame; the one most markers agree with (then the smallest error over
@@ -359,11 +392,11 @@ std::optional<BundlePose> estimateBundlePose(const Bundle &bundle, std::span<con
 		}
 	}
 	if (bestCount == 0)
-		return std::nullopt;
+		return false;
 
 	/* Refined over the agreeing markers, then once more without those
 	 * that still disagree. */
-	std::vector<Seen *> used;
+	std::vector<Seen *> &used = scratch.impl().used;
 	for (int pass = 0; pass < 2; ++pass) {
 		used.clear();
 		for (Seen &s : seen) {
@@ -372,8 +405,8 @@ std::optional<BundlePose> estimateBundlePose(const Bundle &bundle, std::span<con
 				used.push_back(&s);
 		}
 		if (used.empty())
-			return std::nullopt;
-		refine(best, used, lens);
+			return false;
+		refine(best, used, lens, scratch.impl().model, scratch.impl().image);
 	}
 	for (Seen &s : seen) {
 		s.rms = std::sqrt(squaredError(best, s, lens) / 4.0);
@@ -389,7 +422,7 @@ std::optional<BundlePose> estimateBundlePose(const Bundle &bundle, std::span<con
 	out.pose.error = std::sqrt(err / (4.0 * static_cast<double>(used.size())));
 	std::sort(out.used.begin(), out.used.end());
 	std::sort(out.rejected.begin(), out.rejected.end());
-	return out;
+	return true;
 }
 
 } // namespace frappe

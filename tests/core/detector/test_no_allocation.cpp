@@ -180,3 +180,41 @@ TEST(NoAllocationTrack, FramesReadInRegionsAllocateNothingOnceWarm)
 	EXPECT_GE(regions, 6);
 	EXPECT_EQ(after - before, 0) << "detect() allocated in Mode::Track on frames of a size it had seen";
 }
+
+/* A bundle's pose with a BundleScratch and a BundlePose kept between
+ * frames (what the element does): nothing allocated once they have grown,
+ * and the same pose as estimateBundlePose() without them. */
+TEST(NoAllocationBundle, PoseWithScratchAllocatesNothingOnceWarm)
+{
+	const Bundle board = Bundle::grid(3, 4, 0.05, 0.01);
+	const Camera cam = Camera::pinhole(900.0, 900.0, 639.5, 359.5, 1280, 720);
+	Pose truth;
+	truth.rvec = { 2.9, 0.2, 0.3 };
+	truth.tvec = { -0.1, -0.05, 0.8 };
+	std::vector<Marker> seen;
+	for (const BundleMarker &m : board.markers) {
+		const std::vector<Point2f> px = projectPoints(m.corners, truth, cam);
+		Marker mk;
+		mk.id = m.id;
+		for (std::size_t k = 0; k < 4; ++k)
+			mk.corners[k] = px[k];
+		seen.push_back(mk);
+	}
+	seen[5].corners[0].x += 9.0f; /* a marker moved: rejected */
+	BundleScratch scratch;
+	BundlePose pose;
+	ASSERT_TRUE(estimateBundlePose(board, seen, cam, pose, scratch));
+	const long before = gAllocations.load();
+	for (int i = 0; i < 3; ++i)
+		ASSERT_TRUE(estimateBundlePose(board, seen, cam, pose, scratch));
+	EXPECT_EQ(gAllocations.load() - before, 0);
+	const long fresh = gAllocations.load();
+	const auto alone = estimateBundlePose(board, seen, cam);
+	EXPECT_GT(gAllocations.load() - fresh, 0); /* without them it allocates: the count sees it */
+	ASSERT_TRUE(alone.has_value());
+	EXPECT_EQ(pose.pose.rvec, alone->pose.rvec);
+	EXPECT_EQ(pose.pose.tvec, alone->pose.tvec);
+	EXPECT_EQ(pose.pose.error, alone->pose.error);
+	EXPECT_EQ(pose.used, alone->used);
+	EXPECT_EQ(pose.rejected, std::vector<int>{ 5 });
+}
