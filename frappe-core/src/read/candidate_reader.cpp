@@ -152,11 +152,15 @@ void detail::CandidateReader::refineAndWarpAll(const ImageView &image, Slot &slo
 		}
 	}
 	timer.lap(Stage::Warp);
+	warpBatch(image, (dict->bits + 2) * detail::kSamplesPerCell);
+}
+
+void detail::CandidateReader::warpBatch(const ImageView &image, int side)
+{
 	const std::size_t m = batch.quads.size();
 	batch.warpedOk.assign(m, 0);
 	batch.samples.resize(std::max(batch.samples.size(), m));
-	warper->warp(image, batch.quads, (dict->bits + 2) * detail::kSamplesPerCell,
-		     std::span(batch.samples).first(m), batch.warpedOk);
+	warper->warp(image, batch.quads, side, std::span(batch.samples).first(m), batch.warpedOk);
 }
 
 /* Candidates not worth refining: the outline of a decoded marker's quiet

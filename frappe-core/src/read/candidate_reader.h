@@ -179,6 +179,8 @@ private:
 	/* The same for a dictionary with a layout (layout_candidate.cpp). */
 	bool refineLayoutQuad(const ImageView &image, Quad &q, float search) const;
 	void refineAndWarpLayouts(const ImageView &image, Slot &slot, float search);
+	/// The batch's quads warped in one call, `side` samples a side.
+	void warpBatch(const ImageView &image, int side);
 	bool readLayoutCandidate(const ImageView &image, Slot &slot, std::size_t k, float search, StageTimer &timer,
 				 Marker &m);
 	/* Border cells that make a white frame: three quarters of the

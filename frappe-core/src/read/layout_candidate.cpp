@@ -70,11 +70,7 @@ void detail::CandidateReader::refineAndWarpLayouts(const ImageView &image, Slot 
 		}
 	}
 	timer.lap(Stage::Warp);
-	const std::size_t m = batch.quads.size();
-	batch.warpedOk.assign(m, 0);
-	batch.samples.resize(std::max(batch.samples.size(), m));
-	warper->warp(image, batch.quads, detail::layoutGridSide(layout), std::span(batch.samples).first(m),
-		     batch.warpedOk);
+	warpBatch(image, detail::layoutGridSide(layout));
 }
 
 bool detail::CandidateReader::readLayoutCandidate(const ImageView &image, Slot &slot, std::size_t k, float search,
