@@ -196,19 +196,33 @@ def parse_line(line) -> dict:
 
 
 class _Pending:
-    """The parts of one frame received so far."""
+    """The parts of one frame's line received so far, in any order (also
+    frappe.video's pairing of lines with video frames)."""
 
     def __init__(self, header: dict):
         self.header = header
         self.parts = {}
 
+    def add(self, part: dict):
+        self.parts[part["part"]] = part["markers"]
+
+    def whole(self) -> bool:
+        return len(self.parts) == self.header["parts"]
+
+    def markers(self) -> list:
+        return [m for k in sorted(self.parts) for m in self.parts[k]]
+
+    def merged(self) -> dict:
+        """The whole line: the header with every part's markers."""
+        header = {k: v for k, v in self.header.items() if k != "part"}
+        return dict(header, markers=self.markers())
+
     def frame(self, number: int) -> Frame:
         h = self.header
-        markers = [m for k in sorted(self.parts) for m in self.parts[k]]
-        return Frame(number=number, markers=markers, pts=h.get("pts"), running_time=h.get("running_time"),
+        return Frame(number=number, markers=self.markers(), pts=h.get("pts"), running_time=h.get("running_time"),
                      capture_time=h.get("capture_time"), capture_clock=h.get("capture_clock"),
                      width=h.get("width"), height=h.get("height"), frame_id=h.get("frame_id"),
-                     complete=len(self.parts) == h["parts"], parts=h["parts"], received=time.time(),
+                     complete=self.whole(), parts=h["parts"], received=time.time(),
                      bundle=h.get("bundle"))
 
 
@@ -243,7 +257,7 @@ class Reassembler:
         if number is None:  # the old form: whole, numbered by arrival
             self._arrivals += 1
             pending = _Pending(dict(part, parts=1))
-            pending.parts[1] = part["markers"]
+            pending.add(part)
             return [self._deliver(pending.frame(self._arrivals - 1), count_gap=False)]
         number = int(number)
         out = []
@@ -262,8 +276,8 @@ class Reassembler:
         pending = self._pending.get(number)
         if pending is None:
             pending = self._pending[number] = _Pending(part)
-        pending.parts[part["part"]] = part["markers"]
-        if len(pending.parts) == pending.header["parts"]:
+        pending.add(part)
+        if pending.whole():
             out += self._give_up(number)
             del self._pending[number]
             out.append(self._deliver(pending.frame(number)))

@@ -22,6 +22,8 @@ gstreamer1.0-plugins-bad and gstreamer1.0-libav).
 import collections
 import json
 
+from .stream import _Pending
+
 # The KLV key of frappejson's packets (src caps meta/x-klv).
 KLV_KEY = b"frappe/markers/1"
 
@@ -67,24 +69,6 @@ class Paired:
         return f"Paired(key={self.key}, frame={self.line and self.line['frame']}, markers={n})"
 
 
-class _Line:
-    """The parts of one frame's line as they arrive, in any order."""
-
-    def __init__(self, first):
-        self.header = {k: v for k, v in first.items() if k not in ("part", "markers")}
-        self.parts = {}
-
-    def add(self, line):
-        self.parts[line["part"]] = line["markers"]
-
-    def whole(self):
-        return len(self.parts) == self.header["parts"]
-
-    def merged(self):
-        markers = [m for k in sorted(self.parts) for m in self.parts[k]]
-        return dict(self.header, markers=markers)
-
-
 class Pairer:
     """Pairs video frames with marker lines by a key both carry.
 
@@ -97,7 +81,7 @@ class Pairer:
     def __init__(self, max_waiting=30):
         self.max_waiting = max_waiting
         self._frames = collections.deque()  # (key, image, sample)
-        self._lines = collections.OrderedDict()  # key -> _Line
+        self._lines = collections.OrderedDict()  # key -> _Pending
         self.unpaired = 0
         self.orphans = 0
 
@@ -106,7 +90,7 @@ class Pairer:
             line = json.loads(line)
         key = line["frame"] if key is None else key
         if key not in self._lines:
-            self._lines[key] = _Line(line)
+            self._lines[key] = _Pending(line)
             while len(self._lines) > self.max_waiting * 4:
                 self._lines.popitem(last=False)
                 self.orphans += 1

@@ -20,7 +20,7 @@ Then the robot restarts (a second run of the script, frame numbers from
 0 again) while the same host program reads on: every frame of the second
 run is paired as well.
 Exit 77 without gi, the typelib, or the GStreamer elements it takes."""
-import importlib.util
+import importlib
 import json
 import os
 import socket
@@ -34,11 +34,10 @@ RUNS = 2  # the robot's first run, then a restart
 
 
 def load_video_module(path):
-    """python/frappe/video.py on its own: no compiled extension needed."""
-    spec = importlib.util.spec_from_file_location("frappe_video", path)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    """python/frappe/video.py as frappe.video, imported from its source
+    folder: the package imports without the compiled extension."""
+    sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(path))))
+    return importlib.import_module("frappe.video")
 
 
 def shown(n, ids):
