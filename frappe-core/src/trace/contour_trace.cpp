@@ -934,7 +934,7 @@ bool ContourTracer::acceptQuad(const TraceParams &params, int w, int h, Quad &qu
 	 * still covers the four sides, and is kept. */
 	/* Per side: unit normal n and offset c (n . p = c on the side), and the
 	 * bin of a point along it, t = (u . p - t0) * kBins / len. */
-	constexpr int kBins = kSideBins;
+	constexpr int kBins = kSideBins, kCoveredBins = kBins * 7 / 16;
 	const float shortSide = std::sqrt(shortest);
 	const float tol = std::max(1.5f, 0.06f * shortSide);
 	/* A bin is 1/16 of a side: on long sides every point is not needed to
@@ -954,11 +954,11 @@ bool ContourTracer::acceptQuad(const TraceParams &params, int w, int h, Quad &qu
 	for (int i = 0; i < 4; ++i) {
 		const SideLine side = SideLine::between(q[i], q[(i + 1) & 3]);
 #ifdef FRAPPE_HAVE_ARMV6_TRACE
-		const std::uint32_t covered = sideCoverageV6(pts, n, side, tol, w + h);
+		const std::uint32_t covered = sideCoverageV6(pts, n, side, tol, w + h, kCoveredBins);
 #else
 		const std::uint32_t covered = sideCoverage(pts, n, side, tol);
 #endif
-		if (std::popcount(covered) < kBins * 7 / 16)
+		if (std::popcount(covered) < kCoveredBins)
 			return false;
 	}
 	return true;

@@ -13,6 +13,7 @@
 
 #include <arm_acle.h>
 
+#include <climits>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -224,7 +225,8 @@ __attribute__((optimize("omit-frame-pointer"))) OutlineExtremes outlineExtremesV
 	return e;
 }
 
-std::uint32_t sideCoverageV6(const std::uint32_t *pts, std::size_t n, const SideLine &side, float tol, int bound)
+std::uint32_t sideCoverageV6(const std::uint32_t *pts, std::size_t n, const SideLine &side, float tol, int bound,
+			     int need)
 {
 	/* A point far from the line is told in integers first, with SMLAD on
 	 * its two lanes: a = NX x + NY y - NC, the side's normal and offset
@@ -247,6 +249,10 @@ std::uint32_t sideCoverageV6(const std::uint32_t *pts, std::size_t n, const Side
 	const std::int32_t T = static_cast<std::int32_t>(tol * 16384.0f) + bound + bound / 64 + 4;
 	const u32 span = 2 * static_cast<u32>(T);
 	std::uint32_t covered = 0;
+	/* Bins still to cover before the caller's answer is known: the
+	 * scan stops there (a side that is covered is usually so half-way
+	 * through the outline). */
+	int left = need > 0 ? need : INT_MAX;
 	const std::uint32_t *const end = pts + n;
 	for (const std::uint32_t *p = pts; p != end; ++p) {
 		u32 v = *p;
@@ -258,8 +264,14 @@ std::uint32_t sideCoverageV6(const std::uint32_t *pts, std::size_t n, const Side
 		if (std::abs(side.nx * px + side.ny * py - side.nc) > tol)
 			continue;
 		const float t = side.ux * px + side.uy * py - side.t0;
-		if (t >= 0.0f && t < static_cast<float>(kSideBins))
-			covered |= 1u << static_cast<int>(t);
+		if (t >= 0.0f && t < static_cast<float>(kSideBins)) {
+			const std::uint32_t bit = 1u << static_cast<int>(t);
+			if ((covered & bit) == 0) {
+				covered |= bit;
+				if (--left == 0)
+					return covered;
+			}
+		}
 	}
 	return covered;
 }
