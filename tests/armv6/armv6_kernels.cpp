@@ -10,6 +10,7 @@
 // front end (EdgeMap pixels and tiles) on constructed images with several
 // thresholds, and on each binary PGM (P5) given.
 #include <algorithm>
+#include <bit>
 #include <cinttypes>
 #include <cstdio>
 #include <cstdlib>
@@ -380,6 +381,20 @@ void checkSideCoverage(int w, int h, int trials)
 		const std::uint32_t want = sideCoverageScalar(pts.data(), n, side, tol);
 		const std::uint32_t got = sideCoverageV6(pts.data(), n, side, tol, w + h);
 		CHECK(want == got, "sideCoverage %dx%d trial %d: %08x vs %08x", w, h, k, want, got);
+		/* From any first point, stopping at `need` bins: a subset of at
+		 * least need bits, or all of them when there are fewer. */
+		for (const std::size_t first : { std::size_t{ 0 }, n / 3, n - 1, n }) {
+			CHECK(sideCoverageV6(pts.data(), n, side, tol, w + h, 0, first) == want,
+			      "sideCoverage %dx%d trial %d from %zu", w, h, k, first);
+			for (const int need : { 1, 7, 16 }) {
+				const std::uint32_t part = sideCoverageV6(pts.data(), n, side, tol, w + h, need, first);
+				const bool fine = std::popcount(want) < need
+							  ? part == want
+							  : std::popcount(part) >= need && (part & ~want) == 0;
+				CHECK(fine, "sideCoverage %dx%d trial %d need %d from %zu: %08x vs %08x", w, h, k, need,
+				      first, want, part);
+			}
+		}
 	}
 }
 

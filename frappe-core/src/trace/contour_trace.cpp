@@ -370,9 +370,11 @@ void ContourTracer::trace(const TraceMap &edges, const TraceParams &params, std:
 		 * clusters (a marker whose faint corners did not all register
 		 * still has two; clutter with none is most of what reaches here). */
 		Quad quad;
+		std::array<std::size_t, 4> at;
 		if ((!tooManyClusters_ && clusters_.size() >= 4 && quadFromClusters(quad) &&
 		     acceptQuad(params, w, h, quad)) ||
-		    (clusters_.size() >= static_cast<std::size_t>(params.min_clusters) && quadFromOutline(quad) && acceptQuad(params, w, h, quad))) {
+		    (clusters_.size() >= static_cast<std::size_t>(params.min_clusters) && quadFromOutline(quad, at) &&
+		     acceptQuad(params, w, h, quad, &at))) {
 			if (probe && probe->isMarker(quad)) {
 				quad.probeDecoded = true;
 				sealInside(quad, w, h);
@@ -879,7 +881,7 @@ bool ContourTracer::quadFromClusters(Quad &quad) const
  * corner), the outline itself does: the point farthest from the centroid,
  * the point farthest from that one, and the farthest on either side of the
  * diagonal they span. */
-bool ContourTracer::quadFromOutline(Quad &quad) const
+bool ContourTracer::quadFromOutline(Quad &quad, std::array<std::size_t, 4> &at) const
 {
 	const std::size_t n = static_cast<std::size_t>(steps_);
 	if (n < 8)
@@ -891,10 +893,12 @@ bool ContourTracer::quadFromOutline(Quad &quad) const
 		return Point2f{ static_cast<float>(points_[i] & 0xFFFFu), static_cast<float>(points_[i] >> 16) };
 	};
 	quad.corners = { pt(e.i0), pt(e.i1), pt(e.i2), pt(e.i3) };
+	at = { e.i0, e.i1, e.i2, e.i3 };
 	return true;
 }
 
-bool ContourTracer::acceptQuad(const TraceParams &params, int w, int h, Quad &quad)
+bool ContourTracer::acceptQuad(const TraceParams &params, int w, int h, Quad &quad,
+			       [[maybe_unused]] const std::array<std::size_t, 4> *at)
 {
 	auto &q = quad.corners;
 	/* Convex, and oriented clockwise on screen (positive cross in y-down). */
@@ -908,7 +912,8 @@ bool ContourTracer::acceptQuad(const TraceParams &params, int w, int h, Quad &qu
 		else if ((c > 0.0f) != (sign > 0.0f))
 			return false;
 	}
-	if (sign < 0.0f)
+	const bool swapped = sign < 0.0f;
+	if (swapped)
 		std::swap(q[1], q[3]);
 
 	/* Sides of min_side on average, none under 0.6 of it: a marker tilted
@@ -934,7 +939,7 @@ bool ContourTracer::acceptQuad(const TraceParams &params, int w, int h, Quad &qu
 	 * still covers the four sides, and is kept. */
 	/* Per side: unit normal n and offset c (n . p = c on the side), and the
 	 * bin of a point along it, t = (u . p - t0) * kBins / len. */
-	constexpr int kBins = kSideBins;
+	constexpr int kBins = kSideBins, kCoveredBins = kBins * 7 / 16;
 	const float shortSide = std::sqrt(shortest);
 	const float tol = std::max(1.5f, 0.06f * shortSide);
 	/* A bin is 1/16 of a side: on long sides every point is not needed to
@@ -951,14 +956,38 @@ bool ContourTracer::acceptQuad(const TraceParams &params, int w, int h, Quad &qu
 		pts = sampled_.data();
 		n = m;
 	}
+#ifdef FRAPPE_HAVE_ARMV6_TRACE
+	/* Where each side's own stretch of the border begins (in pts): the
+	 * scan stops at the bins it needs, which that stretch covers first.
+	 * The side from corner a to corner b is the way round from one to
+	 * the other that passes no other corner. */
+	std::array<std::size_t, 4> first{};
+	if (at) {
+		std::array<std::size_t, 4> c = *at;
+		if (swapped)
+			std::swap(c[1], c[3]);
+		/* Indices below n: no division (a library call here). */
+		const std::size_t all = static_cast<std::size_t>(steps_);
+		auto ahead = [all](std::size_t from, std::size_t to) {
+			return to >= from ? to - from : to + all - from;
+		};
+		for (int i = 0; i < 4; ++i) {
+			const std::size_t a = c[i], b = c[(i + 1) & 3];
+			const std::size_t span = ahead(a, b);
+			const std::size_t at0 =
+				ahead(a, c[(i + 2) & 3]) < span || ahead(a, c[(i + 3) & 3]) < span ? b : a;
+			first[i] = stride == 1 ? at0 : at0 / stride;
+		}
+	}
+#endif
 	for (int i = 0; i < 4; ++i) {
 		const SideLine side = SideLine::between(q[i], q[(i + 1) & 3]);
 #ifdef FRAPPE_HAVE_ARMV6_TRACE
-		const std::uint32_t covered = sideCoverageV6(pts, n, side, tol, w + h);
+		const std::uint32_t covered = sideCoverageV6(pts, n, side, tol, w + h, kCoveredBins, first[i]);
 #else
 		const std::uint32_t covered = sideCoverage(pts, n, side, tol);
 #endif
-		if (std::popcount(covered) < kBins * 7 / 16)
+		if (std::popcount(covered) < kCoveredBins)
 			return false;
 	}
 	return true;

@@ -115,8 +115,12 @@ private:
 	/// length is at most maxWinding times the perimeter of the box.
 	bool spansAtLeast(float span, float maxWinding) const;
 	bool quadFromClusters(Quad &quad) const;
-	bool quadFromOutline(Quad &quad) const;
-	bool acceptQuad(const TraceParams &params, int w, int h, Quad &quad);
+	/// `at`: the indices of the four corners among the border's points.
+	bool quadFromOutline(Quad &quad, std::array<std::size_t, 4> &at) const;
+	/// With `at` (a quad of outline points: their indices), each side's
+	/// coverage is read from its own stretch of the border first.
+	bool acceptQuad(const TraceParams &params, int w, int h, Quad &quad,
+			const std::array<std::size_t, 4> *at = nullptr);
 	void sealInside(const Quad &quad, int w, int h);
 
 	std::vector<std::uint8_t> labels_;

@@ -102,8 +102,13 @@ void labelsFromEdgesV6(const std::uint8_t *edges, std::size_t n, std::uint8_t *l
 OutlineExtremes outlineExtremesV6(const std::uint32_t *pts, std::size_t n);
 PointsBox pointsBoxV6(const std::uint32_t *pts, std::size_t n);
 /// sideCoverage for points with x + y <= bound (the map's width plus
-/// height): most points are rejected in integers first.
-std::uint32_t sideCoverageV6(const std::uint32_t *pts, std::size_t n, const SideLine &side, float tol, int bound);
+/// height): most points are rejected in integers first. With need > 0 the
+/// scan stops once `need` bins are covered: the result is then a subset of
+/// sideCoverage's with at least `need` bits, and sideCoverage's exactly
+/// when that has fewer. The scan starts at point `first` (< n, or 0) and
+/// wraps round.
+std::uint32_t sideCoverageV6(const std::uint32_t *pts, std::size_t n, const SideLine &side, float tol, int bound,
+			     int need = 0, std::size_t first = 0);
 #endif
 
 } // namespace frappe::detail

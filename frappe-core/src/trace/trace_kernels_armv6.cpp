@@ -13,6 +13,7 @@
 
 #include <arm_acle.h>
 
+#include <climits>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -224,7 +225,8 @@ __attribute__((optimize("omit-frame-pointer"))) OutlineExtremes outlineExtremesV
 	return e;
 }
 
-std::uint32_t sideCoverageV6(const std::uint32_t *pts, std::size_t n, const SideLine &side, float tol, int bound)
+std::uint32_t sideCoverageV6(const std::uint32_t *pts, std::size_t n, const SideLine &side, float tol, int bound,
+			     int need, std::size_t first)
 {
 	/* A point far from the line is told in integers first, with SMLAD on
 	 * its two lanes: a = NX x + NY y - NC, the side's normal and offset
@@ -247,20 +249,36 @@ std::uint32_t sideCoverageV6(const std::uint32_t *pts, std::size_t n, const Side
 	const std::int32_t T = static_cast<std::int32_t>(tol * 16384.0f) + bound + bound / 64 + 4;
 	const u32 span = 2 * static_cast<u32>(T);
 	std::uint32_t covered = 0;
-	const std::uint32_t *const end = pts + n;
-	for (const std::uint32_t *p = pts; p != end; ++p) {
-		u32 v = *p;
-		const std::int32_t a = __smlad(static_cast<int16x2_t>(v), static_cast<int16x2_t>(normal), -nc);
-		if (static_cast<u32>(a + T) > span) /* a > T or a < -T */
-			continue;
-		__asm__("" : "+r"(v)); /* unpack only here, not before the test */
-		const float px = static_cast<float>(v & 0xFFFFu), py = static_cast<float>(v >> 16);
-		if (std::abs(side.nx * px + side.ny * py - side.nc) > tol)
-			continue;
-		const float t = side.ux * px + side.uy * py - side.t0;
-		if (t >= 0.0f && t < static_cast<float>(kSideBins))
-			covered |= 1u << static_cast<int>(t);
-	}
+	/* Bins still to cover before the caller's answer is known: the
+	 * scan stops there (a side that is covered is usually so half-way
+	 * through its own stretch of the border). */
+	int left = need > 0 ? need : INT_MAX;
+	/* Points [from, to); false once the answer is known. */
+	auto scan = [&](const std::uint32_t *from, const std::uint32_t *to) {
+		for (const std::uint32_t *p = from; p != to; ++p) {
+			u32 v = *p;
+			const std::int32_t a = __smlad(static_cast<int16x2_t>(v), static_cast<int16x2_t>(normal), -nc);
+			if (static_cast<u32>(a + T) > span) /* a > T or a < -T */
+				continue;
+			__asm__("" : "+r"(v)); /* unpack only here, not before the test */
+			const float px = static_cast<float>(v & 0xFFFFu), py = static_cast<float>(v >> 16);
+			if (std::abs(side.nx * px + side.ny * py - side.nc) > tol)
+				continue;
+			const float t = side.ux * px + side.uy * py - side.t0;
+			if (t >= 0.0f && t < static_cast<float>(kSideBins)) {
+				const std::uint32_t bit = 1u << static_cast<int>(t);
+				if ((covered & bit) == 0) {
+					covered |= bit;
+					if (--left == 0)
+						return false;
+				}
+			}
+		}
+		return true;
+	};
+	const std::uint32_t *const start = pts + (first < n ? first : 0);
+	if (scan(start, pts + n))
+		scan(pts, start);
 	return covered;
 }
 
