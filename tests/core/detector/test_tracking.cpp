@@ -175,6 +175,53 @@ TEST(RegionFrontEnd, BitIdenticalToTheWholeFrameInsideEachRegion)
 	}
 }
 
+/* A marker read at its prediction: the maps lose the inside of its quad
+ * (moved in by the inset), in each map's own pixels, and nothing else. */
+TEST(RegionFrontEnd, ClearsOnlyInsideTheMarkersReadAtTheirPredictions)
+{
+	EdgeMap maps;
+	maps.resize(200, 160);
+	maps.scale = 1.0f;
+	for (TraceMap *m : { &maps.regions, &maps.shades }) {
+		m->resize(100, 80);
+		m->scale = 0.5f;
+	}
+	for (TraceMap *m : { static_cast<TraceMap *>(&maps), &maps.regions, &maps.shades })
+		std::fill(m->pixels.begin(), m->pixels.end(), 1);
+	Marker mk;
+	mk.corners = squarePose(100.0f, 80.0f, 60.0f, 20.0f, 10.0f);
+	const float inset = 1.5f;
+	detail::clearInsideMarkers(maps, std::span<const Marker>(&mk, 1), inset);
+	/* Signed distances of a point from the quad's sides (inside > 0). */
+	auto inside = [&](float x, float y) {
+		float in = 1e9f;
+		for (int i = 0; i < 4; ++i) {
+			const Point2f a = mk.corners[i], b = mk.corners[(i + 1) % 4];
+			const float len = std::hypot(b.x - a.x, b.y - a.y);
+			const float cross = ((b.x - a.x) * (y - a.y) - (b.y - a.y) * (x - a.x)) / len;
+			in = std::min(in, cross);
+		}
+		return in;
+	};
+	const float orientation = inside(100.0f, 80.0f) > 0 ? 1.0f : -1.0f;
+	for (TraceMap *m : { static_cast<TraceMap *>(&maps), &maps.regions, &maps.shades }) {
+		long cleared = 0;
+		for (int y = 0; y < m->height; ++y)
+			for (int x = 0; x < m->width; ++x) {
+				/* The pixel's centre in frame pixels. */
+				const float d = orientation * inside((x + 0.5f) / m->scale, (y + 0.5f) / m->scale);
+				if (d > inset + 1.0f / m->scale) {
+					EXPECT_EQ(m->at(x, y), 0) << "kept inside at " << x << "," << y;
+				}
+				if (d < 0.0f) {
+					EXPECT_EQ(m->at(x, y), 1) << "cleared outside at " << x << "," << y;
+				}
+				cleared += m->at(x, y) == 0;
+			}
+		EXPECT_GT(cleared, static_cast<long>(0.8f * 55.0f * 55.0f * m->scale * m->scale));
+	}
+}
+
 TEST(RegionFrontEnd, AlignsOutwardAndClips)
 {
 	static_assert(RegionFrontEnd::kAlign == 8);
