@@ -52,7 +52,7 @@ void markRectTiles(const TraceMap *sub, int sx, int sy, TraceMap &out, int x0, i
 				continue;
 			}
 			std::uint64_t any = 0;
-			for (int y = ya; y < yb; ++y) {
+			for (int y = ya; y < yb && !any; ++y) {
 				const std::uint8_t *p = out.pixels.data() + static_cast<std::size_t>(y) * out.width;
 				int x = a;
 				for (; x + 8 <= b; x += 8) {
@@ -357,7 +357,7 @@ Tracker::Tracker(int coverFrames) : coverFrames_(std::max(1, coverFrames))
 	next_.reserve(64);
 	predictions_.reserve(64);
 	regions_.reserve(64);
-	strips_.reserve(4);
+	strips_.reserve(8); /* placeStrips()'s, the gaps to the band, the band */
 	matched_.reserve(64);
 }
 
@@ -491,9 +491,25 @@ bool Tracker::placeRegions(std::span<const std::uint8_t> read)
 		regions_.push_back(bandRect);
 	mergeRects(regions_);
 	placeStrips();
-	/* The region map's band, unless the strip is the whole frame. */
-	if (!fullBand && !(strips_.size() == 1 && strips_[0] == PixelRect{ 0, 0, w, h }))
-		strips_.push_back(bandRect);
+	if (!(strips_.size() == 1 && strips_[0] == PixelRect{ 0, 0, w, h })) {
+		/* A marker entering over the top or bottom edge may be taller
+		 * than the strip there: the rows between the strip and a band
+		 * less than a band away join them in the region map, so that it
+		 * is whole there on that band's frame of each round. */
+		const std::size_t n = strips_.size();
+		for (std::size_t i = 0; i < n; ++i) {
+			const PixelRect st = strips_[i];
+			if (st.x0 != 0 || st.x1 != w)
+				continue;
+			if (st.y0 > bandRect.y1 && st.y0 - bandRect.y1 < h / k)
+				strips_.push_back({ 0, bandRect.y1, w, st.y0 });
+			if (st.y1 < bandRect.y0 && bandRect.y0 - st.y1 < h / k)
+				strips_.push_back({ 0, st.y1, w, bandRect.y0 });
+		}
+		/* The region map's band. */
+		if (!fullBand)
+			strips_.push_back(bandRect);
+	}
 	std::size_t area = 0;
 	for (const PixelRect &r : regions_)
 		area += r.area();
