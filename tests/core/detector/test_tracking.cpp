@@ -6,6 +6,7 @@
 // frame whole.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <stdexcept>
@@ -315,6 +316,66 @@ TEST(Tracking, FollowsMovingMarkersWithMeasuredCornersAndFindsANewOneWithinKFram
 	ASSERT_GE(newFoundAt, newFrom);
 	EXPECT_LT(newFoundAt - newFrom, cfg.track_cover_frames) << "found " << newFoundAt - newFrom << " frames late";
 	EXPECT_GE(partialFrames, 18) << "frames read in regions";
+}
+
+/* The band's schedule, with every track read at its prediction: the
+ * front end's rectangles are a band of rows on every other round of k
+ * frames (the edges and the shade map: every row within 2k frames, its
+ * seams in new places), none on the others (the region map's rounds). */
+TEST(Tracking, TheBandGoesThroughEveryMapOnEveryOtherRound)
+{
+	const int w = 640, h = 480, k = 4;
+	detail::Tracker tracker(k);
+	const Image img(w, h, 120);
+	std::vector<Marker> markers(1);
+	markers[0].id = 5;
+	auto moveTo = [&](int f) {
+		markers[0].corners = squarePose(200.0f + 2.0f * f, 200.0f + 1.0f * f, 50.0f, 0.0f, 0.0f);
+	};
+	moveTo(0);
+	ASSERT_FALSE(tracker.plan(img.view(), true)) << "the first frame is whole";
+	tracker.update(markers, w, h, false, false);
+	/* Each full round's bands (one or two pieces: the last band wraps to
+	 * the top). */
+	std::vector<std::vector<PixelRect>> bands;
+	for (int f = 1; f <= 4 * k; ++f) {
+		ASSERT_TRUE(tracker.plan(img.view(), true)) << "frame " << f;
+		const std::uint8_t read = 1;
+		ASSERT_TRUE(tracker.placeRegions(std::span(&read, 1))) << "frame " << f;
+		const auto regions = tracker.regions();
+		const int round = (f - 1) / k;
+		if (round % 2 == 0) {
+			ASSERT_GE(regions.size(), 1u) << "frame " << f;
+			ASSERT_LE(regions.size(), 2u) << "frame " << f;
+			int rows = 0;
+			for (const PixelRect &r : regions) {
+				EXPECT_EQ(r.x0, 0);
+				EXPECT_EQ(r.x1, w);
+				rows += r.y1 - r.y0;
+			}
+			/* A band, its overlaps and alignment: as tall wherever it is. */
+			EXPECT_GE(rows, h / k) << "frame " << f;
+			EXPECT_LE(rows, h / k + 4 * RegionFrontEnd::kAlign + 8) << "frame " << f;
+			bands.emplace_back(regions.begin(), regions.end());
+		} else {
+			EXPECT_TRUE(regions.empty()) << "frame " << f << ": the region map's round";
+		}
+		moveTo(f);
+		tracker.update(markers, w, h, true, true);
+	}
+	/* Each full round covers every row; the second's seams are elsewhere. */
+	ASSERT_EQ(bands.size(), static_cast<std::size_t>(2 * k));
+	for (int r = 0; r < 2; ++r) {
+		std::vector<int> covered(h, 0);
+		for (int b = 0; b < k; ++b)
+			for (const PixelRect &p : bands[static_cast<std::size_t>(r * k + b)])
+				for (int y = p.y0; y < p.y1; ++y)
+					covered[static_cast<std::size_t>(y)] = 1;
+		EXPECT_EQ(std::count(covered.begin(), covered.end(), 1), h) << "full round " << r;
+	}
+	for (int b = 0; b < k; ++b)
+		EXPECT_NE(bands[static_cast<std::size_t>(b)][0].y0, bands[static_cast<std::size_t>(k + b)][0].y0)
+			<< "band " << b << "'s seam did not move";
 }
 
 /* A marker that the scene's motion (3 px a frame to the right) brings in
