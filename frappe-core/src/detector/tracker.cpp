@@ -357,7 +357,7 @@ Tracker::Tracker(int coverFrames) : coverFrames_(std::max(1, coverFrames))
 	next_.reserve(64);
 	predictions_.reserve(64);
 	regions_.reserve(64);
-	strips_.reserve(12); /* placeStrips()'s, the gaps to the band, the band */
+	strips_.reserve(8); /* placeStrips()'s, the gaps to the band, the band */
 	matched_.reserve(64);
 }
 
@@ -463,7 +463,7 @@ bool Tracker::placeRegions(std::span<const std::uint8_t> read)
 			regions_.push_back(predictions_[i].rect);
 	/* One band of rows of the k, all of the frame every k frames. Its
 	 * boundaries move by a third of a band every round, through three
-	 * places (the last band wrapping to the top), so that a marker on the seam of two bands in one round is
+	 * places, so that a marker on the seam of two bands in one round is
 	 * inside one in the next, and so are the full-path rounds' (every
 	 * other one: they too go through all three); the bands overlap by
 	 * kAlign rows either way. The region map
@@ -478,27 +478,17 @@ bool Tracker::placeRegions(std::span<const std::uint8_t> read)
 	const bool fullBand = round % kFullBandRounds == 0;
 	const int shift = static_cast<int>(static_cast<long long>(h) * (round % 3) / (3 * k));
 	++sinceWhole_;
-	/* Band `band`'s rows, shifted, wrap past the bottom to the top: every
-	 * band as tall, in one or two pieces. */
-	const int y0 = static_cast<int>(static_cast<long long>(h) * band / k) + shift;
-	const int y1 = static_cast<int>(static_cast<long long>(h) * (band + 1) / k) + shift;
-	constexpr int A = RegionFrontEnd::kAlign;
-	std::array<PixelRect, 2> pieces{};
-	std::size_t nPieces = 0;
-	auto addPiece = [&](int a, int b) {
-		const PixelRect r = RegionFrontEnd::alignedRect({ 0, a - A, w, b + A }, w, h);
-		if (!r.empty())
-			pieces[nPieces++] = r;
+	auto boundary = [&](int i) {
+		if (i <= 0)
+			return 0;
+		if (i >= k)
+			return h;
+		return std::clamp(static_cast<int>(static_cast<long long>(h) * i / k) + shift, 0, h);
 	};
-	if (y0 >= h) {
-		addPiece(y0 - h, y1 - h);
-	} else {
-		addPiece(y0, std::min(y1, h));
-		if (y1 > h)
-			addPiece(0, y1 - h);
-	}
+	const PixelRect bandRect = RegionFrontEnd::alignedRect(
+		{ 0, boundary(band) - RegionFrontEnd::kAlign, w, boundary(band + 1) + RegionFrontEnd::kAlign }, w, h);
 	if (fullBand)
-		regions_.insert(regions_.end(), pieces.begin(), pieces.begin() + static_cast<std::ptrdiff_t>(nPieces));
+		regions_.push_back(bandRect);
 	mergeRects(regions_);
 	placeStrips();
 	if (!(strips_.size() == 1 && strips_[0] == PixelRect{ 0, 0, w, h })) {
@@ -511,18 +501,14 @@ bool Tracker::placeRegions(std::span<const std::uint8_t> read)
 			const PixelRect st = strips_[i];
 			if (st.x0 != 0 || st.x1 != w)
 				continue;
-			for (std::size_t j = 0; j < nPieces; ++j) {
-				const PixelRect &p = pieces[j];
-				if (st.y0 > p.y1 && st.y0 - p.y1 < h / k)
-					strips_.push_back({ 0, p.y1, w, st.y0 });
-				if (st.y1 < p.y0 && p.y0 - st.y1 < h / k)
-					strips_.push_back({ 0, st.y1, w, p.y0 });
-			}
+			if (st.y0 > bandRect.y1 && st.y0 - bandRect.y1 < h / k)
+				strips_.push_back({ 0, bandRect.y1, w, st.y0 });
+			if (st.y1 < bandRect.y0 && bandRect.y0 - st.y1 < h / k)
+				strips_.push_back({ 0, st.y1, w, bandRect.y0 });
 		}
 		/* The region map's band. */
 		if (!fullBand)
-			strips_.insert(strips_.end(), pieces.begin(),
-				       pieces.begin() + static_cast<std::ptrdiff_t>(nPieces));
+			strips_.push_back(bandRect);
 	}
 	std::size_t area = 0;
 	for (const PixelRect &r : regions_)
