@@ -128,24 +128,51 @@ bool insideFrame(const std::array<Point2f, 4> &c, int width, int height, float m
 namespace {
 
 /* Clears the pixels of `m` whose centres lie inside the convex quad `q`
- * (in m's coordinates): each row's span between the sides it crosses. */
+ * (in m's coordinates): each row's span between the sides it crosses.
+ * Nothing to do where the tiles under its box are empty (most of a frame
+ * the front end did not read). */
 void clearQuad(TraceMap &m, const std::array<Point2f, 4> &q)
 {
-	float top = q[0].y, bottom = q[0].y;
+	float top = q[0].y, bottom = q[0].y, leftmost = q[0].x, rightmost = q[0].x;
 	for (const Point2f &p : q) {
 		top = std::min(top, p.y);
 		bottom = std::max(bottom, p.y);
+		leftmost = std::min(leftmost, p.x);
+		rightmost = std::max(rightmost, p.x);
 	}
 	const int y0 = std::max(0, static_cast<int>(std::ceil(top - 0.5f)));
 	const int y1 = std::min(m.height - 1, static_cast<int>(std::floor(bottom - 0.5f)));
+	const int bx0 = std::max(0, static_cast<int>(std::floor(leftmost)));
+	const int bx1 = std::min(m.width - 1, static_cast<int>(std::ceil(rightmost)));
+	if (y1 < y0 || bx1 < bx0)
+		return;
+	constexpr int T = TraceMap::kTile;
+	bool any = false;
+	for (int ty = y0 / T; ty <= y1 / T && !any; ++ty)
+		for (int tx = bx0 / T; tx <= bx1 / T && !any; ++tx)
+			any = !m.tileEmpty(tx, ty);
+	if (!any)
+		return;
+	/* Each side's x at a row's centre: a start and a step a row. */
+	struct Side {
+		float ya, yb, x0, dxdy;
+	};
+	std::array<Side, 4> sides{};
+	int n = 0;
+	for (int i = 0; i < 4; ++i) {
+		const Point2f a = q[i], b = q[(i + 1) % 4];
+		if (a.y == b.y)
+			continue;
+		const float dxdy = (b.x - a.x) / (b.y - a.y);
+		sides[n++] = { std::min(a.y, b.y), std::max(a.y, b.y), a.x - a.y * dxdy, dxdy };
+	}
 	for (int y = y0; y <= y1; ++y) {
 		const float yc = static_cast<float>(y) + 0.5f;
 		float left = static_cast<float>(m.width), right = -1.0f;
-		for (int i = 0; i < 4; ++i) {
-			const Point2f a = q[i], b = q[(i + 1) % 4];
-			if ((a.y <= yc) == (b.y <= yc))
+		for (int i = 0; i < n; ++i) {
+			if (yc < sides[i].ya || yc >= sides[i].yb)
 				continue;
-			const float x = a.x + (yc - a.y) * (b.x - a.x) / (b.y - a.y);
+			const float x = sides[i].x0 + yc * sides[i].dxdy;
 			left = std::min(left, x);
 			right = std::max(right, x);
 		}

@@ -187,8 +187,10 @@ TEST(RegionFrontEnd, ClearsOnlyInsideTheMarkersReadAtTheirPredictions)
 		m->resize(100, 80);
 		m->scale = 0.5f;
 	}
-	for (TraceMap *m : { static_cast<TraceMap *>(&maps), &maps.regions, &maps.shades })
+	for (TraceMap *m : { static_cast<TraceMap *>(&maps), &maps.regions, &maps.shades }) {
 		std::fill(m->pixels.begin(), m->pixels.end(), 1);
+		std::fill(m->tiles.begin(), m->tiles.end(), 1);
+	}
 	Marker mk;
 	mk.corners = squarePose(100.0f, 80.0f, 60.0f, 20.0f, 10.0f);
 	const float inset = 1.5f;
