@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <cstring>
 
+#include "quad_geometry.h"
 #include "region_map.h"
 
 namespace frappe::detail {
@@ -133,17 +134,11 @@ namespace {
  * the front end did not read). */
 void clearQuad(TraceMap &m, const std::array<Point2f, 4> &q)
 {
-	float top = q[0].y, bottom = q[0].y, leftmost = q[0].x, rightmost = q[0].x;
-	for (const Point2f &p : q) {
-		top = std::min(top, p.y);
-		bottom = std::max(bottom, p.y);
-		leftmost = std::min(leftmost, p.x);
-		rightmost = std::max(rightmost, p.x);
-	}
-	const int y0 = std::max(0, static_cast<int>(std::ceil(top - 0.5f)));
-	const int y1 = std::min(m.height - 1, static_cast<int>(std::floor(bottom - 0.5f)));
-	const int bx0 = std::max(0, static_cast<int>(std::floor(leftmost)));
-	const int bx1 = std::min(m.width - 1, static_cast<int>(std::ceil(rightmost)));
+	const QuadBox box = quadBox(q);
+	const int y0 = std::max(0, static_cast<int>(std::ceil(box.y0 - 0.5f)));
+	const int y1 = std::min(m.height - 1, static_cast<int>(std::floor(box.y1 - 0.5f)));
+	const int bx0 = std::max(0, static_cast<int>(std::floor(box.x0)));
+	const int bx1 = std::min(m.width - 1, static_cast<int>(std::ceil(box.x1)));
 	if (y1 < y0 || bx1 < bx0)
 		return;
 	constexpr int T = TraceMap::kTile;
