@@ -19,16 +19,19 @@ enum class Mode {
 	/// appear while scaled; every `max_scaled_frames` frames one is at full size.
 	AScale,
 	/// Video: the markers of the last frames predict where each will be (a
-	/// constant-velocity model of its corners) and the full detector runs
-	/// in a region around each prediction, at full resolution. The rest of
-	/// the frame is searched for new markers by the full detector a band
-	/// of rows at a time, all of it at least every `track_cover_frames`
-	/// frames, and by the whole frame's region map (half resolution) on
-	/// every frame; all of it at once after a scene change or when a
-	/// tracked marker is not found where predicted (then the same frame is
-	/// searched again, whole). Marker::tracked says which markers were
-	/// tracked; corners are always measured on the frame. 0.55-0.7 of
-	/// NORMAL's instructions on the synthetic sequences, the same markers
+	/// constant-velocity model of its corners); each is read where
+	/// predicted, its corners measured on the frame, and the full detector
+	/// runs in a region around those that are not. The rest of the frame
+	/// is searched for new markers a band of rows at a time: by the region
+	/// map (half resolution) all of it at least every `track_cover_frames`
+	/// frames, and by every path (edges, the shade map) every other round,
+	/// all of it every 2 `track_cover_frames`; the region map also searches
+	/// strips along the edges where the scene's motion brings markers in.
+	/// All of it at once after a scene change or when a tracked marker is
+	/// not found where predicted (then the same frame is searched again,
+	/// whole). Marker::tracked says which markers were tracked; corners are
+	/// always measured on the frame. About a third of NORMAL's median
+	/// instructions a frame on the synthetic sequences, the same markers
 	/// found (docs/tracking.md). Needs a front end that can run on regions
 	/// (the CPU's); others run every frame whole. One detector per video,
 	/// its frames in order (a Pipeline's Overlap::Frames on several threads
@@ -88,9 +91,10 @@ struct Config {
 	int max_scaled_frames = 5;
 
 	/// k (Track only): every part of the frame is searched for new markers
-	/// at least once every this many frames, a band of rows at a time. A
-	/// marker that enters the scene is found at most k - 1 frames after
-	/// the frame it is first whole in. The default, 4, finds it within
+	/// by the region map at least once every this many frames, a band of
+	/// rows at a time, and by every path every 2k. A marker that enters the
+	/// scene and shows in the region map is found at most k - 1 frames
+	/// after the frame it is first whole in. The default, 4, finds it within
 	/// 100 ms at 30 frames a second; lower finds it sooner at a higher
 	/// cost a frame, 1 searches every frame whole (Normal's cost, with
 	/// Marker::tracked). Range [1, 1000].

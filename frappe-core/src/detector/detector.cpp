@@ -285,6 +285,8 @@ void DetectorStages::frontEnd(Detector &detector, const ImageView &image, int sl
 	s.result.bytes_read = static_cast<std::size_t>(image.width) * image.height;
 	if (regions) {
 		d.tracker->runRegions(image, d.params, s.edges);
+		/* The markers read at their predictions need no trace. */
+		detail::clearInsideMarkers(s.edges, s.known, 1.5f);
 		s.result.bytes_read = d.tracker->bytesRead();
 		s.result.scale = 1.0f;
 		s.result.copy_bytes = 0;

@@ -83,7 +83,8 @@ std::vector<Setting> makeTable()
 		{ "max_scaled_frames", &C::max_scaled_frames, 0, 1000, false, "N",
 		  "ascale: at most this many scaled frames in a row before one at full resolution", kEverywhere },
 		{ "track_cover_frames", &C::track_cover_frames, 1, 1000, false, "K",
-		  "track: every part of the frame is searched for new markers at least once every K frames",
+		  "track: every part of the frame is searched for new markers at least once every K frames "
+		  "(by the region map; by every path every 2K)",
 		  kEverywhere },
 		{ "region_contrast", &C::region_contrast, 0.0, 1.0, false, "R",
 		  "contrast (intensities in [0, 1]) of the dark-region candidates that find blurred markers; 0: off "

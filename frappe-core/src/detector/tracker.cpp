@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <cstring>
 
+#include "quad_geometry.h"
 #include "region_map.h"
 
 namespace frappe::detail {
@@ -52,7 +53,7 @@ void markRectTiles(const TraceMap *sub, int sx, int sy, TraceMap &out, int x0, i
 				continue;
 			}
 			std::uint64_t any = 0;
-			for (int y = ya; y < yb; ++y) {
+			for (int y = ya; y < yb && !any; ++y) {
 				const std::uint8_t *p = out.pixels.data() + static_cast<std::size_t>(y) * out.width;
 				int x = a;
 				for (; x + 8 <= b; x += 8) {
@@ -124,6 +125,81 @@ bool insideFrame(const std::array<Point2f, 4> &c, int width, int height, float m
 }
 
 } // namespace
+
+namespace {
+
+/* Clears the pixels of `m` whose centres lie inside the convex quad `q`
+ * (in m's coordinates): each row's span between the sides it crosses.
+ * Nothing to do where the tiles under its box are empty (most of a frame
+ * the front end did not read). */
+void clearQuad(TraceMap &m, const std::array<Point2f, 4> &q)
+{
+	const QuadBox box = quadBox(q);
+	const int y0 = std::max(0, static_cast<int>(std::ceil(box.y0 - 0.5f)));
+	const int y1 = std::min(m.height - 1, static_cast<int>(std::floor(box.y1 - 0.5f)));
+	const int bx0 = std::max(0, static_cast<int>(std::floor(box.x0)));
+	const int bx1 = std::min(m.width - 1, static_cast<int>(std::ceil(box.x1)));
+	if (y1 < y0 || bx1 < bx0)
+		return;
+	constexpr int T = TraceMap::kTile;
+	bool any = false;
+	for (int ty = y0 / T; ty <= y1 / T && !any; ++ty)
+		for (int tx = bx0 / T; tx <= bx1 / T && !any; ++tx)
+			any = !m.tileEmpty(tx, ty);
+	if (!any)
+		return;
+	/* Each side's x at a row's centre: a start and a step a row. */
+	struct Side {
+		float ya, yb, x0, dxdy;
+	};
+	std::array<Side, 4> sides{};
+	int n = 0;
+	for (int i = 0; i < 4; ++i) {
+		const Point2f a = q[i], b = q[(i + 1) % 4];
+		if (a.y == b.y)
+			continue;
+		const float dxdy = (b.x - a.x) / (b.y - a.y);
+		sides[n++] = { std::min(a.y, b.y), std::max(a.y, b.y), a.x - a.y * dxdy, dxdy };
+	}
+	for (int y = y0; y <= y1; ++y) {
+		const float yc = static_cast<float>(y) + 0.5f;
+		float left = static_cast<float>(m.width), right = -1.0f;
+		for (int i = 0; i < n; ++i) {
+			if (yc < sides[i].ya || yc >= sides[i].yb)
+				continue;
+			const float x = sides[i].x0 + yc * sides[i].dxdy;
+			left = std::min(left, x);
+			right = std::max(right, x);
+		}
+		const int x0 = std::max(0, static_cast<int>(std::ceil(left - 0.5f)));
+		const int x1 = std::min(m.width - 1, static_cast<int>(std::floor(right - 0.5f)));
+		if (x1 >= x0)
+			std::memset(m.pixels.data() + static_cast<std::size_t>(y) * m.width + x0, 0,
+				    static_cast<std::size_t>(x1 - x0 + 1));
+	}
+}
+
+} // namespace
+
+void clearInsideMarkers(EdgeMap &maps, std::span<const Marker> markers, float inset)
+{
+	for (const Marker &mk : markers) {
+		const Point2f c = centre(mk.corners);
+		for (TraceMap *m : { static_cast<TraceMap *>(&maps), &maps.regions, &maps.shades }) {
+			if (m->width == 0)
+				continue;
+			/* Each corner `inset` nearer the centre, in m's pixels. */
+			std::array<Point2f, 4> q;
+			for (int i = 0; i < 4; ++i) {
+				const float dx = mk.corners[i].x - c.x, dy = mk.corners[i].y - c.y;
+				const float r = std::hypot(dx, dy);
+				const float k = r > inset ? (r - inset) / r : 0.0f;
+				q[i] = { (c.x + dx * k) * m->scale, (c.y + dy * k) * m->scale };
+			}
+			clearQuad(*m, q);
+		}
+	}
+}
 
 RegionFrontEnd::RegionFrontEnd(const BandKernels &kernels) : cpu_(makeCpuFrontEnd(1, kernels))
 {
@@ -246,9 +322,10 @@ void RegionFrontEnd::run(const ImageView &image, std::span<const PixelRect> rect
 	halfWritten_ = written_;
 	if (!regions)
 		return;
-	/* The search strips: the region map only. */
+	/* The search strips: the region map only (a shade map would be
+	 * dropped). */
 	eachPart(search, [&](const PixelRect &r, const PixelRect &s, const ImageView &sub) {
-		regionMap(sub, 1.0f, params, subRegions_, subShades_, scratch_);
+		regionMap(sub, 1.0f, params, subRegions_, subShades_, scratch_, false);
 		copyHalf(subRegions_, s.x0, s.y0, out.regions, r);
 		halfWritten_.push_back(r);
 	});
@@ -302,7 +379,7 @@ Tracker::Tracker(int coverFrames) : coverFrames_(std::max(1, coverFrames))
 	next_.reserve(64);
 	predictions_.reserve(64);
 	regions_.reserve(64);
-	strips_.reserve(4);
+	strips_.reserve(8); /* placeStrips()'s, the gaps to the band, the band */
 	matched_.reserve(64);
 }
 
@@ -407,12 +484,21 @@ bool Tracker::placeRegions(std::span<const std::uint8_t> read)
 		if (i >= read.size() || !read[i])
 			regions_.push_back(predictions_[i].rect);
 	/* One band of rows of the k, all of the frame every k frames. Its
-	 * boundaries move by half a band every other round, so that a marker
-	 * on the seam of two bands in one round is inside one in the next; the
-	 * bands overlap by kAlign rows either way. */
+	 * boundaries move by a third of a band every round, through three
+	 * places, so that a marker on the seam of two bands in one round is
+	 * inside one in the next, and so are the full-path rounds' (every
+	 * other one: they too go through all three); the bands overlap by
+	 * kAlign rows either way. The region map
+	 * searches the band on every round, the edges and the shade map on
+	 * one round of kFullBandRounds: a new marker is in the region map
+	 * within k frames (the strips and the band find most of them there)
+	 * and in every map within kFullBandRounds k, at a fraction of the
+	 * front end's and the trace's cost on the other rounds. */
 	const int k = coverFrames_;
+	const int round = sinceWhole_ / k;
 	const int band = sinceWhole_ % k;
-	const int shift = (sinceWhole_ / k) % 2 ? h / (2 * k) : 0;
+	const bool fullBand = round % kFullBandRounds == 0;
+	const int shift = static_cast<int>(static_cast<long long>(h) * (round % 3) / (3 * k));
 	++sinceWhole_;
 	auto boundary = [&](int i) {
 		if (i <= 0)
@@ -423,9 +509,29 @@ bool Tracker::placeRegions(std::span<const std::uint8_t> read)
 	};
 	const PixelRect bandRect = RegionFrontEnd::alignedRect(
 		{ 0, boundary(band) - RegionFrontEnd::kAlign, w, boundary(band + 1) + RegionFrontEnd::kAlign }, w, h);
-	regions_.push_back(bandRect);
+	if (fullBand)
+		regions_.push_back(bandRect);
 	mergeRects(regions_);
 	placeStrips();
+	if (!(strips_.size() == 1 && strips_[0] == PixelRect{ 0, 0, w, h })) {
+		/* A marker entering over the top or bottom edge may be taller
+		 * than the strip there: the rows between the strip and a band
+		 * less than a band away join them in the region map, so that it
+		 * is whole there on that band's frame of each round. */
+		const std::size_t n = strips_.size();
+		for (std::size_t i = 0; i < n; ++i) {
+			const PixelRect st = strips_[i];
+			if (st.x0 != 0 || st.x1 != w)
+				continue;
+			if (st.y0 > bandRect.y1 && st.y0 - bandRect.y1 < h / k)
+				strips_.push_back({ 0, bandRect.y1, w, st.y0 });
+			if (st.y1 < bandRect.y0 && bandRect.y0 - st.y1 < h / k)
+				strips_.push_back({ 0, st.y1, w, bandRect.y0 });
+		}
+		/* The region map's band. */
+		if (!fullBand)
+			strips_.push_back(bandRect);
+	}
 	std::size_t area = 0;
 	for (const PixelRect &r : regions_)
 		area += r.area();

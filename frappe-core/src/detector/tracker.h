@@ -88,6 +88,12 @@ private:
 	std::size_t bytesRead_ = 0;
 };
 
+/// Clears, in the edge, region and shade maps, the inside of each marker
+/// read at its prediction (its quad moved `inset` pixels in): its code
+/// cells' outlines, which the trace would follow only to skip them. No
+/// other marker lies inside one; its neighbours' outlines lie outside.
+void clearInsideMarkers(EdgeMap &maps, std::span<const Marker> markers, float inset);
+
 /// The tracks of Mode::Track and the plan of each frame. plan() (the front
 /// end's) and update() (the finish's) may run on different threads in a
 /// Pipeline's Overlap::Stages: the tracks are under a lock.
@@ -161,6 +167,9 @@ private:
 	/* The search strips: kStrip of the frame's larger side; a mean motion
 	 * under kStill pixels a frame along an axis brings nothing in. */
 	static constexpr float kStrip = 0.15f, kStill = 0.25f;
+	/* The band goes through every map on one round of these, through
+	 * the region map alone on the others (placeRegions()). */
+	static constexpr int kFullBandRounds = 2;
 	Point2f motion_{}; /* the moving tracks' mean motion, pixels a frame */
 	bool haveMotion_ = false;
 	void placeStrips();

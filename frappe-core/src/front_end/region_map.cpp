@@ -248,8 +248,8 @@ void halveImage(const ImageView &src, std::uint8_t *out)
 		decimateRow(src.row(2 * y), src.row(2 * y + 1), w, out + static_cast<std::size_t>(y) * w);
 }
 
-void regionMap(const ImageView &src, float srcScale, const FrontEndParams &params, TraceMap &out,
-	       TraceMap &shades, RegionScratch &s)
+void regionMap(const ImageView &src, float srcScale, const FrontEndParams &params, TraceMap &out, TraceMap &shades,
+	       RegionScratch &s, bool withShades)
 {
 	if (!makesRegionMap(src.width, src.height, params.region_contrast)) {
 		out.resize(0, 0);
@@ -258,11 +258,11 @@ void regionMap(const ImageView &src, float srcScale, const FrontEndParams &param
 	}
 	s.decimated.resize(static_cast<std::size_t>(src.width / 2) * (src.height / 2));
 	halveImage(src, s.decimated.data());
-	regionMapFromMeans(src.width, src.height, srcScale, params, out, shades, s);
+	regionMapFromMeans(src.width, src.height, srcScale, params, out, shades, s, withShades);
 }
 
 void regionMapFromMeans(int width, int height, float srcScale, const FrontEndParams &params, TraceMap &out,
-			TraceMap &shades, RegionScratch &s)
+			TraceMap &shades, RegionScratch &s, bool withShades)
 {
 	const int w = width / 2, h = height / 2;
 	if (!makesRegionMap(width, height, params.region_contrast)) {
@@ -272,7 +272,7 @@ void regionMapFromMeans(int width, int height, float srcScale, const FrontEndPar
 	}
 	out.resize(w, h);
 	out.scale = srcScale / 2.0f;
-	const bool shaded = params.makesShades();
+	const bool shaded = withShades && params.makesShades();
 	if (shaded) {
 		shades.resize(w, h);
 		shades.scale = out.scale;

@@ -30,9 +30,10 @@ struct RegionScratch {
 /// `shades` with those of the shade map (EdgeMap::shades);
 /// out.scale = shades.scale = srcScale / 2. Leaves `out` empty (0 x 0) when
 /// region_contrast is 0 or `src` is too small for a 3 x 3 map, `shades`
-/// also when params.makesShades() is false.
-void regionMap(const ImageView &src, float srcScale, const FrontEndParams &params, TraceMap &out,
-	       TraceMap &shades, RegionScratch &scratch);
+/// also when params.makesShades() is false or `withShades` is (the region
+/// map is the same either way).
+void regionMap(const ImageView &src, float srcScale, const FrontEndParams &params, TraceMap &out, TraceMap &shades,
+	       RegionScratch &scratch, bool withShades = true);
 
 /// Whether regionMap() makes a map of a src.width x src.height frame.
 inline bool makesRegionMap(int width, int height, int minContrast)
@@ -44,7 +45,7 @@ inline bool makesRegionMap(int width, int height, int minContrast)
 /// width / 2 x height / 2, as decimateRow makes them): the CPU front end
 /// makes them as it reads the frame's rows.
 void regionMapFromMeans(int width, int height, float srcScale, const FrontEndParams &params, TraceMap &out,
-			TraceMap &shades, RegionScratch &scratch);
+			TraceMap &shades, RegionScratch &scratch, bool withShades = true);
 
 /// out, (src.width / 2) x (src.height / 2) = decimateRow() of each pair of
 /// src's rows: the image at half resolution, as the region map makes it.

@@ -6,6 +6,7 @@
 // frame whole.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <stdexcept>
@@ -175,6 +176,55 @@ TEST(RegionFrontEnd, BitIdenticalToTheWholeFrameInsideEachRegion)
 	}
 }
 
+/* A marker read at its prediction: the maps lose the inside of its quad
+ * (moved in by the inset), in each map's own pixels, and nothing else. */
+TEST(RegionFrontEnd, ClearsOnlyInsideTheMarkersReadAtTheirPredictions)
+{
+	EdgeMap maps;
+	maps.resize(200, 160);
+	maps.scale = 1.0f;
+	for (TraceMap *m : { &maps.regions, &maps.shades }) {
+		m->resize(100, 80);
+		m->scale = 0.5f;
+	}
+	for (TraceMap *m : { static_cast<TraceMap *>(&maps), &maps.regions, &maps.shades }) {
+		std::fill(m->pixels.begin(), m->pixels.end(), 1);
+		std::fill(m->tiles.begin(), m->tiles.end(), 1);
+	}
+	Marker mk;
+	mk.corners = squarePose(100.0f, 80.0f, 60.0f, 20.0f, 10.0f);
+	const float inset = 1.5f;
+	detail::clearInsideMarkers(maps, std::span<const Marker>(&mk, 1), inset);
+	/* Signed distances of a point from the quad's sides (inside > 0). */
+	auto inside = [&](float x, float y) {
+		float in = 1e9f;
+		for (int i = 0; i < 4; ++i) {
+			const Point2f a = mk.corners[i], b = mk.corners[(i + 1) % 4];
+			const float len = std::hypot(b.x - a.x, b.y - a.y);
+			const float cross = ((b.x - a.x) * (y - a.y) - (b.y - a.y) * (x - a.x)) / len;
+			in = std::min(in, cross);
+		}
+		return in;
+	};
+	const float orientation = inside(100.0f, 80.0f) > 0 ? 1.0f : -1.0f;
+	for (TraceMap *m : { static_cast<TraceMap *>(&maps), &maps.regions, &maps.shades }) {
+		long cleared = 0;
+		for (int y = 0; y < m->height; ++y)
+			for (int x = 0; x < m->width; ++x) {
+				/* The pixel's centre in frame pixels. */
+				const float d = orientation * inside((x + 0.5f) / m->scale, (y + 0.5f) / m->scale);
+				if (d > inset + 1.0f / m->scale) {
+					EXPECT_EQ(m->at(x, y), 0) << "kept inside at " << x << "," << y;
+				}
+				if (d < 0.0f) {
+					EXPECT_EQ(m->at(x, y), 1) << "cleared outside at " << x << "," << y;
+				}
+				cleared += m->at(x, y) == 0;
+			}
+		EXPECT_GT(cleared, static_cast<long>(0.8f * 55.0f * 55.0f * m->scale * m->scale));
+	}
+}
+
 TEST(RegionFrontEnd, AlignsOutwardAndClips)
 {
 	static_assert(RegionFrontEnd::kAlign == 8);
@@ -268,6 +318,66 @@ TEST(Tracking, FollowsMovingMarkersWithMeasuredCornersAndFindsANewOneWithinKFram
 	ASSERT_GE(newFoundAt, newFrom);
 	EXPECT_LT(newFoundAt - newFrom, cfg.track_cover_frames) << "found " << newFoundAt - newFrom << " frames late";
 	EXPECT_GE(partialFrames, 18) << "frames read in regions";
+}
+
+/* The band's schedule, with every track read at its prediction: the
+ * front end's rectangles are a band of rows on every other round of k
+ * frames (the edges and the shade map: every row within 2k frames, its
+ * seams in new places), none on the others (the region map's rounds). */
+TEST(Tracking, TheBandGoesThroughEveryMapOnEveryOtherRound)
+{
+	const int w = 640, h = 480, k = 4;
+	detail::Tracker tracker(k);
+	const Image img(w, h, 120);
+	std::vector<Marker> markers(1);
+	markers[0].id = 5;
+	auto moveTo = [&](int f) {
+		markers[0].corners = squarePose(200.0f + 2.0f * f, 200.0f + 1.0f * f, 50.0f, 0.0f, 0.0f);
+	};
+	moveTo(0);
+	ASSERT_FALSE(tracker.plan(img.view(), true)) << "the first frame is whole";
+	tracker.update(markers, w, h, false, false);
+	/* Each full round's bands. */
+	std::vector<std::vector<PixelRect>> bands;
+	for (int f = 1; f <= 4 * k; ++f) {
+		ASSERT_TRUE(tracker.plan(img.view(), true)) << "frame " << f;
+		const std::uint8_t read = 1;
+		ASSERT_TRUE(tracker.placeRegions(std::span(&read, 1))) << "frame " << f;
+		const auto regions = tracker.regions();
+		const int round = (f - 1) / k;
+		if (round % 2 == 0) {
+			ASSERT_EQ(regions.size(), 1u) << "frame " << f;
+			int rows = 0;
+			for (const PixelRect &r : regions) {
+				EXPECT_EQ(r.x0, 0);
+				EXPECT_EQ(r.x1, w);
+				rows += r.y1 - r.y0;
+			}
+			/* A band and its overlaps; the first one of a round also
+			 * takes the rows its seam moved down by (at most two
+			 * thirds of a band), the last one gives them up. */
+			EXPECT_GE(rows, h / (3 * k)) << "frame " << f;
+			EXPECT_LE(rows, h / k + 2 * h / (3 * k) + 2 * RegionFrontEnd::kAlign + 8) << "frame " << f;
+			bands.emplace_back(regions.begin(), regions.end());
+		} else {
+			EXPECT_TRUE(regions.empty()) << "frame " << f << ": the region map's round";
+		}
+		moveTo(f);
+		tracker.update(markers, w, h, true, true);
+	}
+	/* Each full round covers every row; the second's seams are elsewhere. */
+	ASSERT_EQ(bands.size(), static_cast<std::size_t>(2 * k));
+	for (int r = 0; r < 2; ++r) {
+		std::vector<int> covered(h, 0);
+		for (int b = 0; b < k; ++b)
+			for (const PixelRect &p : bands[static_cast<std::size_t>(r * k + b)])
+				for (int y = p.y0; y < p.y1; ++y)
+					covered[static_cast<std::size_t>(y)] = 1;
+		EXPECT_EQ(std::count(covered.begin(), covered.end(), 1), h) << "full round " << r;
+	}
+	for (int b = 1; b < k; ++b)
+		EXPECT_NE(bands[static_cast<std::size_t>(b)][0].y0, bands[static_cast<std::size_t>(k + b)][0].y0)
+			<< "band " << b << "'s seam did not move";
 }
 
 /* A marker that the scene's motion (3 px a frame to the right) brings in
