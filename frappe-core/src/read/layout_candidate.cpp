@@ -136,7 +136,9 @@ bool detail::CandidateReader::readLayoutCandidate(const ImageView &image, Slot &
 				continue;
 			counted = true;
 			timer.lap(Stage::Decode);
-			read = detail::decodeLayout(detail::readLayoutCells(*samples, layout, pol->weakMargin), *codes, *pol);
+			read = detail::decodeLayout(detail::readLayoutCells(*samples, layout, pol->weakMargin,
+									    pol->tone.apply(detail::kClippedGrey)),
+						    *codes, *pol);
 			if (read.ok())
 				q.corners = square;
 		}
