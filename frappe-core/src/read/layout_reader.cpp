@@ -47,16 +47,17 @@ void forRing(const MarkerLayout &l, int ring, F &&f)
  * take its other cells' mean: the fit then follows the light on the
  * marker, not on the glare. */
 template<typename Unknown>
-Plane fitRing(const WarpedMarker &g, const MarkerLayout &l, int ring, Unknown &&unknown)
+Plane fitRing(const WarpedMarker &g, const MarkerLayout &l, int ring, bool glare, Unknown &&unknown)
 {
 	float known = 0.0f;
 	int nKnown = 0;
-	forRing(l, ring, [&](int x, int y) {
-		if (!unknown(x, y)) {
-			known += g.at(x + 1, y + 1);
-			++nKnown;
-		}
-	});
+	if (glare)
+		forRing(l, ring, [&](int x, int y) {
+			if (!unknown(x, y)) {
+				known += g.at(x + 1, y + 1);
+				++nKnown;
+			}
+		});
 	const float fill = nKnown ? known / static_cast<float>(nKnown) : 0.0f;
 	const float c = 0.5f * static_cast<float>(l.size - 1);
 	float s = 0.0f, sx = 0.0f, sy = 0.0f, xx = 0.0f, yy = 0.0f;
@@ -116,15 +117,25 @@ LayoutCells readLayoutCells(const WarpedMarker &sampled, const MarkerLayout &l, 
 	 * clip is judged on the samples as warped: sharpening lifts a light
 	 * cell beside dark ones.) */
 	auto clips = [&](int x, int y) { return sampled.at(x + 1, y + 1) >= clip; };
-	bool glare = false;
-	for (int y = -1; y <= l.size && !glare; ++y)
-		for (int x = -1; x <= l.size && !glare; ++x) {
-			const bool inside = x >= 0 && y >= 0 && x < l.size && y < l.size;
-			glare = clips(x, y) &&
-				(ringOf(x, y) == darkRing || (inside && l.at(x, y) == MarkerLayout::kBlack));
-		}
+	auto darkClips = [&] {
+		const int n = sampled.side * sampled.side;
+		int i = 0;
+		while (i < n && sampled.samples[static_cast<std::size_t>(i)] < clip)
+			++i;
+		if (i == n) /* nothing clips: the common case, one pass */
+			return false;
+		for (int y = -1; y <= l.size; ++y)
+			for (int x = -1; x <= l.size; ++x) {
+				const bool inside = x >= 0 && y >= 0 && x < l.size && y < l.size;
+				if (clips(x, y) &&
+				    (ringOf(x, y) == darkRing || (inside && l.at(x, y) == MarkerLayout::kBlack)))
+					return true;
+			}
+		return false;
+	};
+	const bool glare = darkClips();
 	auto unknown = [&](int x, int y) { return glare && clips(x, y); };
-	const Plane po = fitRing(g, l, outer, unknown), pi = fitRing(g, l, inner, unknown);
+	const Plane po = fitRing(g, l, outer, glare, unknown), pi = fitRing(g, l, inner, glare, unknown);
 	const Plane &dark = l.reversed ? po : pi, &light = l.reversed ? pi : po;
 	const float c = 0.5f * static_cast<float>(l.size - 1);
 	LayoutCells out;
