@@ -372,7 +372,8 @@ void ContourTracer::trace(const TraceMap &edges, const TraceParams &params, std:
 		Quad quad;
 		if ((!tooManyClusters_ && clusters_.size() >= 4 && quadFromClusters(quad) &&
 		     acceptQuad(params, w, h, quad)) ||
-		    (clusters_.size() >= static_cast<std::size_t>(params.min_clusters) && quadFromOutline(quad) && acceptQuad(params, w, h, quad))) {
+		    (clusters_.size() >= static_cast<std::size_t>(params.min_clusters) && quadFromOutline(quad) &&
+		     acceptQuad(params, w, h, quad))) {
 			if (probe && probe->isMarker(quad)) {
 				quad.probeDecoded = true;
 				sealInside(quad, w, h);
