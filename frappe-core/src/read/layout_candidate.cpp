@@ -169,9 +169,7 @@ bool detail::CandidateReader::readLayoutCandidate(const ImageView &image, Slot &
 	auto ringsNearlyThere = [&](const ImageView &view, const std::array<Point2f, 4> &square) {
 		if (!layoutGrid(square, layout, grid) || !warpToGrid(view, grid, layoutGridSide(layout), warped))
 			return false;
-		const detail::LayoutCells c =
-			detail::readLayoutCells(warped, layout, policy.weakMargin, detail::kClippedGrey);
-		return c.contrast >= 10.0f && 4 * c.ringErrors <= c.ringCells;
+		return detail::ringsNearlyWhole(warped, layout);
 	};
 	/* A small marker's square may have no outline of its own: edges 2 or
 	 * 3 pixels apart on both sides of its black ring join, and what is

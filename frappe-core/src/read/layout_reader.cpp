@@ -102,6 +102,27 @@ void sharpen(const WarpedMarker &in, WarpedMarker &out)
 
 } // namespace
 
+bool ringsNearlyWhole(const WarpedMarker &sampled, const MarkerLayout &l)
+{
+	const int outer = l.square_start - 1, inner = l.square_start;
+	auto none = [](int, int) { return false; }; /* no glare: every cell known */
+	const Plane po = fitRing(sampled, l, outer, false, none), pi = fitRing(sampled, l, inner, false, none);
+	const Plane &dark = l.reversed ? po : pi, &light = l.reversed ? pi : po;
+	if (light.a - dark.a < 10.0f)
+		return false;
+	const float c = 0.5f * static_cast<float>(l.size - 1);
+	int errors = 0, cells = 0;
+	for (const int ring : { outer, inner })
+		forRing(l, ring, [&](int x, int y) {
+			const float dx = static_cast<float>(x) - c, dy = static_cast<float>(y) - c;
+			const float thr = 0.5f * (dark.at(dx, dy) + light.at(dx, dy));
+			const float v = sampled.at(x + 1, y + 1);
+			errors += (ring == outer) == l.reversed ? v > thr : v < thr;
+			++cells;
+		});
+	return 4 * errors <= cells;
+}
+
 LayoutCells readLayoutCells(const WarpedMarker &sampled, const MarkerLayout &l, float weakMargin, float clip)
 {
 	WarpedMarker g;

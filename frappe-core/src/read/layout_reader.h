@@ -45,6 +45,10 @@ struct LayoutCells {
 };
 LayoutCells readLayoutCells(const WarpedMarker &grid, const MarkerLayout &layout, float weakMargin, float clip);
 
+/// Whether the two rings beside the square read three quarters right, on
+/// the samples as warped: a cheap look before refining a guessed square.
+bool ringsNearlyWhole(const WarpedMarker &grid, const MarkerLayout &layout);
+
 /// Decodes and checks a read: enough contrast, rings nearly whole, the
 /// plain cells beyond them one colour but for one in eight (black as
 /// libapriltag draws them, or a circle family's paper), at most
