@@ -83,8 +83,9 @@
  * from all of them (frappe::estimateBundlePose: every agreeing corner
  * through the lens model, a marker whose corners disagree rejected) as a
  * #GstFrappeBundleMeta (gstfrappebundlemeta.h; at most one a buffer, none
- * when the bundle is not seen), the message's `bundle` structure and
- * frappejson's `"bundle"` object. The bundle gives its markers' sizes
+ * when the bundle is not seen; bindings copy it out with
+ * gst_frappe_buffer_get_bundle_pose()), the message's `bundle` structure
+ * and frappejson's `"bundle"` object. The bundle gives its markers' sizes
  * (marker-size is for the single poses); the camera is the pose's
  * (calibration-file or camera-matrix, fitted to the caps): a bundle-file
  * without one fails the start, as a file that cannot be read does.

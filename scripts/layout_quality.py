@@ -2,13 +2,15 @@
 """Issue 32's measure of the AprilTag 3 layout families: scenes rendered by
 `frappe-render --scene` (corner truth from the renderer), read by frappe and
 by AprilTag 3.3 (`apriltag-peer`, decimate 1) and scored by
-../shared/tools/eval.py; then every layout family's detector over the other
-families' scenes and ../shared's synth subsets, where any marker is a wrong id.
+../shared/tools/eval.py, the hard scenes also by the found square's side;
+then every layout family's detector over the other families' scenes and
+../shared's synth subsets, where any marker is a wrong id.
 
 usage: scripts/layout_quality.py BUILD_DIR OUT_DIR [--images 60] [--synth]
 (the synth subsets: also tests/data's data-wrong-ids)
 """
 import json
+import math
 import os
 import subprocess
 import sys
@@ -58,6 +60,37 @@ def count_markers(dets):
     return n
 
 
+# The found square's side in pixels: small markers are where the layout
+# families are lost (docs/quality.md).
+SIDE_BINS = [(0, 12), (12, 15), (15, 20), (20, 30), (30, 1e9)]
+
+
+def side_of(c):
+    return sum(math.dist(c[i], c[(i + 1) % 4]) for i in range(4)) / 4
+
+
+def by_side(folder, dets):
+    """'found/markers' per SIDE_BINS: a marker is found by a detection of
+    its id whose corners lie within eval.py's distance of its own."""
+    found = {}
+    with open(dets) as f:
+        for line in f:
+            r = json.loads(line)
+            found[os.path.basename(r['image'])] = r.get('markers', [])
+    counts = [[0, 0] for _ in SIDE_BINS]
+    with open(os.path.join(folder, 'truth.jsonl')) as f:
+        for line in f:
+            t = json.loads(line)
+            for m in t['markers']:
+                side = side_of(m['corners'])
+                b = next(i for i, (lo, hi) in enumerate(SIDE_BINS) if lo <= side < hi)
+                counts[b][1] += 1
+                counts[b][0] += any(
+                    d['id'] == m['id'] and sum(math.dist(p, q) for p, q in zip(d['corners'], m['corners'])) / 4 <
+                    max(3.0, 0.1 * side) for d in found.get(os.path.basename(t['image']), []))
+    return [f'{a}/{n}' for a, n in counts]
+
+
 def main():
     build, out = sys.argv[1], sys.argv[2]
     images = int(sys.argv[sys.argv.index('--images') + 1]) if '--images' in sys.argv else 60
@@ -68,6 +101,7 @@ def main():
     print('| family | markers | frappe sensitivity | FP | corner mean / median px | ms median '
           '| AprilTag 3.3 d1 sensitivity | FP | corner mean / median px | ms median |')
     print('|---|---|---|---|---|---|---|---|---|---|')
+    sizes = []
     for f, folder in [(f, folders[f]) for f in FAMILIES] + [(f + ' hard', hard[f]) for f in FAMILIES]:
         f = f.split()[0]
         dets = os.path.join(folder, 'frappe.jsonl')
@@ -80,6 +114,9 @@ def main():
             return [f"{s['sensitivity']:.3f}", s['fp'],
                     f"{s['corner_mae_px']:.3f} / {s['corner_median_px']:.3f}", f"{s['time_ms_median']:.2f}"]
         row += cells(a)
+        hard_set = folder == hard[f]
+        if hard_set:
+            sizes.append([f, 'frappe'] + by_side(folder, dets))
         if os.path.exists(peer):
             pd = os.path.join(folder, 'apriltag-d1.jsonl')
             # libapriltag's decode table for the largest families at 2 bits
@@ -88,7 +125,15 @@ def main():
             run([peer, '--dictionary', f, '--list', os.path.join(folder, 'list.txt'), '--out', pd,
                  '--decimate', '1', '--hamming', bits])
             row += cells(score(folder, pd))
+            if hard_set:
+                sizes.append([f, 'AprilTag 3.3 d1'] + by_side(folder, pd))
         print('| ' + ' | '.join(str(x) for x in row) + ' |')
+    print()
+    print('| hard scenes | detector | ' + ' | '.join(f'side {lo:g}-{hi:g} px' if hi < 1e9 else f'side {lo:g}+ px'
+                                                   for lo, hi in SIDE_BINS) + ' |')
+    print('|---|---|' + '---|' * len(SIDE_BINS))
+    for row in sizes:
+        print('| ' + ' | '.join(row) + ' |')
     # Wrong ids: each family over the others' scenes and the shared subsets.
     others = {f'{g} (rendered)': os.path.join(folders[g], 'list.txt') for g in FAMILIES}
     synth = os.path.join(SHARED, 'data', 'synth')

@@ -50,9 +50,8 @@ G_BEGIN_DECLS
  * @reprojection_error, which is in pixels; elements that crop, rotate or
  * otherwise change the geometry drop it, as they drop the marker metas.
  *
- * Bindings, which cannot cast a #GstMeta, read the bundle's pose from the
- * `frappedetect` element message's `bundle` structure or from frappejson's
- * line.
+ * Bindings, which cannot cast a #GstMeta, read a copy of it as a boxed
+ * #GstFrappeBundlePose: gst_frappe_buffer_get_bundle_pose().
  *
  * Since: 0.3
  */
@@ -123,5 +122,131 @@ GST_FRAPPE_META_API GstFrappeBundleMeta *gst_buffer_add_frappe_bundle_meta(GstBu
  */
 #define gst_buffer_get_frappe_bundle_meta(b)                                                                           \
 	((GstFrappeBundleMeta *)gst_buffer_get_meta((b), GST_FRAPPE_BUNDLE_META_API_TYPE))
+
+#define GST_FRAPPE_TYPE_BUNDLE_POSE (gst_frappe_bundle_pose_get_type())
+
+/**
+ * GstFrappeBundlePose:
+ * @name: the bundle's name, as in #GstFrappeBundleMeta, an interned string
+ * @rvec: (array fixed-size=3): rotation (Rodrigues vector) from the bundle
+ *   frame to the camera frame; from bindings use
+ *   gst_frappe_bundle_pose_get_rvec()
+ * @tvec: (array fixed-size=3): the bundle frame's origin in the camera
+ *   frame, in metres; from bindings use gst_frappe_bundle_pose_get_tvec()
+ * @reprojection_error: RMS reprojection error of the pose, in pixels
+ * @n_used: how many ids are in @used
+ * @used: (array length=n_used): the ids whose corners made the pose; from
+ *   bindings use gst_frappe_bundle_pose_get_used()
+ * @n_rejected: how many ids are in @rejected
+ * @rejected: (array length=n_rejected): the ids of the bundle seen but left
+ *   out; from bindings use gst_frappe_bundle_pose_get_rejected()
+ *
+ * A buffer's #GstFrappeBundleMeta copied out (see there for the frames and
+ * conventions): a boxed type, so that bindings can hold it after the
+ * buffer is gone. The struct and its ids are one allocation.
+ *
+ * Since: 0.3
+ */
+typedef struct {
+	const gchar *name;
+	gdouble rvec[3];
+	gdouble tvec[3];
+	gdouble reprojection_error;
+	guint n_used;
+	gint *used;
+	guint n_rejected;
+	gint *rejected;
+} GstFrappeBundlePose;
+
+/**
+ * gst_frappe_bundle_pose_get_type:
+ *
+ * Returns: the boxed type of #GstFrappeBundlePose
+ *
+ * Since: 0.3
+ */
+GST_FRAPPE_META_API GType gst_frappe_bundle_pose_get_type(void);
+
+/**
+ * gst_frappe_bundle_pose_copy:
+ * @pose: a #GstFrappeBundlePose
+ *
+ * Returns: (transfer full): a copy of @pose and its ids, freed with
+ * gst_frappe_bundle_pose_free()
+ *
+ * Since: 0.3
+ */
+GST_FRAPPE_META_API GstFrappeBundlePose *gst_frappe_bundle_pose_copy(const GstFrappeBundlePose *pose);
+
+/**
+ * gst_frappe_bundle_pose_free: (skip)
+ * @pose: (transfer full): a #GstFrappeBundlePose
+ *
+ * Bindings free their poses themselves.
+ *
+ * Since: 0.3
+ */
+GST_FRAPPE_META_API void gst_frappe_bundle_pose_free(GstFrappeBundlePose *pose);
+
+/**
+ * gst_frappe_bundle_pose_get_rvec:
+ * @pose: a #GstFrappeBundlePose
+ *
+ * Returns: (transfer none) (array fixed-size=3): the rotation vector,
+ * bundle to camera
+ *
+ * Since: 0.3
+ */
+GST_FRAPPE_META_API const gdouble *gst_frappe_bundle_pose_get_rvec(const GstFrappeBundlePose *pose);
+
+/**
+ * gst_frappe_bundle_pose_get_tvec:
+ * @pose: a #GstFrappeBundlePose
+ *
+ * Returns: (transfer none) (array fixed-size=3): the bundle frame's origin
+ * in the camera frame, in metres
+ *
+ * Since: 0.3
+ */
+GST_FRAPPE_META_API const gdouble *gst_frappe_bundle_pose_get_tvec(const GstFrappeBundlePose *pose);
+
+/**
+ * gst_frappe_bundle_pose_get_used:
+ * @pose: a #GstFrappeBundlePose
+ * @n_used: (out): how many ids
+ *
+ * Returns: (transfer none) (array length=n_used): the ids that made the
+ * pose (a list of ints in Python)
+ *
+ * Since: 0.3
+ */
+GST_FRAPPE_META_API const gint *gst_frappe_bundle_pose_get_used(const GstFrappeBundlePose *pose, guint *n_used);
+
+/**
+ * gst_frappe_bundle_pose_get_rejected:
+ * @pose: a #GstFrappeBundlePose
+ * @n_rejected: (out): how many ids
+ *
+ * Returns: (transfer none) (array length=n_rejected): the ids of the
+ * bundle seen but left out (a list of ints in Python, often empty)
+ *
+ * Since: 0.3
+ */
+GST_FRAPPE_META_API const gint *gst_frappe_bundle_pose_get_rejected(const GstFrappeBundlePose *pose, guint *n_rejected);
+
+/**
+ * gst_frappe_buffer_get_bundle_pose:
+ * @buffer: a #GstBuffer
+ *
+ * Copies out the bundle pose frappedetect attached to @buffer. Allocates:
+ * meant for applications and bindings; C code on a per-frame path reads
+ * the meta (gst_buffer_get_frappe_bundle_meta()) instead.
+ *
+ * Returns: (transfer full) (nullable): the pose, %NULL when @buffer has no
+ * #GstFrappeBundleMeta; free with gst_frappe_bundle_pose_free()
+ *
+ * Since: 0.3
+ */
+GST_FRAPPE_META_API GstFrappeBundlePose *gst_frappe_buffer_get_bundle_pose(GstBuffer *buffer);
 
 G_END_DECLS

@@ -4,14 +4,18 @@
 GstFrappe-1.0 typelib: exact ids, dictionary and Hamming distance of the
 sample image, corners equal to the element's own bus message and within
 0.1 px of the rendered truth, the pose consistent with its reprojection
-error, and no markers on a frame without any.
+error, and no markers on a frame without any; a board's bundle pose
+(GstFrappeBundlePose) against the pose the board was rendered at and the
+element's message.
 
-Usage: test_meta_gi.py SAMPLES_DIR HAVE_TYPELIB(0|1). Exit 77 when gi or
-Gst cannot be imported, or the typelib was not built."""
+Usage: test_meta_gi.py SAMPLES_DIR HAVE_TYPELIB(0|1) FRAPPE_RENDER. Exit 77
+when gi or Gst cannot be imported, or the typelib was not built."""
 import json
 import math
 import os
+import subprocess
 import sys
+import tempfile
 
 SKIP = 77
 failures = []
@@ -85,6 +89,65 @@ def reprojection_rms(marker, side, fx, fy, cx, cy):
         x, y = marker.get_corner(i)
         total += (u - x) ** 2 + (v - y) ** 2
     return math.sqrt(total / 4)
+
+
+def check_bundle_pose(Gst, GstFrappe, render):
+    """A 2x3 board rendered face on (64 px markers, 16 px apart, 16 px of
+    margin) by frappe-render, which also writes its bundle file; through a
+    pinhole camera the board is at z = f 0.04 m / 64 px, the bundle frame's
+    origin (the board's bottom-left corner, y up) where that corner's pixel
+    edge projects."""
+    with tempfile.TemporaryDirectory() as tmp:
+        png = os.path.join(tmp, 'board.png')
+        subprocess.run([render, '--board', '2x3', '--dictionary', 'aruco_mip_36h12', '--cell', '8', png],
+                       check=True, stdout=subprocess.DEVNULL)
+        f, cx, cy = 600.0, 128.0, 88.0
+        pipeline = Gst.parse_launch(
+            f'filesrc location="{png}" ! pngdec ! videoconvert ! video/x-raw,format=GRAY8 ! '
+            f'imagefreeze num-buffers=1 ! frappedetect bundle-file="{png[:-4]}.yaml" '
+            f'camera-matrix="<{f}, 0.0, {cx}, 0.0, {f}, {cy}, 0.0, 0.0, 1.0>" ! appsink name=sink sync=false')
+        sink, bus = pipeline.get_by_name('sink'), pipeline.get_bus()
+        pipeline.set_state(Gst.State.PLAYING)
+        sample = sink.emit('try-pull-sample', 10 * Gst.SECOND)
+        msg = bus.timed_pop_filtered(10 * Gst.SECOND, Gst.MessageType.ELEMENT)
+        pipeline.set_state(Gst.State.NULL)
+    check(sample is not None and msg is not None, 'bundle: one frame, one message')
+    if sample is None or msg is None:
+        return
+    pose = GstFrappe.buffer_get_bundle_pose(sample.get_buffer())
+    sample = None  # the pose is a copy: it outlives the buffer
+    check(pose is not None, 'bundle: buffer_get_bundle_pose gives the board\'s pose')
+    if pose is None:
+        return
+    z = f * 0.04 / 64
+    want_t = [(15.5 - cx) * z / f, (159.5 - cy) * z / f, z]
+    t, R = list(pose.get_tvec()), rodrigues(pose.get_rvec())
+    check(max(abs(a - b) for a, b in zip(t, want_t)) < 1e-4, f'bundle: tvec {t} is the rendered {want_t}')
+    flip = [[1, 0, 0], [0, -1, 0], [0, 0, -1]]  # board y up, z out; camera y down, z forward
+    check(max(abs(R[i][j] - flip[i][j]) for i in range(3) for j in range(3)) < 1e-4,
+          'bundle: face on (rotation of pi about x)')
+    check(pose.name == 'grid' and list(pose.get_used()) == [0, 1, 2, 3, 4, 5] and pose.n_used == 6 and
+          list(pose.get_rejected()) == [] and pose.n_rejected == 0,
+          f'bundle: name {pose.name!r}, used {list(pose.get_used())}, none rejected')
+    check(pose.reprojection_error < 0.05, f'bundle: reprojection error {pose.reprojection_error:.4f} px')
+    st = msg.get_structure()  # held: the bundle structure is borrowed from it
+    s = st.get_value('bundle')
+    check(list(s.get_value('rvec')) == list(pose.get_rvec()) and list(s.get_value('tvec')) == t and
+          s.get_value('reprojection-error') == pose.reprojection_error and
+          list(s.get_value('used')) == list(pose.get_used()), 'bundle: the message\'s values exactly')
+    copy = pose.copy()
+    pose = None
+    check(list(copy.get_used()) == [0, 1, 2, 3, 4, 5] and list(copy.get_tvec()) == t, 'bundle: a copy holds its ids')
+
+    # A meta added from Python reads back; a buffer without one has none.
+    buf = Gst.Buffer.new()
+    check(GstFrappe.buffer_get_bundle_pose(buf) is None, 'bundle: none on a buffer without the meta')
+    GstFrappe.buffer_add_frappe_bundle_meta(buf, 'b', [0.5, -0.25, 1.0], [0.1, 0.2, 1.5], 0.75, [3, 1], [9])
+    p = GstFrappe.buffer_get_bundle_pose(buf)
+    check(p is not None and p.name == 'b' and list(p.get_rvec()) == [0.5, -0.25, 1.0] and
+          list(p.get_tvec()) == [0.1, 0.2, 1.5] and p.reprojection_error == 0.75 and
+          list(p.get_used()) == [3, 1] and list(p.get_rejected()) == [9],
+          'bundle: buffer_add_frappe_bundle_meta reads back')
 
 
 def main():
@@ -175,6 +238,8 @@ def main():
           markers[0].dictionary == 'apriltag_36h11' and markers[0].hamming == 1 and
           list(markers[0].get_corners()) == [1.5, 2.25, 10.5, 2.0, 10.0, 11.75, 1.0, 11.5] and
           not markers[0].has_pose and markers[0].margin == 0, 'buffer_add_frappe_marker_meta reads back')
+
+    check_bundle_pose(Gst, GstFrappe, sys.argv[3])
 
     print(f'{len(failures)} failure(s)')
     return 1 if failures else 0

@@ -10,6 +10,7 @@
 
 #include "candidate_reader.h"
 #include "corner_refine.h"
+#include "frappe/homography.h"
 #include "layout_reader.h"
 #include "marker_set.h"
 #include "quad_geometry.h"
@@ -22,6 +23,22 @@ using detail::bigEnough;
 using detail::cellSide;
 using detail::StageTimer;
 using detail::toFullResolution;
+
+/* Candidates of cells under this many pixels (were they the square) are
+ * also read as the outline around a smaller square (readLayoutCandidate). */
+constexpr float kInnerSquareCell = 6.0f;
+
+/* The square of `share` of the quad's side at its centre, in the quad's
+ * perspective. */
+bool centredSquare(const std::array<Point2f, 4> &quad, float share, std::array<Point2f, 4> &out)
+{
+	const auto H = Homography::fromUnitSquare(quad);
+	if (!H)
+		return false;
+	const double lo = 0.5 * (1.0 - share), hi = 0.5 * (1.0 + share);
+	out = { H->map(lo, lo), H->map(hi, lo), H->map(hi, hi), H->map(lo, hi) };
+	return true;
+}
 
 std::array<Point2f, 4> reversedOrder(const std::array<Point2f, 4> &q)
 {
@@ -102,46 +119,81 @@ bool detail::CandidateReader::readLayoutCandidate(const ImageView &image, Slot &
 	const float minSide = config.min_marker_side / ff;
 	const bool refined = inBatch ? batch.refined[k] != 0
 				     : refineLayoutQuad(block.view, q, std::max(search / ff, 2.5f));
-	/* The refined square first, then the traced one (refinement can
-	 * slide onto a code cell's edge), each on grey levels, then on the
-	 * log scale. */
 	detail::MarkerRead read;
 	bool counted = false;
 	std::array<Point2f, 4> grid;
+	/* Reads `square` with `pol`, from the batch's samples when it is the
+	 * batch's refined square. */
+	auto readSquare = [&](const std::array<Point2f, 4> &square, const detail::DecodePolicy &pol, bool batched) {
+		if (!bigEnough(square, minSide))
+			return false;
+		timer.lap(Stage::Warp);
+		const detail::WarpedMarker *samples = nullptr;
+		if (batched && inBatch && batch.place[k] >= 0 &&
+		    batch.warpedOk[static_cast<std::size_t>(batch.place[k])]) {
+			samples = &batch.samples[static_cast<std::size_t>(batch.place[k])];
+			if (!pol.tone.linear()) {
+				warped = *samples;
+				pol.tone.apply(warped);
+				samples = &warped;
+			}
+		} else if (detail::layoutGrid(square, layout, grid) &&
+			   detail::warpToGrid(block.view, grid, detail::layoutGridSide(layout), warped)) {
+			pol.tone.apply(warped);
+			samples = &warped;
+		}
+		if (!samples)
+			return false;
+		counted = true;
+		timer.lap(Stage::Decode);
+		read = detail::decodeLayout(
+			detail::readLayoutCells(*samples, layout, pol.weakMargin, pol.tone.apply(detail::kClippedGrey)),
+			*codes, pol);
+		return read.ok();
+	};
+	/* The refined square first, then the traced one (refinement can
+	 * slide onto a code cell's edge), each on grey levels, then on the
+	 * log scale. */
 	for (const detail::DecodePolicy *pol : { &policy, &logPolicy }) {
 		if (pol == &logPolicy && logPolicy.tone.linear())
 			break;
-		for (int attempt = 0; attempt < 2 && !read.ok(); ++attempt) {
-			if (attempt == 1 && !refined)
-				break;
-			const std::array<Point2f, 4> square = attempt == 0 ? q.corners : outline;
-			if (!bigEnough(square, minSide))
-				continue;
-			timer.lap(Stage::Warp);
-			const detail::WarpedMarker *samples = nullptr;
-			if (attempt == 0 && inBatch && batch.place[k] >= 0 &&
-			    batch.warpedOk[static_cast<std::size_t>(batch.place[k])]) {
-				samples = &batch.samples[static_cast<std::size_t>(batch.place[k])];
-				if (!pol->tone.linear()) {
-					warped = *samples;
-					pol->tone.apply(warped);
-					samples = &warped;
-				}
-			} else if (detail::layoutGrid(square, layout, grid) &&
-				   detail::warpToGrid(block.view, grid, detail::layoutGridSide(layout), warped)) {
-				pol->tone.apply(warped);
-				samples = &warped;
-			}
-			if (!samples)
-				continue;
-			counted = true;
-			timer.lap(Stage::Decode);
-			read = detail::decodeLayout(detail::readLayoutCells(*samples, layout, pol->weakMargin), *codes, *pol);
-			if (read.ok())
-				q.corners = square;
-		}
-		if (read.ok())
+		if (readSquare(q.corners, *pol, true))
 			break;
+		if (refined && readSquare(outline, *pol, false)) {
+			q.corners = outline;
+			break;
+		}
+	}
+	/* Refinement costs most: a guessed square is refined only where its
+	 * rings read three quarters right before (most clutter's do not). */
+	auto ringsNearlyThere = [&](const ImageView &view, const std::array<Point2f, 4> &square) {
+		if (!layoutGrid(square, layout, grid) || !warpToGrid(view, grid, layoutGridSide(layout), warped))
+			return false;
+		return detail::ringsNearlyWhole(warped, layout);
+	};
+	/* A small marker's square may have no outline of its own: edges 2 or
+	 * 3 pixels apart on both sides of its black ring join, and what is
+	 * traced is the ring's outside or the whole layout's. The square then
+	 * lies at the candidate's centre, square_cells of the ring's
+	 * square_cells + 2 or of the layout's size: refined from there, it is
+	 * read on grey levels, correcting only what a clear read may (weak
+	 * corrections too read a tagStandard52h13 marker as a tagCustom48h12
+	 * id, the two layouts' rings alike). */
+	if (!read.ok() && f == 1 && cellPx < kInnerSquareCell) {
+		detail::DecodePolicy guessed = policy;
+		guessed.maxTotal = policy.maxHamming;
+		for (const int cells : { layout.square_cells + 2, layout.size }) {
+			detail::Quad inner = q;
+			if (!centredSquare(outline, static_cast<float>(layout.square_cells) / static_cast<float>(cells),
+					   inner.corners) ||
+			    !bigEnough(inner.corners, minSide) || !ringsNearlyThere(block.view, inner.corners) ||
+			    !refineLayoutQuad(block.view, inner, 2.5f))
+				continue;
+			if (readSquare(inner.corners, guessed, false)) {
+				q.corners = inner.corners;
+				break;
+			}
+		}
 	}
 	slot.result.candidates += counted;
 	if (!read.ok())

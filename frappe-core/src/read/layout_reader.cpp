@@ -32,25 +32,46 @@ struct Plane {
 	float at(float x, float y) const { return a + bx * x + by * y; }
 };
 
-Plane fitRing(const WarpedMarker &g, const MarkerLayout &l, int ring)
+/* The grid position (x, y) of each cell of a ring, in order. */
+template<typename F>
+void forRing(const MarkerLayout &l, int ring, F &&f)
 {
+	const int lo = ring, hi = l.size - 1 - ring;
+	for (int y = lo; y <= hi; ++y)
+		for (int x = lo; x <= hi; ++x)
+			if (x == lo || x == hi || y == lo || y == hi)
+				f(x, y);
+}
+
+/* Under glare (`unknown` says which cells clip) a ring's clipped cells
+ * take its other cells' mean: the fit then follows the light on the
+ * marker, not on the glare. */
+template<typename Unknown>
+Plane fitRing(const WarpedMarker &g, const MarkerLayout &l, int ring, bool glare, Unknown &&unknown)
+{
+	float known = 0.0f;
+	int nKnown = 0;
+	if (glare)
+		forRing(l, ring, [&](int x, int y) {
+			if (!unknown(x, y)) {
+				known += g.at(x + 1, y + 1);
+				++nKnown;
+			}
+		});
+	const float fill = nKnown ? known / static_cast<float>(nKnown) : 0.0f;
 	const float c = 0.5f * static_cast<float>(l.size - 1);
 	float s = 0.0f, sx = 0.0f, sy = 0.0f, xx = 0.0f, yy = 0.0f;
 	int n = 0;
-	const int lo = ring, hi = l.size - 1 - ring;
-	for (int y = lo; y <= hi; ++y) {
-		for (int x = lo; x <= hi; ++x) {
-			if (x != lo && x != hi && y != lo && y != hi)
-				continue;
-			const float v = g.at(x + 1, y + 1), dx = static_cast<float>(x) - c, dy = static_cast<float>(y) - c;
-			s += v;
-			sx += dx * v;
-			sy += dy * v;
-			xx += dx * dx;
-			yy += dy * dy;
-			++n;
-		}
-	}
+	forRing(l, ring, [&](int x, int y) {
+		const float v = nKnown && unknown(x, y) ? fill : g.at(x + 1, y + 1);
+		const float dx = static_cast<float>(x) - c, dy = static_cast<float>(y) - c;
+		s += v;
+		sx += dx * v;
+		sy += dy * v;
+		xx += dx * dx;
+		yy += dy * dy;
+		++n;
+	});
 	Plane p;
 	p.a = s / static_cast<float>(n);
 	p.bx = xx > 0.0f ? sx / xx : 0.0f;
@@ -81,14 +102,61 @@ void sharpen(const WarpedMarker &in, WarpedMarker &out)
 
 } // namespace
 
-LayoutCells readLayoutCells(const WarpedMarker &sampled, const MarkerLayout &l, float weakMargin)
+bool ringsNearlyWhole(const WarpedMarker &sampled, const MarkerLayout &l)
+{
+	const int outer = l.square_start - 1, inner = l.square_start;
+	auto none = [](int, int) { return false; }; /* no glare: every cell known */
+	const Plane po = fitRing(sampled, l, outer, false, none), pi = fitRing(sampled, l, inner, false, none);
+	const Plane &dark = l.reversed ? po : pi, &light = l.reversed ? pi : po;
+	if (light.a - dark.a < 10.0f)
+		return false;
+	const float c = 0.5f * static_cast<float>(l.size - 1);
+	int errors = 0, cells = 0;
+	for (const int ring : { outer, inner })
+		forRing(l, ring, [&](int x, int y) {
+			const float dx = static_cast<float>(x) - c, dy = static_cast<float>(y) - c;
+			const float thr = 0.5f * (dark.at(dx, dy) + light.at(dx, dy));
+			const float v = sampled.at(x + 1, y + 1);
+			errors += (ring == outer) == l.reversed ? v > thr : v < thr;
+			++cells;
+		});
+	return 4 * errors <= cells;
+}
+
+LayoutCells readLayoutCells(const WarpedMarker &sampled, const MarkerLayout &l, float weakMargin, float clip)
 {
 	WarpedMarker g;
 	sharpen(sampled, g);
 	/* The ring just outside the square and the one just inside it; the
 	 * outer one may be the quiet zone, a ring of the grid beyond the layout. */
 	const int outer = l.square_start - 1, inner = l.square_start;
-	const Plane po = fitRing(g, l, outer), pi = fitRing(g, l, inner);
+	const int darkRing = l.reversed ? outer : inner;
+	auto ringOf = [&](int x, int y) { return std::min(std::min(x, y), std::min(l.size - 1 - x, l.size - 1 - y)); };
+	/* Glare, as verify.cpp's readCells() judges it: a cell that must be
+	 * black (the dark ring, a black cell) at the sensor's ceiling. Every
+	 * cell that clips is then unknown: black ink may lie under it. (The
+	 * clip is judged on the samples as warped: sharpening lifts a light
+	 * cell beside dark ones.) */
+	auto clips = [&](int x, int y) { return sampled.at(x + 1, y + 1) >= clip; };
+	auto darkClips = [&] {
+		const int n = sampled.side * sampled.side;
+		int i = 0;
+		while (i < n && sampled.samples[static_cast<std::size_t>(i)] < clip)
+			++i;
+		if (i == n) /* nothing clips: the common case, one pass */
+			return false;
+		for (int y = -1; y <= l.size; ++y)
+			for (int x = -1; x <= l.size; ++x) {
+				const bool inside = x >= 0 && y >= 0 && x < l.size && y < l.size;
+				if (clips(x, y) &&
+				    (ringOf(x, y) == darkRing || (inside && l.at(x, y) == MarkerLayout::kBlack)))
+					return true;
+			}
+		return false;
+	};
+	const bool glare = darkClips();
+	auto unknown = [&](int x, int y) { return glare && clips(x, y); };
+	const Plane po = fitRing(g, l, outer, glare, unknown), pi = fitRing(g, l, inner, glare, unknown);
 	const Plane &dark = l.reversed ? po : pi, &light = l.reversed ? pi : po;
 	const float c = 0.5f * static_cast<float>(l.size - 1);
 	LayoutCells out;
@@ -102,18 +170,21 @@ LayoutCells readLayoutCells(const WarpedMarker &sampled, const MarkerLayout &l, 
 			const float dx = static_cast<float>(x) - c, dy = static_cast<float>(y) - c;
 			const float thr = 0.5f * (dark.at(dx, dy) + light.at(dx, dy));
 			const float v = g.at(x + 1, y + 1);
-			const int ring = std::min(std::min(x, y), std::min(l.size - 1 - x, l.size - 1 - y));
-			if (ring == outer || ring == inner) {
-				const bool isDark = (ring == outer) == l.reversed;
-				out.ringErrors += isDark ? v > thr : v < thr;
-				++out.ringCells;
+			const int ring = ringOf(x, y);
+			const bool inside = x >= 0 && y >= 0 && x < l.size && y < l.size;
+			const int bit = inside ? l.at(x, y) : MarkerLayout::kAny;
+			const bool isRing = ring == outer || ring == inner || bit == MarkerLayout::kWhite;
+			if (!inside && !isRing)
+				continue;
+			/* A clipped cell under glare is no evidence either way; a
+			 * bit there is read, and weak (margin 0). */
+			if (unknown(x, y) && bit < 0) {
+				out.ringUnknown += isRing;
 				continue;
 			}
-			if (x < 0 || y < 0 || x >= l.size || y >= l.size)
-				continue;
-			const int bit = l.at(x, y);
-			if (bit == MarkerLayout::kWhite) {
-				out.ringErrors += v < thr;
+			if (isRing) {
+				const bool isDark = bit != MarkerLayout::kWhite && (ring == outer) == l.reversed;
+				out.ringErrors += isDark ? v > thr : v < thr;
 				++out.ringCells;
 				continue;
 			}
@@ -123,7 +194,8 @@ LayoutCells readLayoutCells(const WarpedMarker &sampled, const MarkerLayout &l, 
 				continue;
 			}
 			value[static_cast<std::size_t>(bit)] = v > thr;
-			margin[static_cast<std::size_t>(bit)] = std::min(std::abs(v - thr) / half, 1.0f);
+			margin[static_cast<std::size_t>(bit)] =
+				unknown(x, y) ? 0.0f : std::min(std::abs(v - thr) / half, 1.0f);
 		}
 	}
 	for (int k = 0; k < l.code_bits; ++k) {
@@ -140,8 +212,10 @@ MarkerRead decodeLayout(const LayoutCells &cells, const CodeBook &codes, const D
 	MarkerRead read;
 	const Dictionary &dict = codes.dictionary();
 	/* A square of real contrast, its two rings whole but for a cell in 16
-	 * (blur at the corners, a corner covered). */
-	if (cells.contrast < 10.0f || 16 * cells.ringErrors > cells.ringCells) {
+	 * (blur at the corners, a corner covered), and at most half of them
+	 * under glare (unknown cells count as neither). */
+	const int ring = cells.ringCells + cells.ringUnknown;
+	if (cells.contrast < 10.0f || 16 * cells.ringErrors > ring || 2 * cells.ringUnknown > ring) {
 		read.rejection = Rejection::BorderNotBlack;
 		return read;
 	}

@@ -27,12 +27,15 @@ bool layoutGrid(const std::array<Point2f, 4> &square, const MarkerLayout &layout
 
 /// A layout's cells read against a threshold that follows the light: planes
 /// fitted to the two rings beside the square's edge (black and white by
-/// construction), the threshold halfway between them at each cell.
+/// construction), the threshold halfway between them at each cell. Where
+/// a cell that must be black clips (samples at or above `clip`: glare), every
+/// clipped cell is unknown: no ring or plain evidence, a weak bit.
 struct LayoutCells {
 	std::uint64_t code = 0;
 	std::uint64_t weak = 0;  ///< bits read weakly, in the code's order
 	int ringErrors = 0;      ///< cells of the two rings on the wrong side
-	int ringCells = 0;
+	int ringCells = 0;       ///< cells of the two rings read (not unknown)
+	int ringUnknown = 0;     ///< cells of the two rings clipped under glare
 	/// The other cells that are no bits (always black, or of no matter:
 	/// a circle family's corners), and those of them that read light.
 	int plainCells = 0;
@@ -40,7 +43,11 @@ struct LayoutCells {
 	float contrast = 0.0f;   ///< the white ring's mean less the black ring's
 	float margin = 0.0f;     ///< the weakest bit's distance from its threshold over half the contrast
 };
-LayoutCells readLayoutCells(const WarpedMarker &grid, const MarkerLayout &layout, float weakMargin);
+LayoutCells readLayoutCells(const WarpedMarker &grid, const MarkerLayout &layout, float weakMargin, float clip);
+
+/// Whether the two rings beside the square read three quarters right, on
+/// the samples as warped: a cheap look before refining a guessed square.
+bool ringsNearlyWhole(const WarpedMarker &grid, const MarkerLayout &layout);
 
 /// Decodes and checks a read: enough contrast, rings nearly whole, the
 /// plain cells beyond them one colour but for one in eight (black as

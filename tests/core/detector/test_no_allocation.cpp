@@ -198,6 +198,29 @@ TEST(NoAllocationTrack, AMovingSceneAllocatesNothingTheSecondTime)
 
 /* Mode::Track: the regions, the tracks and the band allocate nothing once a
  * frame of the size was seen, whether a frame is read in regions or whole. */
+/* A layout family (issue 32): small markers whose squares are read inside
+ * the outline traced around them, and larger ones read from their own. */
+TEST(NoAllocationLayout, SmallLayoutMarkersAllocateNothingOnceWarm)
+{
+	const Dictionary &dict = *findDictionary("apriltag_standard41h12");
+	Image img(640, 480, 110);
+	std::mt19937 rng(5);
+	for (int k = 0; k < 6; ++k) {
+		renderMarker(img.mut(), dict, k, squarePose(70.0f + 100.0f * k, 140.0f, 12.0f + k, 15.0f * k, 40.0f));
+		renderMarker(img.mut(), dict, 10 + k, squarePose(70.0f + 100.0f * k, 340.0f, 40.0f, -10.0f * k, 20.0f));
+	}
+	addNoise(img, 3.0f, rng);
+	Config config;
+	config.dictionary = "apriltag_standard41h12";
+	Detector det(config);
+	det.detect(img.view());
+	const long before = gAllocations.load();
+	const std::size_t n = det.detect(img.view()).markers.size();
+	const long after = gAllocations.load();
+	EXPECT_EQ(n, 12u); /* 11 without the read inside the outline */
+	EXPECT_EQ(after - before, 0) << "detect() allocated on a frame of a size it had seen";
+}
+
 TEST(NoAllocationTrack, FramesReadInRegionsAllocateNothingOnceWarm)
 {
 	const std::vector<Image> s = scenes();
