@@ -433,8 +433,10 @@ detail::MarkerRead detail::CandidateReader::readRefined(Reading &r, detail::Quad
 		 * one by part of a cell, and its grid falls between the cells.
 		 * The shift is unknown (how far above the ceiling the white
 		 * lies): read the outline widened by a quarter cell at a time,
-		 * up to three quarters (a cell's blur), and let the checks judge
-		 * each read as any other. */
+		 * up to three quarters (a cell's blur). No edge placed it, so a
+		 * read there must be clear as well as pass every check (a crisp
+		 * marker on paper at 255, widened, reads as another family's
+		 * code with weak cells). */
 		for (int quarters = 1; !read.ok() && refined.refined && quarters <= kClipWidenings; ++quarters) {
 			const float out = 0.25f * static_cast<float>(quarters) / static_cast<float>(dict->bits + 2);
 			if (!widenedQuad(refinedCorners, out, q.corners))
@@ -444,6 +446,8 @@ detail::MarkerRead detail::CandidateReader::readRefined(Reading &r, detail::Quad
 			r.inBatch = false;
 			r.outline = widened;
 			read = readWith(onClip);
+			if (read.ok() && read.margin < onClip.weakMargin)
+				read.rejection = Rejection::WeakRead;
 		}
 	}
 	result.candidates += counted || r.counted;
