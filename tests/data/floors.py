@@ -65,17 +65,18 @@ SETS = {
 # enforced where the target is not met yet (a missing entry: the target).
 EXPOSURE_POINTS = {0.3: 3, 0.15: 10, 2.0: 3}
 # Not met yet: at 200% light small blurred markers lose their black cells
-# to the ceiling (their blur lifts them to within a few grey levels of it;
-# the read on the exponential scale, docs/quality.md, takes back half of
-# what was lost); the lighting subsets, already dim or clipped, darkened or
-# brightened again.
+# to the ceiling (their blur lifts them to within a few grey levels of it,
+# or their border so near it that no edge or dark region closes around
+# them); the lighting subsets, already dim or clipped, darkened or
+# brightened again (glare brightened twice clips the black ink itself).
+# synth/images and apriltag_16h5 meet the 3 points at 200% since clipped
+# candidates are no longer skipped as clutter (docs/quality.md, issue 29).
 EXPOSURE_ENFORCED = {
-    ('synth/images', 2.0): 4, ('synth/blur', 2.0): 12,
-    ('synth/blur-apriltag36h11', 2.0): 12, ('synth/4x4_50', 2.0): 6, ('synth/6x6_250', 2.0): 7,
-    ('synth/apriltag_16h5', 2.0): 6,
-    ('synth/lighting', 0.15): 34, ('synth/lighting', 0.3): 14, ('synth/lighting', 2.0): 6,
+    ('synth/blur', 2.0): 6, ('synth/blur-apriltag36h11', 2.0): 7, ('synth/4x4_50', 2.0): 5,
+    ('synth/6x6_250', 2.0): 5,
+    ('synth/lighting', 0.15): 34, ('synth/lighting', 0.3): 14, ('synth/lighting', 2.0): 5,
     ('synth/lighting-apriltag36h11', 0.15): 29, ('synth/lighting-apriltag36h11', 0.3): 14,
-    ('synth/lighting-apriltag36h11', 2.0): 9,
+    ('synth/lighting-apriltag36h11', 2.0): 8,
 }
 # False positives allowed where the target of none is not met yet: a 15 px
 # marker of synth/images read as another id at 30% (hamming 5, margin 0.03).

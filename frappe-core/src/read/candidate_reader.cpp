@@ -9,6 +9,7 @@
 #include <span>
 
 #include "corner_refine.h"
+#include "frappe/homography.h"
 #include "candidate_reader.h"
 #include "marker_set.h"
 #include "quad_geometry.h"
@@ -192,8 +193,13 @@ bool detail::CandidateReader::skipCandidate(const detail::Quad &q, const std::ar
 	 * to be refined for nothing, at the cost of no marker.) */
 	if (traced < 0)
 		return false;
+	/* Where the probe's brightest sample clips, its midpoint threshold is
+	 * too dark (the true white lies above the ceiling): blur lifts a
+	 * marker's black border over it, and the frame reads mixed. Such a
+	 * frame is no evidence of clutter; the reads after refinement judge. */
+	const bool clips = q.probeLevel + 0.5f * q.probeContrast >= detail::kClippedGrey;
 	const int mixedFrame = 2 * detail::allowedBorderErrors(bits);
-	const bool mixed = traced > mixedFrame && traced < whiteFrame();
+	const bool mixed = traced > mixedFrame && traced < whiteFrame() && !clips;
 	if (q.fromRegion)
 		return mixed || q.probeContrast < static_cast<float>(params.relativeRegionContrast(
 					       static_cast<int>(std::lround(q.probeLevel - 0.5f * q.probeContrast)),
@@ -330,7 +336,21 @@ detail::MarkerRead detail::CandidateReader::decodeCandidate(const Reading &r, de
  * time), so that the midpoint between black and white is too dark a
  * threshold (Tone's exponential scale). */
 constexpr int kClippedShare = 8;
+/* The widest of the clipped reads' outlines, in quarter cells. */
+constexpr int kClipWidenings = 3;
 namespace {
+/* `q` widened by `out` of its side on every side (in the marker's own
+ * plane: through its homography). False when degenerate. */
+bool widenedQuad(const std::array<Point2f, 4> &q, float out, std::array<Point2f, 4> &widened)
+{
+	const auto H = Homography::fromUnitSquare(q);
+	if (!H)
+		return false;
+	const double lo = -out, hi = 1.0 + out;
+	widened = { H->map(lo, lo), H->map(hi, lo), H->map(hi, hi), H->map(lo, hi) };
+	return true;
+}
+
 bool clipsWhite(const detail::WarpedMarker &w)
 {
 	int n = 0;
@@ -405,8 +425,31 @@ detail::MarkerRead detail::CandidateReader::readRefined(Reading &r, detail::Quad
 	};
 	if (!read.ok() && !onLog.tone.linear())
 		readAgain(onLog);
-	if (!read.ok() && clipped && !onClip.tone.linear())
+	if (!read.ok() && clipped && !onClip.tone.linear()) {
 		readAgain(onClip);
+		/* Where the whites clip, blur moves every visible edge towards the
+		 * black: the border's outside inwards by the same amount its
+		 * inside moves out, so the refined outline lies inside the true
+		 * one by part of a cell, and its grid falls between the cells.
+		 * The shift is unknown (how far above the ceiling the white
+		 * lies): read the outline widened by a quarter cell at a time,
+		 * up to three quarters (a cell's blur). No edge placed it, so a
+		 * read there must be clear as well as pass every check (a crisp
+		 * marker on paper at 255, widened, reads as another family's
+		 * code with weak cells). */
+		for (int quarters = 1; !read.ok() && refined.refined && quarters <= kClipWidenings; ++quarters) {
+			const float out = 0.25f * static_cast<float>(quarters) / static_cast<float>(dict->bits + 2);
+			if (!widenedQuad(refinedCorners, out, q.corners))
+				break;
+			const std::array<Point2f, 4> widened = q.corners;
+			r = refined;
+			r.inBatch = false;
+			r.outline = widened;
+			read = readWith(onClip);
+			if (read.ok() && read.margin < onClip.weakMargin)
+				read.rejection = Rejection::WeakRead;
+		}
+	}
 	result.candidates += counted || r.counted;
 	return read;
 }
