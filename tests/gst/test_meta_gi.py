@@ -8,7 +8,7 @@ error, and no markers on a frame without any; a board's bundle pose
 (GstFrappeBundlePose) against the pose the board was rendered at and the
 element's message.
 
-Usage: test_meta_gi.py SAMPLES_DIR HAVE_TYPELIB(0|1) FRAPPE_RENDER. Exit 77
+Usage: test_meta_gi.py SAMPLES_DIR HAVE_TYPELIB(0|1) [FRAPPE_RENDER]. Exit 77
 when gi or Gst cannot be imported, or the typelib was not built."""
 import json
 import math
@@ -239,7 +239,10 @@ def main():
           list(markers[0].get_corners()) == [1.5, 2.25, 10.5, 2.0, 10.0, 11.75, 1.0, 11.5] and
           not markers[0].has_pose and markers[0].margin == 0, 'buffer_add_frappe_marker_meta reads back')
 
-    check_bundle_pose(Gst, GstFrappe, sys.argv[3])
+    if len(sys.argv) > 3:
+        check_bundle_pose(Gst, GstFrappe, sys.argv[3])
+    else:  # a build without the CLI (-Dcli=disabled): no board to render
+        print('bundle pose: not checked, no frappe-render in this build')
 
     print(f'{len(failures)} failure(s)')
     return 1 if failures else 0
