@@ -148,29 +148,11 @@ void clearQuad(TraceMap &m, const std::array<Point2f, 4> &q)
 			any = !m.tileEmpty(tx, ty);
 	if (!any)
 		return;
-	/* Each side's x at a row's centre: a start and a step a row. */
-	struct Side {
-		float ya, yb, x0, dxdy;
-	};
-	std::array<Side, 4> sides{};
-	int n = 0;
-	for (int i = 0; i < 4; ++i) {
-		const Point2f a = q[i], b = q[(i + 1) % 4];
-		if (a.y == b.y)
-			continue;
-		const float dxdy = (b.x - a.x) / (b.y - a.y);
-		sides[n++] = { std::min(a.y, b.y), std::max(a.y, b.y), a.x - a.y * dxdy, dxdy };
-	}
+	const QuadSpans rows(q, true);
 	for (int y = y0; y <= y1; ++y) {
-		const float yc = static_cast<float>(y) + 0.5f;
-		float left = static_cast<float>(m.width), right = -1.0f;
-		for (int i = 0; i < n; ++i) {
-			if (yc < sides[i].ya || yc >= sides[i].yb)
-				continue;
-			const float x = sides[i].x0 + yc * sides[i].dxdy;
-			left = std::min(left, x);
-			right = std::max(right, x);
-		}
+		float left, right;
+		if (!rows.span(static_cast<float>(y) + 0.5f, left, right))
+			continue;
 		const int x0 = std::max(0, static_cast<int>(std::ceil(left - 0.5f)));
 		const int x1 = std::min(m.width - 1, static_cast<int>(std::floor(right - 0.5f)));
 		if (x1 >= x0)

@@ -461,54 +461,6 @@ void ContourTracer::trace(const TraceMap &edges, const TraceParams &params, std:
 	}
 }
 
-namespace {
-
-/* Where the lines y = v (byRows) or x = v cross a convex quad: its four
- * sides as u = u0 + slope (v - v0) over [vLo, vHi], slopes computed once. */
-class QuadSpans
-{
-public:
-	QuadSpans(const std::array<Point2f, 4> &q, bool byRows)
-	{
-		for (int i = 0; i < 4; ++i) {
-			const Point2f &a = q[i], &b = q[(i + 1) & 3];
-			const float au = byRows ? a.x : a.y, av = byRows ? a.y : a.x;
-			const float bu = byRows ? b.x : b.y, bv = byRows ? b.y : b.x;
-			Side &s = sides_[i];
-			s.vLo = std::min(av, bv);
-			s.vHi = std::max(av, bv);
-			s.flat = av == bv;
-			s.u0 = s.flat ? std::min(au, bu) : au;
-			s.u1 = std::max(au, bu);
-			s.v0 = av;
-			s.slope = s.flat ? 0.0f : (bu - au) / (bv - av);
-		}
-	}
-	/* False when the line misses the quad. */
-	bool span(float v, float &lo, float &hi) const
-	{
-		lo = 1e30f;
-		hi = -1e30f;
-		for (const Side &s : sides_) {
-			if (v < s.vLo || v > s.vHi)
-				continue;
-			const float u = s.flat ? s.u0 : s.u0 + s.slope * (v - s.v0);
-			lo = std::min(lo, u);
-			hi = std::max(hi, s.flat ? s.u1 : u);
-		}
-		return lo <= hi;
-	}
-
-private:
-	struct Side {
-		float vLo, vHi, u0, u1, v0, slope;
-		bool flat;
-	};
-	std::array<Side, 4> sides_;
-};
-
-} // namespace
-
 /* Labels the marker's inside kFollowedRightBg, where nothing starts (outer
  * borders start at kUnfollowed, hole borders before a 0), so neither the code's
  * cells nor the hole border of the outline are followed. The quad's sides
