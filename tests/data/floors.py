@@ -69,6 +69,10 @@ EXPOSURE_POINTS = {0.3: 3, 0.15: 10, 2.0: 3}
 # or their border so near it that no edge or dark region closes around
 # them); the lighting subsets, already dim or clipped, darkened or
 # brightened again (glare brightened twice clips the black ink itself).
+# Darkened, the lighting subsets lose what falls below 10 grey levels of
+# contrast (at 15%: 259 of lighting's 499 markers; their markers of 10 or
+# more are found as often as at 1x): the 14/34 and 14/29 points are that
+# ceiling (docs/quality.md, "Low exposure by contrast").
 # synth/images and apriltag_16h5 meet the 3 points at 200% since clipped
 # candidates are no longer skipped as clutter (docs/quality.md, issue 29).
 EXPOSURE_ENFORCED = {

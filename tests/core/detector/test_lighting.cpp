@@ -127,6 +127,37 @@ TEST(Lighting, DimRoom)
 	EXPECT_EQ(lostWhenAbsolute, scenes);
 }
 
+/* Issue 29's criterion: a marker whose black and white differ by 10 grey
+ * levels (5.3% of the light, the ground at 6 grey levels) in a frame with
+ * noise of 1.5 grey levels is found, at the right corners, and nothing
+ * else is; with absolute thresholds none is. (At 7 grey levels all of these
+ * are found too, at 6 three of nine, at 5 none: docs/quality.md.) */
+TEST(Lighting, TenGreyLevelsInANoisyFrame)
+{
+	int found = 0, scenes = 0, foundWhenAbsolute = 0;
+	for (const char *name : { "aruco_mip_36h12", "apriltag_36h11", "4x4_50" }) {
+		const Dictionary &dict = dictionary(name);
+		for (auto [side, roll, tilt] :
+		     { std::tuple{ 40.0f, 5.0f, 10.0f }, { 60.0f, 10.0f, 20.0f }, { 110.0f, -35.0f, 45.0f } }) {
+			const float gain = 10.0f / 190.0f;
+			const Scene s = litScene(
+				dict, 7, side, roll, tilt, [=](float, float) { return gain; }, 1.5f,
+				static_cast<unsigned>(side) + 3);
+			const Outcome o = detectIn(s, dict, kDefault);
+			EXPECT_EQ(o.others, 0) << name << ", side " << side;
+			++scenes;
+			foundWhenAbsolute += detectIn(s, dict, kAbsolute).marker != nullptr;
+			if (!o.marker)
+				continue;
+			EXPECT_LT(o.error, 0.8f) << name << ", side " << side;
+			++found;
+		}
+	}
+	std::printf("10 grey levels, noise 1.5: %d of %d found\n", found, scenes);
+	EXPECT_EQ(found, scenes);
+	EXPECT_EQ(foundWhenAbsolute, 0);
+}
+
 /* A blind's shadow: stripes at a third and a fifth of the light across the
  * marker, its quiet zone and its surroundings, 2.6 cells apart, at three
  * angles: harsher than the shared lighting set's blinds (there the stripes
