@@ -7,7 +7,10 @@ then every layout family's detector over the other families' scenes and
 ../shared's synth subsets, where any marker is a wrong id.
 
 usage: scripts/layout_quality.py BUILD_DIR OUT_DIR [--images 60] [--synth]
-(the synth subsets: also tests/data's data-wrong-ids)
+    [--families a,b] [--hard-only] [--no-cross]
+(the synth subsets: also tests/data's data-wrong-ids; --families, --hard-only
+and --no-cross narrow a run while iterating: scenes of the other families
+are still rendered for the wrong-id table)
 """
 import json
 import math
@@ -96,13 +99,16 @@ def main():
     images = int(sys.argv[sys.argv.index('--images') + 1]) if '--images' in sys.argv else 60
     detect = os.path.join(build, 'tools', 'frappe-detect')
     peer = os.path.join(build, 'tests', 'bench', 'apriltag-peer')
+    chosen = sys.argv[sys.argv.index('--families') + 1].split(',') if '--families' in sys.argv else FAMILIES
     folders = {f: scenes(build, out, f, images) for f in FAMILIES}
-    hard = {f: scenes(build, out, f, images, True) for f in FAMILIES}
+    hard = {f: scenes(build, out, f, images, True) for f in chosen}
+    sets = [] if '--hard-only' in sys.argv else [(f, folders[f]) for f in chosen]
+    sets += [(f + ' hard', hard[f]) for f in chosen]
     print('| family | markers | frappe sensitivity | FP | corner mean / median px | ms median '
           '| AprilTag 3.3 d1 sensitivity | FP | corner mean / median px | ms median |')
     print('|---|---|---|---|---|---|---|---|---|---|')
     sizes = []
-    for f, folder in [(f, folders[f]) for f in FAMILIES] + [(f + ' hard', hard[f]) for f in FAMILIES]:
+    for f, folder in sets:
         f = f.split()[0]
         dets = os.path.join(folder, 'frappe.jsonl')
         run([detect, '--dictionary', f, '--list', os.path.join(folder, 'list.txt'), '--out', dets,
@@ -114,16 +120,18 @@ def main():
             return [f"{s['sensitivity']:.3f}", s['fp'],
                     f"{s['corner_mae_px']:.3f} / {s['corner_median_px']:.3f}", f"{s['time_ms_median']:.2f}"]
         row += cells(a)
-        hard_set = folder == hard[f]
+        hard_set = folder == hard.get(f)
         if hard_set:
             sizes.append([f, 'frappe'] + by_side(folder, dets))
         if os.path.exists(peer):
             pd = os.path.join(folder, 'apriltag-d1.jsonl')
+            # the peer's reads do not change between runs
             # libapriltag's decode table for the largest families at 2 bits
             # needs gigabytes: 1 bit there, as AprilTag's docs advise.
             bits = '1' if f in ('apriltag_standard52h13', 'apriltag_circle49h12', 'apriltag_custom48h12') else '2'
-            run([peer, '--dictionary', f, '--list', os.path.join(folder, 'list.txt'), '--out', pd,
-                 '--decimate', '1', '--hamming', bits])
+            if not os.path.exists(pd):
+                run([peer, '--dictionary', f, '--list', os.path.join(folder, 'list.txt'), '--out', pd,
+                     '--decimate', '1', '--hamming', bits])
             row += cells(score(folder, pd))
             if hard_set:
                 sizes.append([f, 'AprilTag 3.3 d1'] + by_side(folder, pd))
@@ -134,8 +142,12 @@ def main():
     print('|---|---|' + '---|' * len(SIDE_BINS))
     for row in sizes:
         print('| ' + ' | '.join(row) + ' |')
+    if '--no-cross' in sys.argv:
+        return
     # Wrong ids: each family over the others' scenes and the shared subsets.
     others = {f'{g} (rendered)': os.path.join(folders[g], 'list.txt') for g in FAMILIES}
+    others.update({f'{g} hard (rendered)': os.path.join(scenes(build, out, g, images, True), 'list.txt')
+                   for g in FAMILIES})
     synth = os.path.join(SHARED, 'data', 'synth')
     if os.path.isdir(synth) and '--synth' in sys.argv:
         for sub in sorted(os.listdir(synth)):

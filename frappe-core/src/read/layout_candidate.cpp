@@ -176,12 +176,15 @@ bool detail::CandidateReader::readLayoutCandidate(const ImageView &image, Slot &
 	 * traced is the ring's outside or the whole layout's. The square then
 	 * lies at the candidate's centre, square_cells of the ring's
 	 * square_cells + 2 or of the layout's size: refined from there, it is
-	 * read on grey levels, correcting only what a clear read may (weak
-	 * corrections too read a tagStandard52h13 marker as a tagCustom48h12
-	 * id, the two layouts' rings alike). */
+	 * read on grey levels. Its weak bits (cells of 2-3 px blur into their
+	 * neighbours) are corrected as a traced square's are, but at most half
+	 * the clear bits: no edge outlined it, and the whole clear budget with
+	 * weak bits on top read a tagStandard52h13 marker as a tagCustom48h12
+	 * id 3 bits away (the two layouts' rings alike); with none, small
+	 * blurred markers guessed right went unread. */
 	if (!read.ok() && f == 1 && cellPx < kInnerSquareCell) {
 		detail::DecodePolicy guessed = policy;
-		guessed.maxTotal = policy.maxHamming;
+		guessed.maxHamming = policy.maxHamming / 2;
 		for (const int cells : { layout.square_cells + 2, layout.size }) {
 			detail::Quad inner = q;
 			if (!centredSquare(outline, static_cast<float>(layout.square_cells) / static_cast<float>(cells),
