@@ -32,10 +32,10 @@
 #                      frames, each counted alone (docs/arm.md, "Four cores")
 #   --bands N          the front end in N row bands on N threads, counted band
 #                      by band (one at a time): the latency on N cores, in
-#                      BUILD/arm-count/threads.md (arm_threads_report.py)
+#                      threads.md in --out (arm_threads_report.py)
 #   --pipeline N       the list through a Pipeline of N threads (0: a bare
 #                      Detector), each thread's count: what the pipeline adds,
-#                      in BUILD/arm-count/threads.md
+#                      in threads.md in --out
 #                      (--bands and --pipeline run qemu on one host core, where
 #                      frappe's threads never spin: the counts stay exact)
 #   --out DIR          where the results go (default: BUILD/arm-count)
