@@ -28,13 +28,22 @@
 #                      its order (ascale: what the Pi Zero model, vc4-zero-model,
 #                      reads; track: Mode::Track, its whole count in the front
 #                      end's column)
+#   --detectors N      frame k on detector k mod N: a Pipeline of N threads'
+#                      frames, each counted alone (docs/arm.md, "Four cores")
+#   --bands N          the front end in N row bands on N threads, counted band
+#                      by band (one at a time): the latency on N cores, in
+#                      threads.md in --out (arm_threads_report.py)
+#   --pipeline N       the list through a Pipeline of N threads (0: a bare
+#                      Detector), each thread's count: what the pipeline adds,
+#                      in threads.md in --out
+#                      (--bands and --pipeline run qemu on one host core, where
+#                      frappe's threads never spin: the counts stay exact)
 #   --out DIR          where the results go (default: BUILD/arm-count)
 #   --build DIR        cross build dir (default in the checkout: build-armel,
 #                      build-arm64-count, build-arm64-count-scalar)
 #   --setup            install missing host packages with apt-get (root) instead of stopping
 #   --jobs N           ninja -j (default 2)
-# env: FRAPPE_ARM_CACHE  where the sysroot, the plugin, the qemu header and the
-#                        arm64 libpng/libjpeg/zlib archives live
+# env: FRAPPE_ARM_CACHE  where the sysroot, the plugin and the qemu header live
 #                        (default ${XDG_CACHE_HOME:-$HOME/.cache}/frappe-arm)
 #      SYSROOT           an existing armel sysroot to reuse (e.g. /tmp/sysroot-armel
 #                        from the team's make-sysroot.sh; it needs libopencv_aruco
@@ -45,7 +54,7 @@ set -euo pipefail
 SRC=$(cd "$(dirname "$0")/.." && pwd)
 HERE=$SRC/scripts/arm
 LIST="" IMAGES="" DICT=aruco_mip_36h12 MAX=0 OPENCV=1 BUILD="" SETUP=0 JOBS=2 REGION="" OUT="" MODE=normal
-ARCH=armv6 SCALAR=0
+ARCH=armv6 SCALAR=0 DETECTORS=1 BANDS=0 PIPELINE=-1
 while [ $# -gt 0 ]; do
 	case "$1" in
 	--arch) ARCH=$2; shift 2;;
@@ -57,6 +66,9 @@ while [ $# -gt 0 ]; do
 	--no-opencv) OPENCV=0; shift;;
 	--region-contrast) REGION=$2; shift 2;;
 	--mode) MODE=$2; shift 2;;
+	--detectors) DETECTORS=$2; shift 2;;
+	--bands) BANDS=$2; shift 2;;
+	--pipeline) PIPELINE=$2; shift 2;;
 	--out) OUT=$2; shift 2;;
 	--build) BUILD=$2; shift 2;;
 	--setup) SETUP=1; shift;;
@@ -118,6 +130,9 @@ if [ "$ARCH" = aarch64 ]; then
 	# the loader and C++ runtime qemu-aarch64 -L / runs the driver with
 	[ -f /usr/lib/$TRIPLET/libstdc++.so.6 ] || need_pkgs="$need_pkgs libstdc++6:arm64"
 	[ "$SCALAR" = 1 ] || [ -f /usr/lib/$TRIPLET/pkgconfig/libhwy.pc ] || need_pkgs="$need_pkgs libhwy-dev:arm64"
+	[ -f /usr/lib/$TRIPLET/libpng16.a ] || need_pkgs="$need_pkgs libpng-dev:arm64"
+	[ -f /usr/lib/$TRIPLET/libjpeg.a ] || need_pkgs="$need_pkgs libjpeg62-turbo-dev:arm64"
+	[ -f /usr/lib/$TRIPLET/libz.a ] || need_pkgs="$need_pkgs zlib1g-dev:arm64"
 else
 	command -v $TRIPLET-g++ >/dev/null || need_pkgs="$need_pkgs crossbuild-essential-armel"
 fi
@@ -148,7 +163,7 @@ if ! ldd "$(command -v "${QEMU[0]}")" >/dev/null 2>&1; then
 	die "$(command -v "${QEMU[0]}") is a static build, which cannot load TCG plugins: install qemu-user (not only qemu-user-static)" 3
 fi
 
-# ---- the armel sysroot, or arm64 libpng/libjpeg/zlib ----------------------------
+# ---- the armel sysroot -------------------------------------------------------
 if [ "$ARCH" = armv6 ]; then
 if [ ! -f "$SYSROOT/usr/lib/$TRIPLET/libstdc++.so.6" ]; then
 	[ -e "$SYSROOT" ] && [ -n "$(ls -A "$SYSROOT" 2>/dev/null)" ] &&
@@ -167,23 +182,9 @@ if [ "$OPENCV" = 1 ] && [ ! -e "$SYSLIB/libopencv_aruco.so" ]; then
 	die "the sysroot $SYSROOT has no libopencv_aruco.so (scripts/arm/make-sysroot-count.sh adds it); or pass --no-opencv" 3
 fi
 else
-	# The driver's image decoding, linked statically from the arm64 -dev
-	# packages unpacked into the cache: installing them by multiarch pulls
-	# libc6-dev:arm64 and upgrades a dozen host packages to matching versions.
-	# The system's are used when installed.
-	ADEV=$CACHE/arm64-dev
-	if [ -f /usr/lib/$TRIPLET/libpng16.a ] && [ -f /usr/lib/$TRIPLET/libjpeg.a ] && [ -f /usr/lib/$TRIPLET/libz.a ]; then
-		ADEV=""
-	elif [ ! -f "$ADEV/usr/lib/$TRIPLET/libjpeg.a" ] || [ ! -f "$ADEV/usr/lib/$TRIPLET/libpng16.a" ] ||
-	     [ ! -f "$ADEV/usr/lib/$TRIPLET/libz.a" ]; then
-		step "libpng/libjpeg/zlib arm64 archives -> $ADEV (apt-get download)"
-		rm -rf "$ADEV.debs" && mkdir -p "$ADEV.debs" && chmod 777 "$ADEV.debs" # apt's _apt user writes there
-		( cd "$ADEV.debs" && apt-get download -q libpng-dev:arm64 libjpeg62-turbo-dev:arm64 zlib1g-dev:arm64 &&
-		  for d in ./*.deb; do dpkg-deb -x "$d" "$ADEV"; done ) >"$CACHE/arm64-dev.log" 2>&1 ||
-			die "could not get the arm64 libpng/libjpeg/zlib packages (log: $CACHE/arm64-dev.log); or install libpng-dev:arm64 libjpeg62-turbo-dev:arm64" 3
-		rm -rf "$ADEV.debs"
-	fi
-	SYSLIB=${ADEV:-}/usr/lib/$TRIPLET
+	# the driver's image decoding: Debian's arm64 -dev packages (multiarch),
+	# their archives linked statically
+	SYSLIB=/usr/lib/$TRIPLET
 fi
 
 # ---- the counting plugin (needs qemu-plugin.h from Debian's qemu source) ------
@@ -260,8 +261,9 @@ if [ "$ARCH" = armv6 ]; then
 	LIBS+=(-L"$SYSLIB" -lpng16 -ljpeg -lz -Wl,-rpath-link,"$SYSLIB" -Wl,-rpath-link,"$SYSROOT/lib/$TRIPLET")
 else
 	# the archives by path: -L/usr/lib/$TRIPLET could also put the multiarch
-	# libc before the cross toolchain's
-	[ -n "$ADEV" ] && CXXFLAGS+=(-isystem "$ADEV/usr/include" -isystem "$ADEV/usr/include/$TRIPLET")
+	# libc before the cross toolchain's; their headers are the host's
+	# (/usr/include, and jconfig.h in /usr/include/$TRIPLET)
+	CXXFLAGS+=(-idirafter /usr/include -idirafter "/usr/include/$TRIPLET")
 	[ "$SCALAR" = 1 ] || LIBS+=(/usr/lib/$TRIPLET/libhwy.so)
 	LIBS+=("$SYSLIB/libpng16.a" "$SYSLIB/libjpeg.a" "$SYSLIB/libz.a" -lm)
 fi
@@ -288,11 +290,26 @@ args=(--list "$LIST" --dictionary "$DICT" --max "$MAX" --out-frappe "$OUT/frappe
 [ "$OPENCV" = 1 ] && args+=(--out-opencv "$OUT/opencv.jsonl") || args+=(--no-opencv)
 [ -n "$REGION" ] && args+=(--region-contrast "$REGION")
 args+=(--mode "$MODE")
+PLUGARGS="$PLUGIN,out=$OUT/count.log,marks=$OUT/marks.txt" PIN=()
+[ "$DETECTORS" -gt 1 ] && args+=(--detectors "$DETECTORS")
+[ "$BANDS" -gt 0 ] && args+=(--bands "$BANDS")
+[ "$PIPELINE" -ge 0 ] && args+=(--pipeline "$PIPELINE") && PLUGARGS="$PLUGARGS,vcpus=1"
+# one host core: std::thread::hardware_concurrency() is then 1 in the guest,
+# and frappe's workers sleep instead of polling (src/base/worker.cpp)
+[ "$BANDS" -gt 0 ] || [ "$PIPELINE" -ge 0 ] && PIN=(taskset -c 0)
 # relative paths in the list are relative to the current directory (the contract)
-( "${QEMU[@]}" -d plugin -plugin "$PLUGIN,out=$OUT/count.log,marks=$OUT/marks.txt" \
+( "${PIN[@]}" "${QEMU[@]}" -d plugin -plugin "$PLUGARGS" \
 	"$OUT/frappe-count" "${args[@]}" > "$OUT/driver.txt" 2> "$OUT/qemu.log" ) ||
 	{ tail -20 "$OUT/qemu.log" >&2; die "the counting run failed (log: $OUT/qemu.log)" 5; }
 
+if [ "$BANDS" -gt 0 ] || [ "$PIPELINE" -ge 0 ]; then
+	step "report (threads)"
+	python3 "$HERE/arm_threads_report.py" --log "$OUT/count.log" --map "$OUT/frappe-count.map" \
+		--syms "$OUT/frappe-count.syms" --driver "$OUT/driver.txt" --md "$OUT/threads.md" \
+		--csv "$OUT/threads.csv"
+	step "done: $OUT/threads.md"
+	exit 0
+fi
 step "report"
 python3 "$HERE/arm_count_report.py" --log "$OUT/count.log" --map "$OUT/frappe-count.map" \
 	--syms "$OUT/frappe-count.syms" --driver "$OUT/driver.txt" --md "$OUT/report.md" \

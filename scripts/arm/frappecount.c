@@ -31,12 +31,17 @@
  * function name after the prefix. At exit:
  *    N <bucket> <entry address hex> <mangled name>
  * Counters are inline and not atomic: exact for single-threaded guests.
+ * vcpus=1 also counts each guest thread (a vCPU under qemu-user) apart, by
+ * a callback per translation block into that thread's own slot: exact with
+ * threads, at some speed; after each M line (and at exit) one line per
+ * thread seen so far, its count since the start:
+ *    V <vcpu index> <insns>
  *
  * Compiled against QEMU's qemu-plugin.h and loaded into QEMU:
  * SPDX-License-Identifier: GPL-2.0-or-later
  *
  * Use: qemu-arm -cpu arm1176 -L SYSROOT -d plugin \
- *          -plugin ./libfrappecount.so,out=FILE[,marks=FILE] ./prog args
+ *          -plugin ./libfrappecount.so,out=FILE[,marks=FILE][,vcpus=1] ./prog args
  *      qemu-aarch64 -cpu cortex-a53 -L / -d plugin -plugin ... ./prog args
  */
 #include <inttypes.h>
@@ -84,6 +89,16 @@ static uint64_t mem_acc, mem_snap;
 static uint32_t cur_caller;          /* bucket of the last executed BL/BLX */
 static FILE *out;
 static bool a64;                     /* qemu-aarch64 */
+
+/* vcpus=1: instructions per guest thread, each slot written by its own
+ * vCPU's thread only */
+#define MAX_VCPUS 64
+static bool per_vcpu;
+static struct {
+	uint64_t insns;
+	char pad[56]; /* one cache line each */
+} vcpu_insns[MAX_VCPUS];
+static unsigned int vcpus_seen;
 
 /* marks=FILE: the markers' entry addresses from the symbol table */
 #define MAX_MARKS 64
@@ -233,6 +248,17 @@ static void on_lib_tb(unsigned int vcpu, void *ud)
     buckets[cur_caller].lib += (uint64_t)(uintptr_t)ud;
 }
 
+static void on_tb_vcpu(unsigned int vcpu, void *ud)
+{
+	/* qemu-user numbers threads as they start; one that ends leaves its slot */
+	if (vcpu < MAX_VCPUS) {
+		vcpu_insns[vcpu].insns += (uint64_t)(uintptr_t)ud;
+		if (vcpu >= vcpus_seen) {
+			vcpus_seen = vcpu + 1; /* racy but only grows; read at exit */
+		}
+	}
+}
+
 static void write_mark(const char *label)
 {
     uint64_t total = 0;
@@ -246,6 +272,9 @@ static void write_mark(const char *label)
     }
     fprintf(out, " %" PRIu64 "\n", mem_acc - mem_snap);
     mem_snap = mem_acc;
+    for (unsigned int v = 0; per_vcpu && v < vcpus_seen; v++) {
+	    fprintf(out, "V %u %" PRIu64 "\n", v, vcpu_insns[v].insns);
+    }
     for (uint32_t k = 0; k < n_buckets; k++) {
         Bucket *b = &buckets[k];
         if (b->self != b->snap_self || b->lib != b->snap_lib) {
@@ -357,6 +386,9 @@ static void tb_trans(qemu_plugin_id_t id, struct qemu_plugin_tb *tb)
                                                    (void *)(s + strlen(MARK_PREFIX)));
         }
     }
+    if (per_vcpu) {
+	    qemu_plugin_register_vcpu_tb_exec_cb(tb, on_tb_vcpu, QEMU_PLUGIN_CB_NO_REGS, (void *)(uintptr_t)n);
+    }
     if (lib_insns) {
         qemu_plugin_register_vcpu_tb_exec_cb(tb, on_lib_tb, QEMU_PLUGIN_CB_NO_REGS,
                                              (void *)(uintptr_t)lib_insns);
@@ -401,14 +433,16 @@ QEMU_PLUGIN_EXPORT int qemu_plugin_install(qemu_plugin_id_t id, const qemu_info_
                 fprintf(stderr, "frappecount: cannot write %s\n", argv[k] + 4);
                 return -1;
             }
-        } else if (strncmp(argv[k], "marks=", 6) == 0) {
-            if (read_marks(argv[k] + 6) != 0) {
-                return -1;
-            }
-        } else {
-            fprintf(stderr, "frappecount: unknown argument %s\n", argv[k]);
-            return -1;
-        }
+	} else if (strcmp(argv[k], "vcpus=1") == 0) {
+		per_vcpu = true;
+	} else if (strncmp(argv[k], "marks=", 6) == 0) {
+		if (read_marks(argv[k] + 6) != 0) {
+			return -1;
+		}
+	} else {
+		fprintf(stderr, "frappecount: unknown argument %s\n", argv[k]);
+		return -1;
+	}
     }
     a64 = strcmp(info->target_name, "aarch64") == 0;
     if (!a64 && strcmp(info->target_name, "arm") != 0) {

@@ -12,6 +12,7 @@
 //   frappe-count --list LIST.txt [--dictionary aruco_mip_36h12] [--max N]
 //                [--no-opencv] [--out-frappe F.jsonl] [--out-opencv O.jsonl]
 //                [--region-contrast C] [--mode normal|ascale|track]
+//                [--detectors N | --bands N | --pipeline N]
 //
 // --region-contrast sets Config::region_contrast (0 turns the region map and
 // its candidates off), to measure what that path costs. --mode ascale runs
@@ -28,6 +29,21 @@
 // (libjpeg), converted to grey if needed. Prints one line per image on
 // stdout: "image <index> <width> <height> <frappe markers> <opencv markers> <path>".
 // Natively (without the plugin) the markers do nothing.
+//
+// Threads (issue 35 item 4), each a model of a four-core board:
+// --detectors N runs frame k on detector k mod N, as a Pipeline of N threads
+// does in a steady stream (each detector's AScale or Track state then comes
+// from every N-th frame); the counts stay per frame, single-threaded.
+// --bands N cuts the front end into N row bands on N threads (Config::threads)
+// whose band kernel is wrapped in armcount_mark_band_begin/_end and run one
+// band at a time (a lock), so each band's count is exact: a frame's latency
+// on N cores is the front end's serial rest plus its largest band plus the
+// back end. Run it on one host core (taskset), so that the worker threads
+// never spin (frappe spins only with more than one core).
+// --pipeline N pushes the whole list through a Pipeline of N threads
+// (Overlap::Frames) between armcount_mark_pipeline_begin/_end; 0 runs the same
+// loop on a bare Detector: with the plugin's vcpus=1 each thread's count,
+// and the difference is what the pipeline adds.
 #include <algorithm>
 #include <array>
 #include <cstdio>
@@ -36,6 +52,8 @@
 #include <csetjmp>
 #include <fstream>
 #include <iostream>
+#include <memory>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -44,6 +62,7 @@
 
 #include "frappe/frappe.h"
 #include "detector_stages.h" /* frappe-core/src: internal */
+#include "front_end_rows.h"  /* frappe-core/src: internal (the band kernels) */
 
 #ifdef FRAPPE_COUNT_OPENCV
 #include <opencv2/core/utility.hpp>
@@ -68,6 +87,10 @@ FRAPPE_COUNT_MARK(frappe_front, 3)
 FRAPPE_COUNT_MARK(frappe_back, 4)
 FRAPPE_COUNT_MARK(opencv_begin, 5)
 FRAPPE_COUNT_MARK(opencv_end, 6)
+FRAPPE_COUNT_MARK(band_begin, 7)
+FRAPPE_COUNT_MARK(band_end, 8)
+FRAPPE_COUNT_MARK(pipeline_begin, 9)
+FRAPPE_COUNT_MARK(pipeline_end, 10)
 
 namespace {
 
@@ -166,6 +189,20 @@ void writeLine(std::ofstream &out, const std::string &image, const std::vector<i
 	out << "], \"time_ms\": 0}\n";
 }
 
+/* --bands: one band at a time, so that the plugin's shared counters see
+ * only that band between its markers. */
+std::mutex bandLock;
+
+void countedBand(const frappe::detail::BandJob &job)
+{
+	std::lock_guard<std::mutex> guard(bandLock);
+	armcount_mark_band_begin();
+	frappe::detail::bestBandKernels().band(job);
+	armcount_mark_band_end();
+}
+
+const frappe::detail::BandKernels countedBandKernels{ "counted", countedBand };
+
 } // namespace
 
 int main(int argc, char **argv)
@@ -175,6 +212,7 @@ int main(int argc, char **argv)
 	bool useOpencv = true;
 	float regionContrast = -1.0f; /* < 0: the Config default */
 	std::string mode = "normal";
+	int detectors = 1, bands = 0, pipelineThreads = -1;
 	for (int i = 1; i < argc; ++i) {
 		const std::string a = argv[i];
 		auto value = [&]() -> std::string {
@@ -198,11 +236,19 @@ int main(int argc, char **argv)
 			outO = value();
 		else if (a == "--mode")
 			mode = value();
+		else if (a == "--detectors")
+			detectors = std::stoi(value());
+		else if (a == "--bands")
+			bands = std::stoi(value());
+		else if (a == "--pipeline")
+			pipelineThreads = std::stoi(value());
 		else if (a == "--region-contrast")
 			regionContrast = std::stof(value());
 		else {
 			std::cerr << "usage: frappe-count --list L [--dictionary D] [--max N] [--no-opencv] "
-				     "[--out-frappe F] [--out-opencv O] [--region-contrast C] [--mode normal|ascale|track]\n";
+				     "[--out-frappe F] [--out-opencv O] [--region-contrast C] [--mode "
+				     "normal|ascale|track] "
+				     "[--detectors N | --bands N | --pipeline N]\n";
 			return 2;
 		}
 	}
@@ -256,7 +302,63 @@ int main(int argc, char **argv)
 	}
 	if (regionContrast >= 0.0f)
 		cfg.region_contrast = regionContrast;
-	frappe::Detector det(cfg);
+	if (detectors < 1 || detectors > 64 || bands < 0 || bands > 64 || pipelineThreads > 64 ||
+	    (detectors > 1) + (bands > 0) + (pipelineThreads >= 0) > 1 ||
+	    (bands > 0 && cfg.mode == frappe::Mode::Track)) {
+		std::cerr << "frappe-count: one of --detectors N, --bands N, --pipeline N (N <= 64); "
+			     "--bands not in track mode (its front end runs over rectangles)\n";
+		return 2;
+	}
+	if (pipelineThreads >= 0) {
+		/* No per-frame markers: the threads overlap. Results are only counted
+		 * in the loop, so that the caller's work is the pipeline's. */
+		cfg.threads = std::max(1, pipelineThreads);
+		std::unique_ptr<frappe::Pipeline> pipe;
+		std::unique_ptr<frappe::Detector> bare;
+		if (pipelineThreads > 0)
+			pipe = std::make_unique<frappe::Pipeline>(cfg, frappe::Pipeline::Overlap::Frames);
+		else
+			bare = std::make_unique<frappe::Detector>(cfg);
+		auto pushAll = [&](std::size_t n, std::vector<int> *found) {
+			auto take = [&](const frappe::Result *r) {
+				if (r && found)
+					found->push_back(static_cast<int>(r->markers.size()));
+			};
+			for (std::size_t k = 0; k < n; ++k) {
+				const Gray &g = images[k];
+				const frappe::ImageView view(g.pixels.data(), g.width, g.height);
+				take(pipe ? pipe->push(view) : &bare->detect(view));
+			}
+			while (pipe && pipe->pending())
+				take(pipe->flush());
+		};
+		/* warm-up: every detector sees frames (sizes, tables), then forgets them */
+		pushAll(std::min<std::size_t>(images.size(), 4 * static_cast<std::size_t>(cfg.threads)), nullptr);
+		if (pipe)
+			pipe->reset();
+		else
+			bare->reset();
+		armcount_mark_warmup();
+		std::vector<int> found;
+		found.reserve(images.size());
+		armcount_mark_pipeline_begin();
+		pushAll(images.size(), &found);
+		armcount_mark_pipeline_end();
+		for (std::size_t k = 0; k < images.size(); ++k)
+			std::printf("image %zu %d %d %d -1 %s\n", k, images[k].width, images[k].height,
+				    k < found.size() ? found[k] : -1, paths[k].c_str());
+		std::fflush(stdout);
+		return 0;
+	}
+	if (bands > 0)
+		cfg.threads = bands;
+	std::vector<std::unique_ptr<frappe::Detector>> dets;
+	for (int i = 0; i < detectors; ++i) {
+		dets.push_back(std::make_unique<frappe::Detector>(cfg));
+		if (bands > 0)
+			dets.back()->setFrontEnd(frappe::detail::makeCpuFrontEnd(bands, countedBandKernels));
+	}
+	frappe::Detector &det = *dets[0];
 	std::ofstream fo, oo;
 	if (!outF.empty())
 		fo.open(outF);
@@ -276,7 +378,8 @@ int main(int argc, char **argv)
 	 * frame of a size, dictionaries and lazy tables are built. */
 	{
 		const Gray &g = images[0];
-		det.detect(frappe::ImageView(g.pixels.data(), g.width, g.height));
+		for (auto &d : dets)
+			d->detect(frappe::ImageView(g.pixels.data(), g.width, g.height));
 #ifdef FRAPPE_COUNT_OPENCV
 		if (useOpencv) {
 			cv::Mat m(g.height, g.width, CV_8UC1, const_cast<std::uint8_t *>(g.pixels.data()));
@@ -284,21 +387,23 @@ int main(int argc, char **argv)
 		}
 #endif
 		armcount_mark_warmup();
-		det.reset(); /* the video starts at its first frame */
+		for (auto &d : dets)
+			d->reset(); /* the video starts at its first frame */
 	}
 
 	for (std::size_t k = 0; k < images.size(); ++k) {
 		const Gray &g = images[k];
 		const frappe::ImageView view(g.pixels.data(), g.width, g.height);
+		frappe::Detector &dk = *dets[k % dets.size()];
 		armcount_mark_frappe_begin();
 		const frappe::Result *r = nullptr;
 		if (cfg.mode == frappe::Mode::Track) {
-			r = &det.detect(view);
+			r = &dk.detect(view);
 			armcount_mark_frappe_front();
 		} else {
-			frappe::detail::DetectorStages::frontEnd(det, view, 0);
+			frappe::detail::DetectorStages::frontEnd(dk, view, 0);
 			armcount_mark_frappe_front();
-			r = &frappe::detail::DetectorStages::backEnd(det, view, 0);
+			r = &frappe::detail::DetectorStages::backEnd(dk, view, 0);
 		}
 		armcount_mark_frappe_back();
 		const frappe::Result &res = *r;
