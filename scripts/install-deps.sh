@@ -41,9 +41,9 @@ packages=(
 	qemu-user crossbuild-essential-armel crossbuild-essential-arm64
 	libgtest-dev:armel libgmock-dev:armel
 	libhwy-dev:arm64 libgtest-dev:arm64 libgmock-dev:arm64
-	# the image decoding of the aarch64 instruction count's driver
-	# (scripts/arm-count.sh --arch aarch64), linked statically
-	libpng-dev:arm64 libjpeg62-turbo-dev:arm64 zlib1g-dev:arm64
+	# (scripts/arm-count.sh --arch aarch64 --setup adds its image decoding,
+	# libpng, libjpeg and zlib for arm64: not needed to build or test, and
+	# installing them moves the host's copies to the same version)
 )
 
 if [ "$(id -u)" -ne 0 ]; then
