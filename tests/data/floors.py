@@ -74,12 +74,14 @@ EXPOSURE_POINTS = {0.3: 3, 0.15: 10, 2.0: 3}
 # more are found as often as at 1x): the 14/32 and 14/28 points are that
 # ceiling (docs/quality.md, "Low exposure by contrast"; the light floor from
 # the frame's noise took back 2 and 1 points at 15%).
-# synth/images and apriltag_16h5 meet the 3 points at 200% since clipped
-# candidates are no longer skipped as clutter (docs/quality.md, issue 29).
+# apriltag_16h5 meets the 3 points at 200% since clipped candidates are no
+# longer skipped as clutter (docs/quality.md, issue 29); synth/images and
+# lighting missed them by 0.05 and 0.2 points once the noise floor raised
+# their 1x (0.9415 -> 0.9428, 0.8898 -> 0.8938; 200% unchanged).
 EXPOSURE_ENFORCED = {
     ('synth/blur', 2.0): 6, ('synth/blur-apriltag36h11', 2.0): 7, ('synth/4x4_50', 2.0): 5,
-    ('synth/6x6_250', 2.0): 5,
-    ('synth/lighting', 0.15): 32, ('synth/lighting', 0.3): 14, ('synth/lighting', 2.0): 5,
+    ('synth/6x6_250', 2.0): 5, ('synth/images', 2.0): 4,
+    ('synth/lighting', 0.15): 32, ('synth/lighting', 0.3): 14, ('synth/lighting', 2.0): 6,
     ('synth/lighting-apriltag36h11', 0.15): 28, ('synth/lighting-apriltag36h11', 0.3): 14,
     ('synth/lighting-apriltag36h11', 2.0): 8,
 }
