@@ -79,6 +79,7 @@ class Detector:
         track_cover_frames: int = 4,
         region_contrast: float = 0.16,
         light_floor: float = 0.063,
+        light_floor_noise: float = 5.3,
         corner_cluster_radius: float = 4.0,
         min_marker_side: float = 10.0,
         max_pixels: int = 67108864,

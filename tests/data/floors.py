@@ -71,20 +71,24 @@ EXPOSURE_POINTS = {0.3: 3, 0.15: 10, 2.0: 3}
 # brightened again (glare brightened twice clips the black ink itself).
 # Darkened, the lighting subsets lose what falls below 10 grey levels of
 # contrast (at 15%: 259 of lighting's 499 markers; their markers of 10 or
-# more are found as often as at 1x): the 14/34 and 14/29 points are that
-# ceiling (docs/quality.md, "Low exposure by contrast").
-# synth/images and apriltag_16h5 meet the 3 points at 200% since clipped
-# candidates are no longer skipped as clutter (docs/quality.md, issue 29).
+# more are found as often as at 1x): the 14/32 and 14/28 points are that
+# ceiling (docs/quality.md, "Low exposure by contrast"; the light floor from
+# the frame's noise took back 2 and 1 points at 15%).
+# apriltag_16h5 meets the 3 points at 200% since clipped candidates are no
+# longer skipped as clutter (docs/quality.md, issue 29); synth/images and
+# lighting missed them by 0.05 and 0.2 points once the noise floor raised
+# their 1x (0.9415 -> 0.9428, 0.8898 -> 0.8938; 200% unchanged).
 EXPOSURE_ENFORCED = {
     ('synth/blur', 2.0): 6, ('synth/blur-apriltag36h11', 2.0): 7, ('synth/4x4_50', 2.0): 5,
-    ('synth/6x6_250', 2.0): 5,
-    ('synth/lighting', 0.15): 34, ('synth/lighting', 0.3): 14, ('synth/lighting', 2.0): 5,
-    ('synth/lighting-apriltag36h11', 0.15): 29, ('synth/lighting-apriltag36h11', 0.3): 14,
+    ('synth/6x6_250', 2.0): 5, ('synth/images', 2.0): 4,
+    ('synth/lighting', 0.15): 32, ('synth/lighting', 0.3): 14, ('synth/lighting', 2.0): 6,
+    ('synth/lighting-apriltag36h11', 0.15): 28, ('synth/lighting-apriltag36h11', 0.3): 14,
     ('synth/lighting-apriltag36h11', 2.0): 8,
 }
-# False positives allowed where the target of none is not met yet: a 15 px
-# marker of synth/images read as another id at 30% (hamming 5, margin 0.03).
-EXPOSURE_FP_ENFORCED = {('synth/images', 0.3): 1, ('synth/lighting', 2.0): 1}
+# False positives allowed where the target of none is not met yet. (The 15 px
+# marker of synth/images read as another id at 30% is no longer read since the
+# light floor follows the frame's noise.)
+EXPOSURE_FP_ENFORCED = {('synth/lighting', 2.0): 1}
 
 # Photographs: every marker of the folders with source ground truth found
 # (detector-labelled folders are incomplete: not counted), and in every folder

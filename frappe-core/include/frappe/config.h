@@ -117,8 +117,21 @@ struct Config {
 	/// light (the exact rule: front_end_cpu.cpp). The floor keeps sensor
 	/// noise in the darkest pixels from making edges: lower finds markers
 	/// in darker scenes at the price of more clutter traced there; 0.5 or
-	/// more keeps every threshold absolute (the paper's). Range [0, 1].
+	/// more keeps every threshold absolute (the paper's). With
+	/// light_floor_noise it is the ceiling: a frame's floor lies between
+	/// half of it and it. Range [0, 1].
 	float light_floor = 0.063f;
+
+	/// The light floor from the frame's own noise: each frame's noise
+	/// deviation is estimated (a median of the Laplacian over a sparse
+	/// sample; the rule: front_end/noise_floor.h) and its floor is this
+	/// many times that deviation, between light_floor / 2 and light_floor.
+	/// The default, 5.3, gives today's 16 grey levels at a noise of 3 and 8
+	/// at a quiet sensor's 1.5, finding markers of 7-10 grey levels of
+	/// contrast in dark frames; higher keeps the floor nearer light_floor
+	/// (fewer edges traced in noisy dark areas), 0 fixes it at light_floor.
+	/// Range [0, 100].
+	float light_floor_noise = 5.3f;
 
 	/// Corner pixels closer than this (pixels, at the traced resolution)
 	/// belong to one corner cluster.

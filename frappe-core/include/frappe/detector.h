@@ -129,6 +129,8 @@ public:
 	/// else the built-in named by Config::dictionary.
 	const Dictionary &dictionary() const;
 	int maxHamming() const;
+	/// The front end's parameters as configured; a frame's light floor
+	/// lies between half of this one and it (Config::light_floor_noise).
 	FrontEndParams frontEndParams() const;
 
 private:

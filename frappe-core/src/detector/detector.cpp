@@ -15,6 +15,7 @@
 
 #include "detector_impl.h"
 #include "front_end_rows.h"
+#include "noise_floor.h"
 #include "quad_geometry.h"
 
 namespace frappe {
@@ -195,6 +196,7 @@ Detector::Detector(const Config &config) : impl_(std::make_unique<Impl>())
 		impl_->params.region_contrast = std::max(1, impl_->params.region_contrast);
 	impl_->params.light_floor = std::min(FrontEndParams::kLightReference,
 					     static_cast<int>(std::lround(config.light_floor * 255.0f)));
+	impl_->noiseMultiplier = detail::noiseFloorMultiplier(config.light_floor_noise);
 	/* The second look corrects only what a clear read may: on the log
 	 * scale the weak cells of clutter and of other families' codes are
 	 * many, and they made wrong ids. */
@@ -259,6 +261,13 @@ void DetectorStages::frontEnd(Detector &detector, const ImageView &image, int sl
 		scale = 1.0f;
 	s.image = image;
 	timer.lap(Stage::FrontEnd);
+	/* The light floor from the frame's own noise (noise_floor.h): a quiet
+	 * sensor's dark frame keeps edges of 7-10 grey levels, a noisy one's
+	 * noise stays under the configured floor. */
+	s.params = d.params;
+	if (d.noiseMultiplier > 0 && d.params.light_floor < FrontEndParams::kLightReference)
+		s.params.light_floor =
+			detail::noiseLightFloor(detail::noiseMedian(image), d.noiseMultiplier, d.params.light_floor);
 	/* Track: the CPU front end over the regions the tracks predict and a
 	 * band of the rest, or the whole frame. */
 	bool regions = d.tracker && d.tracker->plan(image, std::string_view(d.frontEnd->name()) == "cpu");
@@ -284,7 +293,7 @@ void DetectorStages::frontEnd(Detector &detector, const ImageView &image, int sl
 	s.result.whole_frame = !regions;
 	s.result.bytes_read = static_cast<std::size_t>(image.width) * image.height;
 	if (regions) {
-		d.tracker->runRegions(image, d.params, s.edges);
+		d.tracker->runRegions(image, s.params, s.edges);
 		/* The markers read at their predictions need no trace. */
 		detail::clearInsideMarkers(s.edges, s.known, 1.5f);
 		s.result.bytes_read = d.tracker->bytesRead();
@@ -294,14 +303,14 @@ void DetectorStages::frontEnd(Detector &detector, const ImageView &image, int sl
 	}
 	if (d.tracker)
 		d.tracker->ranWhole();
-	d.frontEnd->run(image, scale, d.params, s.edges);
+	d.frontEnd->run(image, scale, s.params, s.edges);
 	if (!d.frontEnd->makesRegionMap()) {
 		/* A front end without a region map (one of the caller's): the
 		 * CPU's, from the full-resolution frame (the edge map's scale
 		 * is taken into account when its quads are mapped); empty when
 		 * region_contrast is 0. */
-		detail::regionMap(image, 1.0f, d.params, s.edges.regions, s.edges.shades, d.regionScratch);
-	} else if (d.params.makesShades() && !d.frontEnd->makesShadeMap()) {
+		detail::regionMap(image, 1.0f, s.params, s.edges.regions, s.edges.shades, d.regionScratch);
+	} else if (s.params.makesShades() && !d.frontEnd->makesShadeMap()) {
 		/* A front end with a region map but no shade map (the QPUs'
 		 * today): the CPU's, from the frame the front end traced (its
 		 * region map made again, unused), so the markers are the CPU
@@ -312,7 +321,7 @@ void DetectorStages::frontEnd(Detector &detector, const ImageView &image, int sl
 			detail::scaleNearest(image, s.edges.width, s.edges.height, d.shadeFrame.data());
 			traced = ImageView(d.shadeFrame.data(), s.edges.width, s.edges.height, s.edges.width);
 		}
-		detail::regionMap(traced, s.edges.scale, d.params, d.shadeRegions, s.edges.shades, d.regionScratch);
+		detail::regionMap(traced, s.edges.scale, s.params, d.shadeRegions, s.edges.shades, d.regionScratch);
 	}
 	s.result.scale = s.edges.scale;
 	s.result.copy_bytes = d.frontEnd->lastCopyBytes();

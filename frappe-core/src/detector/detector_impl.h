@@ -43,7 +43,10 @@ struct FRAPPE_HIDDEN Detector::Impl {
 	 * whites clip (none when light_floor keeps thresholds absolute). */
 	detail::DecodePolicy clipPolicy;
 	std::array<float, 256> clipTable;
+	/* The configured front end's parameters; each frame's light floor
+	 * follows its noise (Slot::params) when noiseMultiplier > 0. */
 	FrontEndParams params;
+	int noiseMultiplier = 0; /* detail::noiseFloorMultiplier(config.light_floor_noise) */
 	std::unique_ptr<FrontEnd> frontEnd;
 	std::unique_ptr<CandidateWarper> warper; /* nullptr: warp on the CPU, one by one */
 	/* Read by the front end, written by the back end: in pipelined use
@@ -58,6 +61,9 @@ struct FRAPPE_HIDDEN Detector::Impl {
 	/* One frame in flight: its edges, its candidates, its result. */
 	struct Slot {
 		ImageView image; /* the frame, valid until its back end returns */
+		/* params with the frame's light floor: what its maps were made
+		 * with and its region candidates are judged by. */
+		FrontEndParams params;
 		EdgeMap edges;
 		std::vector<detail::Quad> quads;
 		/* Mode::Track: the markers read at their tracks' predictions
@@ -81,19 +87,19 @@ struct FRAPPE_HIDDEN Detector::Impl {
 	TraceMap shadeRegions;
 	/* The read stage's own state (halved frames, the warp batch, the
 	 * marker grids), reading through the settings above. */
-	detail::CandidateReader reader{ config, dict, codes, policy, logPolicy, clipPolicy, params, warper };
+	detail::CandidateReader reader{ config, dict, codes, policy, logPolicy, clipPolicy, warper };
 
 	void checkImage(const ImageView &image) const;
 	void trace(Slot &slot);
 	/* Mode::Track's reads at the predictions, in the front end's stage:
 	 * state of their own, as the finish of another frame may run at
 	 * once (Pipeline's Overlap::Stages); per prediction whether it read. */
-	detail::CandidateReader trackReader{ config, dict, codes, policy, logPolicy, clipPolicy, params, warper };
+	detail::CandidateReader trackReader{ config, dict, codes, policy, logPolicy, clipPolicy, warper };
 	std::vector<std::uint8_t> readAtPrediction;
 
 	void finish(const ImageView &image, Slot &slot)
 	{
-		reader.read(image, slot.edges, slot.quads, slot.result, slot.known);
+		reader.read(image, slot.edges, slot.params, slot.quads, slot.result, slot.known);
 	}
 	Slot &slotAt(int slot) { return const_cast<Slot &>(static_cast<const Impl *>(this)->slotAt(slot)); }
 	const Slot &slotAt(int slot) const

@@ -35,7 +35,7 @@ constexpr std::size_t memberCount()
 /* A new Config member needs its entry below (or a word here on why no
  * surface can show it, as custom_dictionary, a shared object). */
 constexpr std::size_t kFieldsWithoutSetting = 1;
-constexpr std::size_t kSettingCount = 16;
+constexpr std::size_t kSettingCount = 17;
 static_assert(memberCount<Config>() == kSettingCount + kFieldsWithoutSetting,
 	      "a Config field was added or removed: describe it in settings.cpp's table (frappe/settings.h)");
 
@@ -92,7 +92,11 @@ std::vector<Setting> makeTable()
 		  kEverywhere },
 		{ "light_floor", &C::light_floor, 0.0, 1.0, false, "L",
 		  "below mid-grey the thresholds follow the local brightness plus this; 0.5 or more: absolute "
-		  "(the paper's)",
+		  "(the paper's); the ceiling of the floor from the frame's noise",
+		  kEverywhere },
+		{ "light_floor_noise", &C::light_floor_noise, 0.0, 100.0, false, "K",
+		  "each frame's light floor is K times its noise deviation, between light_floor / 2 and "
+		  "light_floor; 0: light_floor",
 		  kEverywhere },
 		{ "corner_cluster_radius", &C::corner_cluster_radius, 1.0, 32.0, false, "PX",
 		  "corner pixels closer than this (traced resolution) are one corner", kEverywhere },

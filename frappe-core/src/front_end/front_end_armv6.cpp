@@ -416,11 +416,11 @@ void fillLightTable(LightTable &tab, const FrontEndParams &params)
 	tab.floor = params.light_floor;
 }
 
-/* A table is made once for each params a process uses (a detector has
- * one), then read without a lock: a per-row table would cost more than
+/* A table is made once for each params a process uses (a detector's
+ * floor takes the values from half its light_floor to it), then read without a lock: a per-row table would cost more than
  * the row's edge pass saves, thread_local a __tls_get_addr call a row in
  * a shared library. Beyond kLightTables a row makes its own in `own`. */
-constexpr int kLightTables = 8;
+constexpr int kLightTables = 16; /* a detector's floors follow its frames' noise: up to 9 */
 LightTable gLightTables[kLightTables];
 std::atomic<int> gLightTablesMade{ 0 };
 std::mutex gLightTablesLock;

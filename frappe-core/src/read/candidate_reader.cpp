@@ -167,8 +167,9 @@ void detail::CandidateReader::warpBatch(const ImageView &image, int side)
 /* Candidates not worth refining: the outline of a decoded marker's quiet
  * zone, and clutter as the probe's read at the traced outline shows it. */
 bool detail::CandidateReader::skipCandidate(const detail::Quad &q, const std::array<Point2f, 4> &tracedOutline,
-					    const std::vector<Marker> &found) const
+					    const Slot &slot) const
 {
+	const std::vector<Marker> &found = slot.result.markers;
 	const int bits = dict->bits;
 	const int traced = q.probeRead;
 	const float area = quadArea(tracedOutline);
@@ -201,9 +202,10 @@ bool detail::CandidateReader::skipCandidate(const detail::Quad &q, const std::ar
 	const int mixedFrame = 2 * detail::allowedBorderErrors(bits);
 	const bool mixed = traced > mixedFrame && traced < whiteFrame() && !clips;
 	if (q.fromRegion)
-		return mixed || q.probeContrast < static_cast<float>(params.relativeRegionContrast(
-					       static_cast<int>(std::lround(q.probeLevel - 0.5f * q.probeContrast)),
-					       static_cast<int>(std::lround(q.probeLevel + 0.5f * q.probeContrast))));
+		return mixed ||
+		       q.probeContrast < static_cast<float>(slot.params.relativeRegionContrast(
+						 static_cast<int>(std::lround(q.probeLevel - 0.5f * q.probeContrast)),
+						 static_cast<int>(std::lround(q.probeLevel + 0.5f * q.probeContrast))));
 	return mixed && sidesAtLeast(tracedOutline, 4.0f * static_cast<float>(bits + 2));
 }
 
@@ -370,7 +372,7 @@ bool detail::CandidateReader::readCandidate(const ImageView &image, Slot &slot, 
 		return readLayoutCandidate(image, slot, k, search, timer, m);
 	detail::Quad &q = slot.quads[k];
 	const std::array<Point2f, 4> tracedOutline = warper ? batch.outlines[k] : q.corners;
-	if (skipCandidate(q, tracedOutline, slot.result.markers))
+	if (skipCandidate(q, tracedOutline, slot))
 		return false;
 	Reading r = placeCandidate(image, q, tracedOutline);
 	/* With at least the frame's search on a halved frame: blur spreads a
@@ -475,7 +477,9 @@ bool detail::CandidateReader::readTracked(const ImageView &image, const EdgeMap 
 	detail::Quad &q = trackQuads[0];
 	q.corners = predicted;
 	trackResult.candidates = 0;
-	Slot slot{ edges, trackQuads, trackResult };
+	/* No clutter test here (skipCandidate()): no front end's parameters. */
+	static const FrontEndParams kUnused{};
+	Slot slot{ edges, kUnused, trackQuads, trackResult };
 	StageTimer timer(trackResult.times, Stage::Refine);
 	Reading r = placeCandidate(image, q, predicted);
 	r.inBatch = false;

@@ -55,22 +55,23 @@ public:
 	 * (Detector::setWarper()). */
 	CandidateReader(const Config &config, const Dictionary *const &dict, const std::unique_ptr<CodeBook> &codes,
 			const DecodePolicy &policy, const DecodePolicy &logPolicy, const DecodePolicy &clipPolicy,
-			const FrontEndParams &params, const std::unique_ptr<CandidateWarper> &warper)
+			const std::unique_ptr<CandidateWarper> &warper)
 		: config(config), dict(dict), codes(codes), policy(policy), logPolicy(logPolicy),
-		  clipPolicy(clipPolicy), params(params), warper(warper)
+		  clipPolicy(clipPolicy), warper(warper)
 	{}
 	CandidateReader(const CandidateReader &) = delete;
 	CandidateReader &operator=(const CandidateReader &) = delete;
 
 	/* Reads the candidates `quads` (traced at edges.scale; moved to full
-	 * resolution and refined in place) of `image` into result.markers,
+	 * resolution and refined in place; `params`: what the front end made
+	 * edges with, this frame's light floor) of `image` into result.markers,
 	 * result.candidates and the read stages' times. */
 	/* `known`: markers read before the trace (readTracked()), kept first;
 	 * the candidates that would only read as them again are skipped. */
-	void read(const ImageView &image, const EdgeMap &edges, std::vector<Quad> &quads, Result &result,
-		  std::span<const Marker> known = {})
+	void read(const ImageView &image, const EdgeMap &edges, const FrontEndParams &params, std::vector<Quad> &quads,
+		  Result &result, std::span<const Marker> known = {})
 	{
-		Slot slot{ edges, quads, result, known };
+		Slot slot{ edges, params, quads, result, known };
 		finish(image, slot);
 	}
 
@@ -87,6 +88,7 @@ private:
 	/* What finish() reads of the detector's frame. */
 	struct Slot {
 		const EdgeMap &edges;
+		const FrontEndParams &params;
 		std::vector<Quad> &quads;
 		Result &result;
 		std::span<const Marker> known = {};
@@ -101,7 +103,6 @@ private:
 	/* policy on the exponential scale, the last read of a candidate whose
 	 * whites clip (linear: none). */
 	const DecodePolicy &clipPolicy;
-	const FrontEndParams &params;
 	const std::unique_ptr<CandidateWarper> &warper; /* nullptr: warp on the CPU, one by one */
 
 	PointGrid markerGrid;    /* dropNestedMarkers()'s */
@@ -167,8 +168,7 @@ private:
 	bool readCandidate(const ImageView &image, Slot &slot, std::size_t k, float search, StageTimer &timer,
 			   Marker &m);
 	MarkerRead readRefined(Reading &r, Quad &q, std::size_t k, StageTimer &timer, Result &result);
-	bool skipCandidate(const Quad &q, const std::array<Point2f, 4> &tracedOutline,
-			   const std::vector<Marker> &found) const;
+	bool skipCandidate(const Quad &q, const std::array<Point2f, 4> &tracedOutline, const Slot &slot) const;
 	Reading placeCandidate(const ImageView &image, Quad &q, const std::array<Point2f, 4> &tracedOutline);
 	void sampleRefined(Reading &r, const Quad &q, std::size_t k, const DecodePolicy &pol, StageTimer &timer);
 	void readInset(Reading &r, Quad &q, const DecodePolicy &pol, StageTimer &timer);
