@@ -313,11 +313,16 @@ bool EdgeRow(const GradRows &rows, int w, const FrontEndParams &params, std::uin
 			prev = hn::IfThenElse(notHorizontal, prev, ml);
 			next = hn::IfThenElse(notHorizontal, next, mr);
 			const auto edge = hn::And(hn::And(strong, hn::Lt(prev, m)), hn::Not(hn::Lt(m, next)));
-			any |= !hn::AllFalse(d32, edge);
+			/* A strong vector with no edge left after the suppression
+			 * (about one in seven on synth/images) skips the corner
+			 * test: some 60 instructions of its ~130. */
+			if (hn::AllFalse(d32, edge)) {
+				hn::StoreU(bytes, d8, out + x);
+				return;
+			}
+			any = true;
 			/* Shi-Tomasi in isCorner's int32 form, summed here from the
-			 * pairs, for every vector with a strong pixel: a branch on
-			 * edge mispredicts on textured frames more often than the
-			 * test costs. Sxx + Syy is the sum of the nine magnitudes. */
+			 * pairs. Sxx + Syy is the sum of the nine magnitudes. */
 			const auto s = hn::Add(hn::Add(hn::Add(hn::Add(ul, um), hn::Add(ur, dl)),
 						       hn::Add(hn::Add(dm, dr), hn::Add(ml, mr))), m);
 			/* The 3x3 sums as column sums over the three rows,
