@@ -207,6 +207,12 @@ void GradientRow(const std::uint8_t *a, const std::uint8_t *b, const std::uint8_
 			24, 56, 25, 57, 26, 58, 27, 59, 28, 60, 29, 61, 30, 62, 31, 63 };
 		store(x, hn::Vec<decltype(d32)>{ _mm512_permutex2var_epi16(sx.raw, _mm512_load_si512(kLo), sy.raw) });
 		store(x + N / 2, hn::Vec<decltype(d32)>{ _mm512_permutex2var_epi16(sx.raw, _mm512_load_si512(kHi), sy.raw) });
+#elif HWY_ARCH_X86 && HWY_TARGET == HWY_AVX2
+		/* Interleave within 128-bit blocks, after putting the 64-bit
+		 * chunks in the order 0, 2, 1, 3: four instructions, not ten. */
+		const __m256i px = _mm256_permute4x64_epi64(sx.raw, 0xD8), py = _mm256_permute4x64_epi64(sy.raw, 0xD8);
+		store(x, hn::Vec<decltype(d32)>{ _mm256_unpacklo_epi16(px, py) });
+		store(x + N / 2, hn::Vec<decltype(d32)>{ _mm256_unpackhi_epi16(px, py) });
 #else
 		/* Widen each half into pairs: gx zero-extended, gy in the top. */
 		auto widen = [&](hn::Vec<decltype(d16h)> vx, hn::Vec<decltype(d16h)> vy) {
