@@ -273,12 +273,21 @@ bool EdgeRow(const GradRows &rows, int w, const FrontEndParams &params, std::uin
 	 * 2 gx gy (xy2). Pairs of variables, not a struct: SVE's sizeless
 	 * vectors cannot be members. */
 	using V32 = hn::Vec<decltype(d32)>;
+#if HWY_ARCH_X86 && HWY_TARGET == HWY_AVX2
+	const __m256i swapHalves = _mm256_setr_epi8(2, 3, 0, 1, 6, 7, 4, 5, 10, 11, 8, 9, 14, 15, 12, 13, 2, 3, 0, 1, 6,
+						    7, 4, 5, 10, 11, 8, 9, 14, 15, 12, 13);
+#endif
 	auto columnSums = [&](int x, V32 &xx, V32 &xy2) FRAPPE_INLINE_LAMBDA {
 		xx = zero;
 		xy2 = zero;
 		for (int r = 0; r < 3; ++r) {
 			const auto t = pairs(r, x);
+#if HWY_ARCH_X86 && HWY_TARGET == HWY_AVX2
+			/* (gy, gx): one byte shuffle; AVX2's 32-bit rotate is three. */
+			const auto swapped = hn::Vec<decltype(d16)>{ _mm256_shuffle_epi8(t.raw, swapHalves) };
+#else
 			const auto swapped = hn::BitCast(d16, hn::RotateRight<16>(hn::BitCast(du32, t)));
+#endif
 			xx = hn::Add(xx, PairDot(d32, t, hn::And(t, lowHalf)));
 			xy2 = hn::Add(xy2, PairDot(d32, t, swapped));
 		}
