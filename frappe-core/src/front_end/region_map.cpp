@@ -96,6 +96,46 @@ bool DarkRow(const std::uint8_t *d, const std::uint8_t *mid, int w, std::uint8_t
 	return found;
 }
 
+/* tileThresholdsScalar on whole vectors of tiles, one int32 lane a tile:
+ * the lane's four bytes are the tile's four columns of mid. Returns how
+ * many tiles it did; the float root is the scalar one's (IEEE, exact below
+ * 2^24), its integer corrections too. */
+int TileThresholds(const std::uint8_t *tmin, const std::uint8_t *tmax, int tx, int contrast, int lightFloor,
+		   bool shaded, std::uint8_t *mid, std::uint8_t *shadeMid)
+{
+	const hn::ScalableTag<std::int32_t> d;
+	const hn::RebindToUnsigned<decltype(d)> du;
+	const hn::Rebind<float, decltype(d)> df;
+	const hn::Rebind<std::uint8_t, decltype(d)> d8;
+	const int N = static_cast<int>(hn::Lanes(d));
+	const auto floor2 = hn::Set(d, 2 * lightFloor), cap = hn::Set(d, 2 * FrontEndParams::kLightReference);
+	const auto c = hn::Set(d, contrast), round = hn::Set(d, 255), one = hn::Set(d, 1);
+	const auto four = hn::Set(d, FrontEndParams::kShadeFloor), zero = hn::Zero(d);
+	const auto bytes = hn::Set(du, 0x01010101u);
+	auto replicate = [&](hn::Vec<decltype(d)> v) HWY_ATTR { return hn::Mul(hn::BitCast(du, v), bytes); };
+	int i = 0;
+	for (; i + N <= tx; i += N) {
+		const auto lo = hn::PromoteTo(d, hn::LoadU(d8, tmin + i));
+		const auto hi = hn::PromoteTo(d, hn::LoadU(d8, tmax + i));
+		const auto sum = hn::Add(lo, hi);
+		const auto need = hn::ShiftRight<8>(hn::Add(hn::Mul(c, hn::Min(hn::Add(sum, floor2), cap)), round));
+		const auto pass = hn::Not(hn::Lt(hn::Sub(hi, lo), need));
+		const auto m = hn::IfThenElseZero(pass, hn::ShiftRight<1>(hn::Add(sum, one)));
+		hn::StoreU(replicate(m), du, reinterpret_cast<std::uint32_t *>(mid + 4 * i));
+		if (!shaded)
+			continue;
+		const auto p = hn::Mul(hn::Add(lo, four), hn::Add(hi, four));
+		auto r = hn::ConvertTo(d, hn::Sqrt(hn::ConvertTo(df, p)));
+		r = hn::Add(r, hn::VecFromMask(d, hn::Lt(p, hn::Mul(r, r)))); /* s -= s^2 > p */
+		const auto r1 = hn::Add(r, one);
+		r = hn::Sub(r, hn::VecFromMask(d, hn::Not(hn::Lt(p, hn::Mul(r1, r1))))); /* s += (s+1)^2 <= p */
+		r = hn::Sub(r, hn::VecFromMask(d, hn::Lt(hn::Mul(r, r), p)));            /* the least root */
+		const auto g = hn::IfThenElseZero(hn::Not(hn::Eq(m, zero)), hn::Sub(r, four));
+		hn::StoreU(replicate(g), du, reinterpret_cast<std::uint32_t *>(shadeMid + 4 * i));
+	}
+	return i;
+}
+
 /* spreadTilesScalar's two passes with whole vectors of tiles. */
 void SpreadTiles(std::uint8_t *tileMin, std::uint8_t *tileMax, int tx, int ty, std::uint8_t *work)
 {
@@ -181,6 +221,25 @@ void spreadTilesScalar(std::uint8_t *tileMin, std::uint8_t *tileMax, int tx, int
 	spreadTilesWith(tileMin, tileMax, tx, ty, work, none, none);
 }
 
+void tileThresholdsScalar(const std::uint8_t *tmin, const std::uint8_t *tmax, int tx, const FrontEndParams &params,
+			  bool shaded, std::uint8_t *mid, std::uint8_t *shadeMid)
+{
+	for (int i = 0; i < tx; ++i) {
+		const int lo = tmin[i], hi = tmax[i];
+		const std::uint32_t m = hi - lo >= params.relativeRegionContrast(lo, hi)
+						? static_cast<std::uint32_t>((lo + hi + 1) >> 1)
+						: 0u;
+		const std::uint32_t word = m * 0x01010101u;
+		std::memcpy(mid + i * kRegionTile, &word, 4);
+		if (shaded) {
+			const std::uint32_t g =
+				m ? static_cast<std::uint32_t>(FrontEndParams::shadeThreshold(lo, hi)) : 0u;
+			const std::uint32_t gword = g * 0x01010101u;
+			std::memcpy(shadeMid + i * kRegionTile, &gword, 4);
+		}
+	}
+}
+
 bool darkRowTilesScalar(const std::uint8_t *d, const std::uint8_t *mid, int w, std::uint8_t *out,
 			std::uint8_t *tiles)
 {
@@ -197,6 +256,16 @@ HWY_EXPORT(DecimateRow);
 HWY_EXPORT(DarkRow);
 HWY_EXPORT(MinPairs);
 HWY_EXPORT(MaxPairs);
+HWY_EXPORT(TileThresholds);
+
+void tileThresholds(const std::uint8_t *tmin, const std::uint8_t *tmax, int tx, const FrontEndParams &params,
+		    bool shaded, std::uint8_t *mid, std::uint8_t *shadeMid)
+{
+	const int done = HWY_DYNAMIC_DISPATCH(TileThresholds)(tmin, tmax, tx, params.region_contrast,
+							      params.light_floor, shaded, mid, shadeMid);
+	tileThresholdsScalar(tmin + done, tmax + done, tx - done, params, shaded, mid + kRegionTile * done,
+			     shaded ? shadeMid + kRegionTile * done : shadeMid);
+}
 
 void extremePairs(const std::uint8_t *a0, const std::uint8_t *a1, int w, std::uint8_t *out, bool least)
 {
@@ -221,6 +290,12 @@ bool darkRow(const std::uint8_t *d, const std::uint8_t *mid, int w, std::uint8_t
 	return HWY_DYNAMIC_DISPATCH(DarkRow)(d, mid, w, out);
 }
 #else
+void tileThresholds(const std::uint8_t *tmin, const std::uint8_t *tmax, int tx, const FrontEndParams &params,
+		    bool shaded, std::uint8_t *mid, std::uint8_t *shadeMid)
+{
+	tileThresholdsScalar(tmin, tmax, tx, params, shaded, mid, shadeMid);
+}
+
 void decimateRow(const std::uint8_t *r0, const std::uint8_t *r1, int w, std::uint8_t *out)
 {
 #ifdef FRAPPE_HAVE_ARMV6_REGION
@@ -363,10 +438,24 @@ void regionMapFromMeans(int width, int height, float srcScale, const FrontEndPar
 	/* Each tile row's tile mask from the OR of its dark rows. */
 	auto markTileRow = [&](TraceMap &map, std::uint8_t *rowOr, int y) {
 		std::uint8_t *tileRow = map.tiles.data() + static_cast<std::size_t>(y / ET) * map.tiles_x;
+		static_assert(ET == 16);
 		for (int t = 0; t < map.tiles_x; ++t) {
+			const int x0 = t * ET, x1 = std::min(w, x0 + ET);
 			std::uint8_t any = 0;
-			for (int x = t * ET; x < std::min(w, (t + 1) * ET); ++x)
-				any |= rowOr[x];
+			if (x1 - x0 == ET) {
+				/* A whole tile's bytes ORed as two words, folded. */
+				std::uint64_t a, b;
+				std::memcpy(&a, rowOr + x0, 8);
+				std::memcpy(&b, rowOr + x0 + 8, 8);
+				a |= b;
+				a |= a >> 32;
+				a |= a >> 16;
+				a |= a >> 8;
+				any = static_cast<std::uint8_t>(a);
+			} else {
+				for (int x = x0; x < x1; ++x)
+					any |= rowOr[x];
+			}
 			tileRow[t] = any;
 		}
 		std::fill_n(rowOr, w, 0);
@@ -378,19 +467,7 @@ void regionMapFromMeans(int width, int height, float srcScale, const FrontEndPar
 		 * they are too close. */
 		const std::uint8_t *tmin = s.tileMin.data() + static_cast<std::size_t>(j) * tx;
 		const std::uint8_t *tmax = s.tileMax.data() + static_cast<std::size_t>(j) * tx;
-		for (int i = 0; i < tx; ++i) {
-			const int lo = tmin[i], hi = tmax[i];
-			const std::uint32_t m = hi - lo >= params.relativeRegionContrast(lo, hi)
-							? static_cast<std::uint32_t>((lo + hi + 1) >> 1)
-							: 0u;
-			const std::uint32_t word = m * 0x01010101u;
-			std::memcpy(mid + i * T, &word, 4); /* mid has room for whole tiles */
-			if (shaded) {
-				const std::uint32_t g = m ? static_cast<std::uint32_t>(FrontEndParams::shadeThreshold(lo, hi)) : 0u;
-				const std::uint32_t gword = g * 0x01010101u;
-				std::memcpy(shadeMid + i * T, &gword, 4);
-			}
-		}
+		tileThresholds(tmin, tmax, tx, params, shaded, mid, shadeMid); /* mid has room for whole tiles */
 		mid[0] = mid[w - 1] = 0; /* the outermost columns are never dark */
 		if (shaded)
 			shadeMid[0] = shadeMid[w - 1] = 0;

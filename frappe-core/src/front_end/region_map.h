@@ -60,10 +60,19 @@ void extremePairs(const std::uint8_t *a0, const std::uint8_t *a1, int w, std::ui
 /// out[x] = kEdge if d[x] < mid[x], else 0, for x in [0, w); whether any is.
 bool darkRow(const std::uint8_t *d, const std::uint8_t *mid, int w, std::uint8_t *out);
 
+/// The thresholds of a row of tx tiles from their (spread) extremes, one
+/// byte per column of the tile (kRegionTile bytes a tile): mid, the
+/// midpoint (lo + hi + 1) >> 1 where hi - lo >= relativeRegionContrast(lo,
+/// hi), else 0; when shaded, shadeMid: shadeThreshold(lo, hi) where mid is
+/// not 0, else 0.
+void tileThresholds(const std::uint8_t *tmin, const std::uint8_t *tmax, int tx, const FrontEndParams &params,
+		    bool shaded, std::uint8_t *mid, std::uint8_t *shadeMid);
 /// The same without SIMD, the references the vector forms are tested against.
 void decimateRowScalar(const std::uint8_t *r0, const std::uint8_t *r1, int w, std::uint8_t *out);
 void extremePairsScalar(const std::uint8_t *a0, const std::uint8_t *a1, int w, std::uint8_t *out, bool least);
 bool darkRowScalar(const std::uint8_t *d, const std::uint8_t *mid, int w, std::uint8_t *out);
+void tileThresholdsScalar(const std::uint8_t *tmin, const std::uint8_t *tmax, int tx, const FrontEndParams &params,
+			  bool shaded, std::uint8_t *mid, std::uint8_t *shadeMid);
 
 /// One row of tiles in one pass, the form the ARMv6 kernels take: tmin[i]
 /// and tmax[i] = the least and greatest of columns [4i, min(4i + 4, w)) of

@@ -106,6 +106,37 @@ TEST(RegionMap, RowKernelsMatchTheirScalarReferences)
 			EXPECT_EQ(mx, mx2) << target << " spread max " << tx << "x" << ty;
 		}
 #endif
+		/* The tiles' thresholds: every pair of extremes (hi below lo
+		 * too), in rows of every length, at each light floor. */
+		for (int lightFloor : { 0, 16, 100, FrontEndParams::kLightReference })
+			for (int contrast : { 1, 41, 255 })
+				for (int tx : { 1, 7, 16, 17, 80, 256 }) {
+					FrontEndParams params;
+					params.region_contrast = contrast;
+					params.light_floor = lightFloor;
+					for (int start = 0; start < 65536; start += tx < 16 ? 61 * tx : tx) {
+						const int n = std::min(tx, 65536 - start);
+						std::vector<std::uint8_t> lo(n), hi(n);
+						for (int i = 0; i < n; ++i) {
+							lo[i] = static_cast<std::uint8_t>((start + i) >> 8);
+							hi[i] = static_cast<std::uint8_t>(start + i);
+						}
+						std::vector<std::uint8_t> mid(4 * n + 1, 0xAA), mid2 = mid, shade = mid,
+												shade2 = mid;
+						detail::tileThresholds(lo.data(), hi.data(), n, params, true,
+								       mid.data(), shade.data());
+						detail::tileThresholdsScalar(lo.data(), hi.data(), n, params, true,
+									     mid2.data(), shade2.data());
+						ASSERT_EQ(mid, mid2) << target << " tile midpoints from " << start;
+						ASSERT_EQ(shade, shade2)
+							<< target << " shade thresholds from " << start;
+						std::vector<std::uint8_t> alone(4 * n + 1, 0xAA);
+						detail::tileThresholds(lo.data(), hi.data(), n, params, false,
+								       alone.data(), nullptr);
+						ASSERT_EQ(alone, mid2)
+							<< target << " midpoints without shades from " << start;
+					}
+				}
 	});
 }
 
