@@ -27,13 +27,15 @@ int noiseMedian(const ImageView &image)
 			const int nw = a[x - 1], nn = a[x], ne = a[x + 1];
 			const int ww = b[x - 1], cc = b[x], ee = b[x + 1];
 			const int sw = c[x - 1], ss = c[x], se = c[x + 1];
-			const int lo = std::min({ nw, nn, ne, ww, cc, ee, sw, ss, se });
-			const int hi = std::max({ nw, nn, ne, ww, cc, ee, sw, ss, se });
-			if (lo == 0 || hi == 255)
-				continue;
+			/* A 0 or a 255 in the window: (v + 1) & 255 <= 1 for one of
+			 * them, one chain of minima and no branch. */
+			auto up = [](int v) { return (v + 1) & 255; };
+			const int lo =
+				std::min({ up(nw), up(nn), up(ne), up(ww), up(cc), up(ee), up(sw), up(ss), up(se) });
+			const int clear = lo > 1;
 			const int l = 4 * cc - 2 * (nn + ss + ww + ee) + (nw + ne + sw + se);
-			++hist[static_cast<std::size_t>(std::min(std::abs(l), kNoiseCap))];
-			++n;
+			hist[static_cast<std::size_t>(std::min(std::abs(l), kNoiseCap))] += clear;
+			n += clear;
 		}
 	}
 	if (n < kNoiseMinSamples)
