@@ -7,7 +7,11 @@
 //                [--out-apriltag PREFIX] [--threads N] [--no-extras]
 //
 // Prints median and p90 milliseconds per frame for each detector, their
-// ratio, and each stage's share of frappe's time. OpenCV gets the same
+// ratio, and each stage's share of frappe's time. When the light floor
+// leaves the lighting path on (issue 29), frappe runs a second time with
+// it off (light_floor 0.5: the paper's absolute thresholds, no shade map,
+// no second read on the log scale), interleaved, and the path's share of a
+// frame is printed. OpenCV gets the same
 // dictionary as a custom Dictionary, at most 5 corrected bits (capped by
 // the dictionary's safe maximum), and no corner refinement, as in
 // ../shared/design/DETECTOR-CONTRACT.md (the team's folder beside the
@@ -377,6 +381,11 @@ int main(int argc, char **argv)
 	cfg.region_contrast = regionContrast;
 	cfg.light_floor = lightFloor;
 	frappe::Detector frappeDet(cfg);
+	/* The same detector without the lighting path, when it is on. */
+	frappe::Config absoluteCfg = cfg;
+	absoluteCfg.light_floor = 0.5f;
+	const bool withAbsolute = frappeDet.frontEndParams().light_floor < frappe::FrontEndParams::kLightReference;
+	frappe::Detector absoluteDet(absoluteCfg);
 	const auto cvDict = opencvDictionary(*dict, std::min(5, frappeDet.maxHamming()));
 	auto params = cv::aruco::DetectorParameters::create();
 	params->cornerRefinementMethod = cv::aruco::CORNER_REFINE_NONE;
@@ -398,7 +407,7 @@ int main(int argc, char **argv)
 		a1o.open(outA + "-d1.jsonl");
 		a2o.open(outA + "-d2.jsonl");
 	}
-	std::vector<double> tF, tO, tA1, tA2;
+	std::vector<double> tF, tO, tA1, tA2, tAbs;
 	std::vector<int> atIds;
 	std::vector<std::array<frappe::Point2f, 4>> atCorners;
 	std::array<double, frappe::kStageCount> stageSum{};
@@ -408,7 +417,7 @@ int main(int argc, char **argv)
 	for (std::size_t k = 0; k < images.size(); ++k) {
 		const cv::Mat &g = images[k];
 		const frappe::ImageView view(g.data, g.cols, g.rows, static_cast<int>(g.step[0]));
-		std::vector<double> a, b, c1, c2;
+		std::vector<double> a, b, c1, c2, abs;
 		for (int r = 0; r < repeat; ++r) {
 			/* Interleaved: each repetition runs both, so drift hits both. */
 			auto t0 = Clock::now();
@@ -418,6 +427,11 @@ int main(int argc, char **argv)
 			auto t2 = Clock::now();
 			a.push_back(ms(t0, t1));
 			b.push_back(ms(t1, t2));
+			if (withAbsolute) {
+				const auto t3 = Clock::now();
+				absoluteDet.detect(view);
+				abs.push_back(ms(t3, Clock::now()));
+			}
 #ifdef FRAPPE_BENCH_APRILTAG
 			if (withAprilTag) {
 				const auto t3 = Clock::now();
@@ -453,6 +467,8 @@ int main(int argc, char **argv)
 		}
 		tF.push_back(percentile(a, 0.5));
 		tO.push_back(percentile(b, 0.5));
+		if (withAbsolute)
+			tAbs.push_back(percentile(abs, 0.5));
 		if (withAprilTag) {
 			tA1.push_back(percentile(c1, 0.5));
 			tA2.push_back(percentile(c2, 0.5));
@@ -464,12 +480,26 @@ int main(int argc, char **argv)
 		    dictName.c_str(), repeat, threads, CV_VERSION);
 	std::printf("%-22s %10s %10s\n", "detector", "median ms", "p90 ms");
 	std::printf("%-22s %10.3f %10.3f\n", "frappe", mf, percentile(tF, 0.9));
+	if (withAbsolute)
+		std::printf("%-22s %10.3f %10.3f\n", "frappe, light floor 0.5", percentile(tAbs, 0.5),
+			    percentile(tAbs, 0.9));
 	std::printf("%-22s %10.3f %10.3f\n", "opencv aruco", mo, percentile(tO, 0.9));
 	if (withAprilTag) {
 		std::printf("%-22s %10.3f %10.3f\n", "apriltag 3.3 decimate 1", percentile(tA1, 0.5), percentile(tA1, 0.9));
 		std::printf("%-22s %10.3f %10.3f\n", "apriltag 3.3 decimate 2", percentile(tA2, 0.5), percentile(tA2, 0.9));
 	}
 	std::printf("speed ratio (opencv / frappe, medians): %.2fx\n", mo / mf);
+	if (withAbsolute) {
+		/* Per frame, then the median: the path's cost where it is paid. */
+		std::vector<double> share(tF.size());
+		for (std::size_t k = 0; k < tF.size(); ++k)
+			share[k] = 1.0 - tAbs[k] / std::max(1e-9, tF[k]);
+		std::printf(
+			"lighting path's share of a frame at defaults (1 - light floor 0.5 / defaults): median "
+			"%.1f%%, of the medians %.1f%%; opencv / frappe at light floor 0.5: %.2fx\n",
+			100.0 * percentile(share, 0.5), 100.0 * (1.0 - percentile(tAbs, 0.5) / mf),
+			mo / percentile(tAbs, 0.5));
+	}
 	if (withAprilTag)
 		std::printf("speed ratio (apriltag decimate 2 / frappe, medians): %.2fx; decimate 1: %.2fx\n",
 			    percentile(tA2, 0.5) / mf, percentile(tA1, 0.5) / mf);
