@@ -179,7 +179,14 @@ std::vector<Placed> renderScene(Image &img, const Dictionary &dict, int count, s
 		/* The whole layout and its quiet zone fit its slot. */
 		const float side = std::min(side0 * (0.8f + 0.4f * u(rng)), 0.8f * std::min(cw, ch) * squareCells / sizeCells);
 		const float cx = cw * (static_cast<float>(k % cols) + 0.5f), cy = ch * (static_cast<float>(k / cols) + 0.5f);
-		const auto q = squarePose(cx + u(rng) - 0.5f, cy + u(rng) - 0.5f, side, 360.0f * u(rng), 50.0f * u(rng));
+		/* One draw a statement, in the order x86 has drawn them: a call's
+		 * arguments are evaluated in an unspecified order (GCC for ARM
+		 * draws them in another, rendering other scenes). */
+		const float tilt = 50.0f * u(rng);
+		const float roll = 360.0f * u(rng);
+		const float dy = u(rng);
+		const float dx = u(rng);
+		const auto q = squarePose(cx + dx - 0.5f, cy + dy - 0.5f, side, roll, tilt);
 		/* Ids differ within a scene (tagCircle21h7 has 38). */
 		int id = 0;
 		do
