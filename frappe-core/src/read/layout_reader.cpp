@@ -189,8 +189,13 @@ LayoutCells readLayoutCells(const WarpedMarker &sampled, const MarkerLayout &l, 
 				continue;
 			}
 			if (bit < 0) {
-				++out.plainCells;
-				out.plainLight += v > thr;
+				/* A plain cell counts only where it reads clearly: at
+				 * cells of 2 px blur mixes a circle's corner cells with
+				 * their neighbours (4 light, 16 dark on one exact read). */
+				if (std::abs(v - thr) / half >= weakMargin) {
+					++out.plainCells;
+					out.plainLight += v > thr;
+				}
 				continue;
 			}
 			value[static_cast<std::size_t>(bit)] = v > thr;
@@ -221,7 +226,8 @@ MarkerRead decodeLayout(const LayoutCells &cells, const CodeBook &codes, const D
 	}
 	/* A circle family's corners carry nothing, but they are one colour
 	 * (drawn black, or the paper around a printed circle); another
-	 * layout's bits there are a mixture. (A tagStandard41h12 marker read
+	 * layout's bits there are a mixture. (Only the cells read clearly
+	 * count: blur mixes small corner cells with their neighbours.) (A tagStandard41h12 marker read
 	 * as a tagCircle21h7 code, exactly, on 1 in 360 rendered markers.) */
 	if (8 * std::min(cells.plainLight, cells.plainCells - cells.plainLight) > cells.plainCells) {
 		read.rejection = Rejection::BorderNotBlack;

@@ -37,7 +37,8 @@ struct LayoutCells {
 	int ringCells = 0;       ///< cells of the two rings read (not unknown)
 	int ringUnknown = 0;     ///< cells of the two rings clipped under glare
 	/// The other cells that are no bits (always black, or of no matter:
-	/// a circle family's corners), and those of them that read light.
+	/// a circle family's corners) read clearly (margin at least the weak
+	/// margin), and those of them that read light.
 	int plainCells = 0;
 	int plainLight = 0;
 	float contrast = 0.0f;   ///< the white ring's mean less the black ring's

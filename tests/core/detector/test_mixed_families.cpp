@@ -213,8 +213,17 @@ Image clutter(int kind, float scale, std::mt19937 &rng)
 			for (float x = 10.0f; x < 460.0f; x += 22.0f * scale) {
 				const float s = 18.0f * scale;
 				fillQuad(img, turned(x + s / 2, y + s / 2, s, 3.0f), 40);
-				if (u(rng) < 0.3f)
-					fillQuad(img, turned(x + s * (0.3f + 0.4f * u(rng)), y + s * (0.3f + 0.4f * u(rng)), s * 0.08f, 30.0f), 200);
+				if (u(rng) < 0.3f) {
+					/* One draw a statement, in the order x86 has drawn them: a call's
+					 * arguments are evaluated in an unspecified order (GCC for ARM
+					 * draws them in another, rendering other scenes). */
+					const float gy = u(rng);
+					const float gx = u(rng);
+					fillQuad(img,
+						 turned(x + s * (0.3f + 0.4f * gx), y + s * (0.3f + 0.4f * gy),
+							s * 0.08f, 30.0f),
+						 200);
+				}
 			}
 		break;
 	case 3: /* checkerboards */

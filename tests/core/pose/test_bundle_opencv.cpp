@@ -127,8 +127,13 @@ TEST(BundleOpenCv, BoardPoseAgainstTruthAndEstimatePoseBoard)
 		const cv::Mat R = flip * Rr * Rt;
 		const double w = cols * size + (cols - 1) * gap, h = rows * size + (rows - 1) * gap;
 		const cv::Mat centre = R * (cv::Mat_<double>(3, 1) << w / 2, h / 2, 0.0);
-		const cv::Vec3d t(-centre.at<double>(0) + 0.1 * distance * (u(rng) - 0.5),
-				  -centre.at<double>(1) + 0.1 * distance * (u(rng) - 0.5), distance - centre.at<double>(2));
+		/* One draw a statement, in the order x86 has drawn them: a call's
+		 * arguments are evaluated in an unspecified order (GCC for ARM
+		 * draws them in another, rendering other scenes). */
+		const double dy = u(rng);
+		const double dx = u(rng);
+		const cv::Vec3d t(-centre.at<double>(0) + 0.1 * distance * (dx - 0.5),
+				  -centre.at<double>(1) + 0.1 * distance * (dy - 0.5), distance - centre.at<double>(2));
 		cv::Mat rv;
 		cv::Rodrigues(R, rv);
 		Pose truth;

@@ -389,9 +389,18 @@ TEST(Nesting, GridDropsWhatTestingEveryPairDrops)
 			/* Within (or straddling) an earlier one. */
 			const Marker &o = found[static_cast<std::size_t>(rng() % found.size())];
 			const float os = o.corners[1].x - o.corners[0].x, s = os * (0.1f + 0.5f * frac(rng));
-			m.corners = square(o.corners[0].x + (os - s) * frac(rng), o.corners[0].y + (os - s) * frac(rng), s);
+			/* One draw a statement, in the order x86 has drawn them: a call's
+			 * arguments are evaluated in an unspecified order (GCC for ARM
+			 * draws them in another, rendering other scenes). */
+			const float fy = frac(rng);
+			const float fx = frac(rng);
+			m.corners = square(o.corners[0].x + (os - s) * fx, o.corners[0].y + (os - s) * fy, s);
 		} else {
-			m.corners = test::squarePose(place(rng), place(rng), side(rng), 90.0f * frac(rng), 0.0f);
+			const float roll = 90.0f * frac(rng);
+			const float sd = side(rng);
+			const float y = place(rng);
+			const float x = place(rng);
+			m.corners = test::squarePose(x, y, sd, roll, 0.0f);
 		}
 		found.push_back(m);
 	}
@@ -427,7 +436,11 @@ TEST(Nesting, SurroundsMarkerThroughTheGridAsThroughAll)
 	centres.reset(found.size(), 32.0f);
 	for (std::size_t i = 0; i < found.size(); ++i) {
 		found[i].id = static_cast<int>(i);
-		found[i].corners = square(place(rng), place(rng), side(rng));
+		/* One draw a statement, in x86's order (see above). */
+		const float sd = side(rng);
+		const float y = place(rng);
+		const float x = place(rng);
+		found[i].corners = square(x, y, sd);
 		centres.add(static_cast<int>(i), 0, detail::quadCentre(found[i].corners));
 	}
 	const detail::PointGrid none = [] {

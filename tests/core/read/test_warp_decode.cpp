@@ -224,11 +224,27 @@ std::vector<Quad> makeQuads(int width, int height, std::mt19937 &rng)
 	std::vector<Quad> quads;
 	for (int k = 0; k < 60; ++k) {
 		const float r = std::max(w, h) * (0.05f + 0.5f * unit(rng));
-		quads.push_back(around(w * unit(rng), h * unit(rng), r)); /* anywhere, often across the border */
-		quads.push_back(around(w * (0.3f + 0.4f * unit(rng)), h * (0.3f + 0.4f * unit(rng)),
-				       std::min(w, h) * 0.25f * unit(rng))); /* mostly inside */
-		quads.push_back(around(w * unit(rng), h * unit(rng), 0.01f + unit(rng))); /* tiny */
-		quads.push_back(around(w * (4.0f * unit(rng) - 1.5f), h * (4.0f * unit(rng) - 1.5f), w * unit(rng)));
+		/* One draw a statement, in the order x86 has drawn them: a call's
+		 * arguments are evaluated in an unspecified order (GCC for ARM
+		 * draws them in another, rendering other scenes). */
+		/* anywhere, often across the border */
+		float y = unit(rng);
+		float x = unit(rng);
+		quads.push_back(around(w * x, h * y, r));
+		/* mostly inside */
+		float s = unit(rng);
+		y = unit(rng);
+		x = unit(rng);
+		quads.push_back(around(w * (0.3f + 0.4f * x), h * (0.3f + 0.4f * y), std::min(w, h) * 0.25f * s));
+		/* tiny */
+		s = unit(rng);
+		y = unit(rng);
+		x = unit(rng);
+		quads.push_back(around(w * x, h * y, 0.01f + s));
+		s = unit(rng);
+		y = unit(rng);
+		x = unit(rng);
+		quads.push_back(around(w * (4.0f * x - 1.5f), h * (4.0f * y - 1.5f), w * s));
 	}
 	const float xs = w - 2.0f, ys = h - 2.0f; /* the last corners that need no clamps */
 	quads.push_back({ Point2f{ 0, 0 }, { xs, 0 }, { xs, ys }, { 0, ys } });

@@ -535,8 +535,14 @@ TEST(PointsBox, VectorFormMatchesTheScalarOne)
 		std::mt19937 rng(41);
 		for (int n = 1; n < 80; ++n) {
 			std::vector<std::uint32_t> pts(n + kPointsPadding, 0xFFFFFFFFu);
-			for (int k = 0; k < n; ++k)
-				pts[k] = (rng() % 600) | (rng() % 400) << 16;
+			for (int k = 0; k < n; ++k) {
+				/* One draw a statement, in the order x86 has drawn
+				 * them: the operands of | are evaluated in an
+				 * unspecified order. */
+				const std::uint32_t x = rng() % 600;
+				const std::uint32_t y = rng() % 400;
+				pts[k] = x | y << 16;
+			}
 			const PointsBox a = pointsBox(pts.data(), n), b = pointsBoxScalar(pts.data(), n);
 			ASSERT_EQ(a.minX, b.minX) << target << " n " << n;
 			ASSERT_EQ(a.maxX, b.maxX) << target << " n " << n;
