@@ -145,7 +145,6 @@ void Detector::Impl::trace(Slot &slot)
 		rtp.min_clusters = 0;
 		rtp.max_winding = 2.0f;
 		rtp.holes = false;
-		rtp.prune_spurs = false; /* filled regions: no one-pixel edge lines */
 		rtp.corners = false; /* kEdge alone marks a region pixel */
 		rtp.min_side = std::max(4.0f, config.min_marker_side * regions->scale);
 		TracedMarkerProbe regionProbe(slot.image, regions->scale, *codes, maxHamming, traceDecodes);

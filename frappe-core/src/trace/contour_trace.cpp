@@ -359,13 +359,22 @@ void ContourTracer::trace(const TraceMap &edges, const TraceParams &params, std:
 		 * and spans at least min_side / sqrt(2) each way. */
 		if (static_cast<float>(steps_) < 2.8f * params.min_side)
 			return;
+		clusterCorners();
+		/* Both ways of making a quad below need two clusters. */
+		if (clusters_.size() < static_cast<std::size_t>(params.min_clusters))
+			return;
+		if (!spansAtLeast(0.7f * params.min_side, params.max_winding))
+			return;
+		/* The paper's rule first: the corner clusters; failing that, the
+		 * outline's extreme points, for a border with at least two corner
+		 * clusters (a marker whose faint corners did not all register
+		 * still has two; clutter with none is most of what reaches here). */
 		Quad quad;
-		/* Failing that, without its spurs, if what is left goes round its
-		 * box no more than once (a convex outline does; pruned clutter
-		 * still winds). */
-		if (fitQuad(params, w, h, quad) ||
-		    (params.prune_spurs && pruneSpurs(edges, params) && spansAtLeast(0.7f * params.min_side, 1.0f) &&
-		     fitQuad(params, w, h, quad))) {
+		std::array<std::size_t, 4> at;
+		if ((!tooManyClusters_ && clusters_.size() >= 4 && quadFromClusters(quad) &&
+		     acceptQuad(params, w, h, quad)) ||
+		    (clusters_.size() >= static_cast<std::size_t>(params.min_clusters) && quadFromOutline(quad, at) &&
+		     acceptQuad(params, w, h, quad, &at))) {
 			if (probe && probe->isMarker(quad)) {
 				quad.probeDecoded = true;
 				sealInside(quad, w, h);
@@ -780,70 +789,6 @@ void ContourTracer::followV6(int x0, int y0, int fromDir, const TraceMap &edges,
 	cornerCount_ = static_cast<int>(a.cout - corners_.data());
 }
 #endif
-
-/* The paper's rule first: the corner clusters; failing that, the outline's
- * extreme points, for a border with at least two corner clusters (a marker
- * whose faint corners did not all register still has two; clutter with none
- * is most of what reaches here). */
-bool ContourTracer::fitQuad(const TraceParams &params, int w, int h, Quad &quad)
-{
-	if (static_cast<float>(steps_) < 2.8f * params.min_side)
-		return false;
-	clusterCorners();
-	/* Both ways of making a quad below need two clusters. */
-	if (clusters_.size() < static_cast<std::size_t>(params.min_clusters))
-		return false;
-	if (!spansAtLeast(0.7f * params.min_side, params.max_winding))
-		return false;
-	std::array<std::size_t, 4> at;
-	return (!tooManyClusters_ && clusters_.size() >= 4 && quadFromClusters(quad) &&
-		acceptQuad(params, w, h, quad)) ||
-	       (clusters_.size() >= static_cast<std::size_t>(params.min_clusters) && quadFromOutline(quad, at) &&
-		acceptQuad(params, w, h, quad, &at));
-}
-
-/* A one-pixel line attached to a border (a shadow's edge running into a
- * marker's outline) is walked out and back: the point after the tip's
- * return repeats the one before it. Cancelling each such pair, as a stack,
- * in place, leaves the border without its spurs; then the same at the
- * ends, since the walk may start on a spur. The corner pixels are read
- * again from the edge map for the points kept. Whether anything went. */
-bool ContourTracer::pruneSpurs(const TraceMap &edges, const TraceParams &params)
-{
-	std::uint32_t *const P = points_.data();
-	const std::size_t n = static_cast<std::size_t>(steps_);
-	std::size_t m = 0;
-	for (std::size_t k = 0; k < n; ++k) {
-		const std::uint32_t p = P[k];
-		if (m >= 2 && P[m - 2] == p)
-			--m; /* back where it was two points ago: drop the tip */
-		else
-			P[m++] = p;
-	}
-	/* A closed walk: the last point returning to the second cancels the
-	 * first. */
-	std::size_t lo = 0;
-	while (m - lo >= 3 && P[m - 1] == P[lo + 1]) {
-		++lo;
-		--m;
-	}
-	if (m - lo == n || static_cast<float>(m - lo) < 2.8f * params.min_side)
-		return false;
-	if (lo > 0)
-		std::memmove(P, P + lo, (m - lo) * sizeof(std::uint32_t));
-	steps_ = static_cast<int>(m - lo);
-	int c = 0;
-	if (params.corners)
-		for (int k = 0; k < steps_; ++k) {
-			const std::uint32_t xy = P[k];
-			if (edges.pixels[static_cast<std::size_t>(xy >> 16) * static_cast<std::size_t>(stride_) +
-					 (xy & 0xFFFFu)] &
-			    EdgeMap::kCorner)
-				corners_[static_cast<std::size_t>(c++)] = xy;
-		}
-	cornerCount_ = c;
-	return true;
-}
 
 /* The paper's rule is "exactly four corner clusters". Noise adds clusters
  * part-way along a side, so with more than four the four spanning the

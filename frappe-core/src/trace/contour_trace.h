@@ -65,10 +65,6 @@ struct TraceParams {
 	/// border of a light hole in it (a marker's white cells, the quiet zone
 	/// of a marker on a dark panel) never outlines a marker's dark frame.
 	bool holes = true;
-	/// Whether a border that made no quad is tried again without its spurs
-	/// (one-pixel lines walked out and back, such as shadow edges that
-	/// run into a marker's outline).
-	bool prune_spurs = true;
 };
 
 /// Asked during the scan whether an accepted quad is a marker. Nothing else
@@ -118,11 +114,6 @@ private:
 	/// The last border's bounding box spans `span` both ways, and its
 	/// length is at most maxWinding times the perimeter of the box.
 	bool spansAtLeast(float span, float maxWinding) const;
-	/// Clusters the last border's corners and fits and checks a quad.
-	bool fitQuad(const TraceParams &params, int w, int h, Quad &quad);
-	/// Drops the last border's out-and-back excursions; false when it had
-	/// none or too little is left.
-	bool pruneSpurs(const TraceMap &edges, const TraceParams &params);
 	bool quadFromClusters(Quad &quad) const;
 	/// `at`: the indices of the four corners among the border's points.
 	bool quadFromOutline(Quad &quad, std::array<std::size_t, 4> &at) const;
