@@ -391,9 +391,10 @@ struct Sums {
 };
 
 /* Adds column U's crossing, at vc + dir * wMoment2 / (2 wMass) when wMass > 0,
- * if it lies within reachFix (16.16) of the side's vFix. */
+ * if it lies within reachFix (16.16) of the side's vFix, less `shift` px
+ * (SideOffsets', along v). */
 inline void addCrossing(Sums &s, int U, std::int32_t vFix, int vc, int wMass, int wMoment2, int dir, int vRef,
-			std::int64_t reachFix)
+			std::int64_t reachFix, float shift = 0.0f)
 {
 	if (wMass <= 0)
 		return;
@@ -403,7 +404,8 @@ inline void addCrossing(Sums &s, int U, std::int32_t vFix, int vc, int wMass, in
 				 static_cast<std::int64_t>(dir * wMoment2) * 65536;
 	if ((off < 0 ? -off : off) > m2 * reachFix)
 		return;
-	const std::int64_t q = m2 * (vc - vRef) + dir * wMoment2;
+	const std::int64_t q =
+		m2 * (vc - vRef) + dir * wMoment2 - (shift != 0.0f ? std::llround(static_cast<double>(m2) * shift) : 0);
 	s.sw += wMass;
 	s.su += static_cast<std::int64_t>(wMass) * U;
 	s.suu += static_cast<std::int64_t>(wMass) * U * U;
@@ -415,18 +417,19 @@ inline void addCrossing(Sums &s, int U, std::int32_t vFix, int vc, int wMass, in
 #if FRAPPE_HAVE_HWY
 /* Out of line: inside fitSide the sums stay in memory. */
 [[gnu::noinline]] void addColumns(Sums &s, const Columns &c, int n, const int *Us, const std::int32_t *vFixes, int dir,
-				  int vRef, std::int64_t reachFix)
+				  int vRef, std::int64_t reachFix, const float *shifts)
 {
 	for (int i = 0; i < n; ++i)
 		addCrossing(s, Us[i], vFixes[i], (vFixes[i] + 32768) >> 16, c.mass[i], c.moment2[i], dir, vRef,
-			    reachFix);
+			    reachFix, shifts ? shifts[i] : 0.0f);
 }
 #endif
 
 /* Measures one side from a to b (clockwise quad, so the marker interior is
- * on the right of a->b on screen). */
+ * on the right of a->b on screen); with `side`, its columns' crossings
+ * moved back by it (SideOffsets). */
 bool fitSide(const ImageView &img, Point2f a, Point2f b, float search, int maxPoints, const RefineWindow &win,
-	     RefineKernels kernels, Line &line)
+	     RefineKernels kernels, Line &line, const float *side = nullptr)
 {
 	const int kRun = win.run;
 	const float dx = b.x - a.x, dy = b.y - a.y;
@@ -478,6 +481,17 @@ bool fitSide(const ImageView &img, Point2f a, Point2f b, float search, int maxPo
 	/* Columns spread evenly, in 16.16 steps (one division per side). */
 	const std::int32_t stepFix = (count << 16) / nPoints;
 	std::int32_t accFix = stepFix >> 1;
+	/* Each column's shift from `side`, by its fraction along a->b: along
+	 * v, an inward normal offset is 1 / cosV as long, `dir` signed. */
+	float shifts[kFinePoints];
+	if (side) {
+		for (int i = 0; i < nPoints; ++i) {
+			const int U = (accFix + i * stepFix) >> 16;
+			const float t = (static_cast<float>(u0 + U) - au) / du;
+			const int bin = std::clamp(floorInt(t * SideOffsets::kSteps), 0, SideOffsets::kSteps - 1);
+			shifts[i] = static_cast<float>(dir) * side[bin] / cosV;
+		}
+	}
 
 	Sums sums;
 #if FRAPPE_HAVE_HWY
@@ -538,7 +552,7 @@ bool fitSide(const ImageView &img, Point2f a, Point2f b, float search, int maxPo
 		for (int r = 0; r < rows; ++r)
 			std::memset(&cols.p[r][nPoints], 0, Columns::kPad);
 		HWY_DYNAMIC_DISPATCH(MeasureColumns)(cols);
-		addColumns(sums, cols, nPoints, Us, vFixes, dir, vRef, reachFix);
+		addColumns(sums, cols, nPoints, Us, vFixes, dir, vRef, reachFix, side ? shifts : nullptr);
 	} else
 #else
 	(void)kernels;
@@ -563,7 +577,7 @@ bool fitSide(const ImageView &img, Point2f a, Point2f b, float search, int maxPo
 					p[j] = img.data[uc * uStep + std::clamp(vc + dir * j, 0, vDim - 1) * vStep];
 				wMass = measureColumn([p](int j) { return p[j]; }, kLo, kHi, win, wMoment2);
 			}
-			addCrossing(sums, U, vFix, vc, wMass, wMoment2, dir, vRef, reachFix);
+			addCrossing(sums, U, vFix, vc, wMass, wMoment2, dir, vRef, reachFix, side ? shifts[i] : 0.0f);
 		}
 	}
 	const std::int64_t sw = sums.sw, su = sums.su, suu = sums.suu, sq = sums.sq, suq = sums.suq;
@@ -595,12 +609,13 @@ bool intersect(const Line &l1, const Line &l2, Point2f &p)
 	return true;
 }
 
-bool refineOnce(const ImageView &img, std::array<Point2f, 4> &q, float search, int maxPoints,
-		const RefineWindow &win, RefineKernels kernels)
+bool refineOnce(const ImageView &img, std::array<Point2f, 4> &q, float search, int maxPoints, const RefineWindow &win,
+		RefineKernels kernels, const SideOffsets *offsets = nullptr)
 {
 	Line lines[4];
 	for (int i = 0; i < 4; ++i) {
-		if (!fitSide(img, q[i], q[(i + 1) & 3], search, maxPoints, win, kernels, lines[i]))
+		if (!fitSide(img, q[i], q[(i + 1) & 3], search, maxPoints, win, kernels, lines[i],
+			     offsets ? offsets->d[static_cast<std::size_t>(i)].data() : nullptr))
 			return false;
 	}
 	std::array<Point2f, 4> r;
@@ -634,6 +649,12 @@ bool refineCorners(const ImageView &image, std::array<Point2f, 4> &corners, floa
 	refineOnce(image, q, std::min(search, 1.5f), kFinePoints, win, kernels);
 	corners = q;
 	return true;
+}
+
+bool refineCornersOffset(const ImageView &image, std::array<Point2f, 4> &corners, float search,
+			 const SideOffsets &offsets, RefineKernels kernels)
+{
+	return refineOnce(image, corners, search, kFinePoints, RefineWindow{}, kernels, &offsets);
 }
 
 } // namespace frappe::detail

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <array>
+#include <cstdint>
 
 #include "frappe/image.h"
 
@@ -50,5 +51,20 @@ enum class RefineKernels {
 /// unchanged.
 bool refineCorners(const ImageView &image, std::array<Point2f, 4> &corners, float search,
 		   const RefineWindow &window = {}, RefineKernels kernels = RefineKernels::Best);
+
+/// What pulls each column's crossing of a side off the edge, known from
+/// the marker's pattern: side k (corners k to k + 1) at fraction t of its
+/// length from corner k is measured d[k][t * kSteps] px too far inwards
+/// (along the side's normal; negative: outwards).
+struct SideOffsets {
+	static constexpr int kSteps = 64;
+	std::array<std::array<float, kSteps>, 4> d{};
+};
+
+/// One more narrow pass of refineCorners() (RefineWindow's defaults) from
+/// corners already within a fraction of a pixel, each column's crossing
+/// moved back by `offsets`.
+bool refineCornersOffset(const ImageView &image, std::array<Point2f, 4> &corners, float search,
+			 const SideOffsets &offsets, RefineKernels kernels = RefineKernels::Best);
 
 } // namespace frappe::detail
