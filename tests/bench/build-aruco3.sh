@@ -13,7 +13,9 @@
 # the folder aruco_nano.
 # Only the detector is built: no camera calibration, pose, boards or SVM
 # labeler, so a few symbols the detector's camera-parameter overloads name
-# are stubbed here (never called without camera parameters).
+# are stubbed here (never called without camera parameters), and
+# dictionary.cpp is compiled from a trimmed copy (below): as published it
+# includes the boards' markermap.h, which is not fetched.
 set -eu
 [ $# -eq 2 ] || { echo "usage: $0 SRC PREFIX" >&2; exit 2; }
 SRC=$(cd "$1" && pwd)
@@ -47,7 +49,25 @@ EOF
 # As CMake's Release build would. ArUco 3.0's dictionary_based.cpp names
 # OpenCV 3's C constant CV_BGR2GRAY, which OpenCV 4 keeps in types_c.h.
 CXXFLAGS="-O3 -DNDEBUG -std=c++11 -fPIC -I$SRC/include/aruco -I$SRC/src/aruco $(pkg-config --cflags opencv4)"
-for f in "$SRC"/src/aruco/markerdetector.cpp "$SRC"/src/aruco/marker.cpp "$SRC"/src/aruco/dictionary.cpp \
+# dictionary.cpp as published (276 KB) holds thirteen dictionaries' tables and
+# two functions that need the boards' markermap.h (createMarkerMap; and
+# getMarkerImage_id, whose definition no longer matches dictionary.h at
+# 02badc8). The copy compiled keeps loadPredefined's ARUCO_MIP_36h12, CUSTOM
+# and ALL_DICTS cases and drops the include and those two functions; an
+# already trimmed file passes through unchanged.
+awk '
+	$0 == "#include \"markermap.h\"" { next }
+	/^(cv::Mat Dictionary::getMarkerImage_id|MarkerMap Dictionary::createMarkerMap)\(/ { drop = 1 }
+	drop { if ($0 == "}") drop = 0; next }
+	/^Dictionary Dictionary::loadPredefined\(DICT_TYPES type\)/ { inlp = 1 }
+	inlp && $0 == "}" { inlp = 0 }
+	inlp && /^    case [A-Za-z0-9_]+:$/ { skip = ($0 !~ /case (ARUCO_MIP_36h12|CUSTOM|ALL_DICTS):$/) }
+	inlp && /^    default:$/ { skip = 0 }
+	!skip { print }
+' "$SRC/src/aruco/dictionary.cpp" > "$OBJ/dictionary.cpp"
+grep -q '0xd2b63a09dUL, 0x6001134e5UL, 0x1206fbe72UL' "$OBJ/dictionary.cpp" ||
+	{ echo "$0: ARUCO_MIP_36h12's table not found in $SRC/src/aruco/dictionary.cpp" >&2; exit 1; }
+for f in "$SRC"/src/aruco/markerdetector.cpp "$SRC"/src/aruco/marker.cpp "$OBJ/dictionary.cpp" \
 	"$SRC"/src/aruco/markerlabeler.cpp "$SRC"/src/aruco/markerlabelers/dictionary_based.cpp \
 	"$SRC"/src/aruco/debug.cpp "$OBJ/aruco3_stubs.cpp"; do
 	# shellcheck disable=SC2086
