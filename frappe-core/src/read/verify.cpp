@@ -79,7 +79,9 @@ bool quietZoneIsPaper(const QuietZone &q, const Binarised &b, Tone tone)
 {
 	if (tone.linear() || q.seen < 8)
 		return true;
-	const float white = tone.invert(b.threshold + 0.5f * b.contrast);
+	/* Sharpened cell centres overshoot the code's white: on the log scale
+	 * by a factor of two or more in grey levels. */
+	const float white = tone.invert(b.lightest >= 0.0f ? b.lightest : b.threshold + 0.5f * b.contrast);
 	return q.brightest >= kPaperWhite * white;
 }
 
@@ -347,10 +349,12 @@ MarkerRead readCellCentres(const ImageView &image, const std::array<Point2f, 4> 
 			   const DecodePolicy &policy, WarpedMarker &scratch)
 {
 	const int bits = codes.dictionary().bits;
-	float reference = 0.0f;
-	if (!warpCellCentres(image, corners, bits, kSharpening, scratch, &reference, policy.tone, policy.memo))
+	float reference = 0.0f, lightest = 0.0f;
+	if (!warpCellCentres(image, corners, bits, kSharpening, scratch, &reference, policy.tone, policy.memo,
+			     &lightest))
 		return {};
-	const Binarised b = binarise(scratch, bits);
+	Binarised b = binarise(scratch, bits);
+	b.lightest = lightest;
 	const float lo = b.threshold - 0.5f * b.contrast, hi = b.threshold + 0.5f * b.contrast;
 	if (!readable(b, bits) || !(lo < reference && hi > reference))
 		return {};

@@ -91,7 +91,8 @@ bool quietZoneIsLight(const QuietZone &q, Scrutiny scrutiny = Scrutiny::Strict);
 
 /// On the log scale (Tone), where a light grey beside black ink reads as
 /// white, the ring's lightest cell must also be at least half as light, in
-/// grey levels, as the code's lightest sample; always true on grey levels.
+/// grey levels, as the code's lightest sample (Binarised::lightest where
+/// sharpening overshot it); always true on grey levels.
 bool quietZoneIsPaper(const QuietZone &q, const Binarised &b, Tone tone);
 
 /// Few cells read on both sides of the threshold: one in eight of the
