@@ -425,8 +425,28 @@ detail::MarkerRead detail::CandidateReader::readRefined(Reading &r, detail::Quad
 		q.corners = refinedCorners;
 		read = readWith(pol);
 	};
-	if (!read.ok() && !onLog.tone.linear())
+	if (!read.ok() && !onLog.tone.linear()) {
 		readAgain(onLog);
+		/* Light that falls across the marker by more than black and white
+		 * differ (a blind's stripe, a bright patch at one corner): one
+		 * threshold splits the code into a lit and a dark part; one per
+		 * cell, between the border's black and the quiet zone's white
+		 * where the cell lies, follows it. Cells of 4 px or more (the
+		 * quarter-cell grid); the log read's policy. */
+		if (!read.ok() && refined.refined && bigEnough(refinedCorners, refined.minSide) &&
+		    !smallCells(refinedCorners, dict->bits)) {
+			r = refined;
+			q.corners = refinedCorners;
+			timer.lap(Stage::Warp);
+			if (detail::warpMarker(r.block.view, q.corners, dict->bits, warped, onLog.tone, onLog.memo)) {
+				timer.lap(Stage::Decode);
+				const detail::Binarised b = detail::binariseInLight(r.block.view, q.corners, warped,
+										    dict->bits, onLog.tone);
+				if (detail::readable(b, dict->bits))
+					read = detail::readMarker(r.block.view, q.corners, *codes, onLog, warped, b);
+			}
+		}
+	}
 	if (!read.ok() && clipped && !onClip.tone.linear()) {
 		readAgain(onClip);
 		/* Where the whites clip, blur moves every visible edge towards the
