@@ -167,8 +167,9 @@ void detail::CandidateReader::warpBatch(const ImageView &image, int side)
 /* Candidates not worth refining: the outline of a decoded marker's quiet
  * zone, and clutter as the probe's read at the traced outline shows it. */
 bool detail::CandidateReader::skipCandidate(const detail::Quad &q, const std::array<Point2f, 4> &tracedOutline,
-					    const Slot &slot) const
+					    const Slot &slot, bool &mixedOnly) const
 {
+	mixedOnly = false;
 	const std::vector<Marker> &found = slot.result.markers;
 	const int bits = dict->bits;
 	const int traced = q.probeRead;
@@ -206,7 +207,8 @@ bool detail::CandidateReader::skipCandidate(const detail::Quad &q, const std::ar
 		       q.probeContrast < static_cast<float>(slot.params.relativeRegionContrast(
 						 static_cast<int>(std::lround(q.probeLevel - 0.5f * q.probeContrast)),
 						 static_cast<int>(std::lround(q.probeLevel + 0.5f * q.probeContrast))));
-	return mixed && sidesAtLeast(tracedOutline, 4.0f * static_cast<float>(bits + 2));
+	mixedOnly = mixed && sidesAtLeast(tracedOutline, 4.0f * static_cast<float>(bits + 2));
+	return mixedOnly;
 }
 
 /* Large cells are read on the frame halved f times, in its pixels
@@ -372,9 +374,22 @@ bool detail::CandidateReader::readCandidate(const ImageView &image, Slot &slot, 
 		return readLayoutCandidate(image, slot, k, search, timer, m);
 	detail::Quad &q = slot.quads[k];
 	const std::array<Point2f, 4> tracedOutline = warper ? batch.outlines[k] : q.corners;
-	if (skipCandidate(q, tracedOutline, slot))
+	bool mixed = false;
+	if (skipCandidate(q, tracedOutline, slot, mixed) && !mixed)
 		return false;
 	Reading r = placeCandidate(image, q, tracedOutline);
+	/* A blind's stripes across a black border make the probe's frame read
+	 * mixed against its one threshold: refined only if the border reads
+	 * black against thresholds that follow the light (binariseInLight()). */
+	if (mixed) {
+		if (logPolicy.tone.linear() ||
+		    !detail::warpMarker(r.block.view, r.outline, dict->bits, warped, logPolicy.tone))
+			return false;
+		const detail::Binarised b =
+			detail::binariseInLight(r.block.view, r.outline, warped, dict->bits, logPolicy.tone);
+		if (!detail::readable(b, dict->bits))
+			return false;
+	}
 	/* With at least the frame's search on a halved frame: blur spreads a
 	 * large marker's edges over as many of its pixels as a small one's
 	 * over the frame's. */
@@ -425,8 +440,28 @@ detail::MarkerRead detail::CandidateReader::readRefined(Reading &r, detail::Quad
 		q.corners = refinedCorners;
 		read = readWith(pol);
 	};
-	if (!read.ok() && !onLog.tone.linear())
+	if (!read.ok() && !onLog.tone.linear()) {
 		readAgain(onLog);
+		/* Light that falls across the marker by more than black and white
+		 * differ (a blind's stripe, a bright patch at one corner): one
+		 * threshold splits the code into a lit and a dark part; one per
+		 * cell, between the border's black and the quiet zone's white
+		 * where the cell lies, follows it. Cells of 4 px or more (the
+		 * quarter-cell grid); the log read's policy. */
+		if (!read.ok() && refined.refined && bigEnough(refinedCorners, refined.minSide) &&
+		    !smallCells(refinedCorners, dict->bits)) {
+			r = refined;
+			q.corners = refinedCorners;
+			timer.lap(Stage::Warp);
+			if (detail::warpMarker(r.block.view, q.corners, dict->bits, warped, onLog.tone, onLog.memo)) {
+				timer.lap(Stage::Decode);
+				const detail::Binarised b = detail::binariseInLight(r.block.view, q.corners, warped,
+										    dict->bits, onLog.tone);
+				if (detail::readable(b, dict->bits))
+					read = detail::readMarker(r.block.view, q.corners, *codes, onLog, warped, b);
+			}
+		}
+	}
 	if (!read.ok() && clipped && !onClip.tone.linear()) {
 		readAgain(onClip);
 		/* Where the whites clip, blur moves every visible edge towards the

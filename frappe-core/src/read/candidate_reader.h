@@ -168,7 +168,9 @@ private:
 	bool readCandidate(const ImageView &image, Slot &slot, std::size_t k, float search, StageTimer &timer,
 			   Marker &m);
 	MarkerRead readRefined(Reading &r, Quad &q, std::size_t k, StageTimer &timer, Result &result);
-	bool skipCandidate(const Quad &q, const std::array<Point2f, 4> &tracedOutline, const Slot &slot) const;
+	/* `mixed`: skipped for a mixed frame alone (an edge quad). */
+	bool skipCandidate(const Quad &q, const std::array<Point2f, 4> &tracedOutline, const Slot &slot,
+			   bool &mixed) const;
 	Reading placeCandidate(const ImageView &image, Quad &q, const std::array<Point2f, 4> &tracedOutline);
 	void sampleRefined(Reading &r, const Quad &q, std::size_t k, const DecodePolicy &pol, StageTimer &timer);
 	void readInset(Reading &r, Quad &q, const DecodePolicy &pol, StageTimer &timer);

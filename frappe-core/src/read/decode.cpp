@@ -159,7 +159,7 @@ bool warpToGridScalar(const ImageView &image, const std::array<Point2f, 4> &corn
 }
 
 bool warpCellCentres(const ImageView &image, const std::array<Point2f, 4> &corners, int bits, float sharpening,
-		     WarpedMarker &out, float *reference, Tone tone, WarpMemo *memo)
+		     WarpedMarker &out, float *reference, Tone tone, WarpMemo *memo, float *lightest)
 {
 	const auto H = Homography::fromUnitSquare(corners);
 	if (!H)
@@ -191,6 +191,12 @@ bool warpCellCentres(const ImageView &image, const std::array<Point2f, 4> &corne
 	const float borderMean = border / static_cast<float>(4 * (cells - 1));
 	if (reference)
 		*reference = 0.5f * (ringMean + borderMean);
+	if (lightest) {
+		*lightest = grid.at(2, 2);
+		for (int y = 2; y <= bits + 1; ++y)
+			for (int x = 2; x <= bits + 1; ++x)
+				*lightest = std::max(*lightest, grid.at(x, y));
+	}
 	for (int y = 0; y < cells; ++y) {
 		for (int x = 0; x < cells; ++x) {
 			const float c = grid.at(x + 1, y + 1);

@@ -118,9 +118,12 @@ bool insetQuad(const ImageView &image, std::array<Point2f, 4> &corners, int bits
 /// blur spread over the neighbouring cells. `out` holds one value per cell
 /// (side bits + 2), for binarise and readMarker; `reference`, when given,
 /// the grey level halfway between the mean of the border cells and that of
-/// the ring outside them. False when the quad is degenerate.
+/// the ring outside them; `lightest`, when given, the lightest code cell's
+/// centre before sharpening (sharpening overshoots it). False when the quad
+/// is degenerate.
 bool warpCellCentres(const ImageView &image, const std::array<Point2f, 4> &corners, int bits, float sharpening,
-		     WarpedMarker &out, float *reference = nullptr, Tone tone = {}, WarpMemo *memo = nullptr);
+		     WarpedMarker &out, float *reference = nullptr, Tone tone = {}, WarpMemo *memo = nullptr,
+		     float *lightest = nullptr);
 
 /// The bits of a warped marker, read as in the dictionary files with the
 /// grid's top-left cell first.
@@ -129,6 +132,9 @@ struct Binarised {
 	int border_errors = 0; ///< border cells that read white
 	float contrast = 0.0f; ///< max - min sample over the payload
 	float threshold = 0.0f; ///< the grey level between black and white
+	/// The code's lightest level where the samples overshoot it (sharpened
+	/// cell centres); below 0: threshold + contrast / 2.
+	float lightest = -1.0f;
 };
 
 /// The mean of cell (cx, cy)'s k x k samples.

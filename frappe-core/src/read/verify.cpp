@@ -79,7 +79,9 @@ bool quietZoneIsPaper(const QuietZone &q, const Binarised &b, Tone tone)
 {
 	if (tone.linear() || q.seen < 8)
 		return true;
-	const float white = tone.invert(b.threshold + 0.5f * b.contrast);
+	/* Sharpened cell centres overshoot the code's white: on the log scale
+	 * by a factor of two or more in grey levels. */
+	const float white = tone.invert(b.lightest >= 0.0f ? b.lightest : b.threshold + 0.5f * b.contrast);
 	return q.brightest >= kPaperWhite * white;
 }
 
@@ -163,6 +165,98 @@ QuietZone readQuietZone(const ImageView &image, const std::array<Point2f, 4> &co
 	for (int c = 0; c < cells; ++c) {
 		sample(-1, c);
 		sample(cells, c);
+	}
+	return out;
+}
+
+namespace {
+
+/* Least squares of v = a + b x + c y: the sums of the normal equations. */
+struct PlaneFit {
+	double m[6] = {}; /* n, x, y, xx, xy, yy */
+	double r[3] = {}; /* v, x v, y v */
+	void add(double x, double y, double v)
+	{
+		m[0] += 1.0;
+		m[1] += x;
+		m[2] += y;
+		m[3] += x * x;
+		m[4] += x * y;
+		m[5] += y * y;
+		r[0] += v;
+		r[1] += x * v;
+		r[2] += y * v;
+	}
+	/* The plane's a, b, c; false when the points do not span one. */
+	bool solve(double (&p)[3]) const
+	{
+		const double a = m[0], b = m[1], c = m[2], d = m[3], e = m[4], f = m[5];
+		const double i00 = d * f - e * e, i01 = c * e - b * f, i02 = b * e - c * d;
+		const double det = a * i00 + b * i01 + c * i02;
+		if (!(std::abs(det) > 1e-9))
+			return false;
+		const double i11 = a * f - c * c, i12 = b * c - a * e, i22 = a * d - b * b;
+		p[0] = (i00 * r[0] + i01 * r[1] + i02 * r[2]) / det;
+		p[1] = (i01 * r[0] + i11 * r[1] + i12 * r[2]) / det;
+		p[2] = (i02 * r[0] + i12 * r[1] + i22 * r[2]) / det;
+		return true;
+	}
+};
+
+} // namespace
+
+Binarised binariseInLight(const ImageView &image, const std::array<Point2f, 4> &corners, const WarpedMarker &w,
+			  int bits, Tone tone)
+{
+	Binarised out = binarise(w, bits);
+	const int cells = bits + 2;
+	const int k = std::max(1, w.side / cells);
+	const auto H = Homography::fromUnitSquare(corners);
+	PlaneFit black, white;
+	for (int c = 0; c < cells; ++c)
+		for (int e : { 0, cells - 1 }) {
+			black.add(c + 0.5, e + 0.5, cellMean(w, k, c, e));
+			if (c > 0 && c < cells - 1)
+				black.add(e + 0.5, c + 0.5, cellMean(w, k, e, c));
+		}
+	const float maxX = static_cast<float>(image.width - 1), maxY = static_cast<float>(image.height - 1);
+	auto ring = [&](int cx, int cy) {
+		const Point2f p = H->map((cx + 0.5) / cells, (cy + 0.5) / cells);
+		if (p.x >= 0.0f && p.y >= 0.0f && p.x <= maxX && p.y <= maxY)
+			white.add(cx + 0.5, cy + 0.5, tone.apply(sampleBilinear(image, p.x, p.y)));
+	};
+	if (H)
+		for (int c = -1; c <= cells; ++c) {
+			ring(c, -1);
+			ring(c, cells);
+			if (c >= 0 && c < cells) {
+				ring(-1, c);
+				ring(cells, c);
+			}
+		}
+	double pb[3], pw[3];
+	/* A ring mostly in the image: three sides' worth. */
+	if (white.m[0] < 3.0 * cells || !black.solve(pb) || !white.solve(pw)) {
+		out.contrast = 0.0f;
+		return out;
+	}
+	out.code = 0;
+	out.border_errors = 0;
+	for (int cy = 0; cy < cells; ++cy) {
+		for (int cx = 0; cx < cells; ++cx) {
+			const double x = cx + 0.5, y = cy + 0.5;
+			const double lo = pb[0] + pb[1] * x + pb[2] * y, hi = pw[0] + pw[1] * x + pw[2] * y;
+			const bool code = cx > 0 && cy > 0 && cx <= bits && cy <= bits;
+			if (code && !(hi - lo >= kMinContrast)) {
+				out.contrast = 0.0f;
+				return out;
+			}
+			const bool light = cellMean(w, k, cx, cy) > 0.5 * (lo + hi);
+			if (code)
+				out.code = (out.code << 1) | (light ? 1u : 0u);
+			else
+				out.border_errors += light;
+		}
 	}
 	return out;
 }
@@ -347,10 +441,12 @@ MarkerRead readCellCentres(const ImageView &image, const std::array<Point2f, 4> 
 			   const DecodePolicy &policy, WarpedMarker &scratch)
 {
 	const int bits = codes.dictionary().bits;
-	float reference = 0.0f;
-	if (!warpCellCentres(image, corners, bits, kSharpening, scratch, &reference, policy.tone, policy.memo))
+	float reference = 0.0f, lightest = 0.0f;
+	if (!warpCellCentres(image, corners, bits, kSharpening, scratch, &reference, policy.tone, policy.memo,
+			     &lightest))
 		return {};
-	const Binarised b = binarise(scratch, bits);
+	Binarised b = binarise(scratch, bits);
+	b.lightest = lightest;
 	const float lo = b.threshold - 0.5f * b.contrast, hi = b.threshold + 0.5f * b.contrast;
 	if (!readable(b, bits) || !(lo < reference && hi > reference))
 		return {};

@@ -55,6 +55,18 @@ struct QuietZone {
 QuietZone readQuietZone(const ImageView &image, const std::array<Point2f, 4> &corners, int bits,
 			const Binarised &b, Tone tone = {});
 
+/// binarise() with a threshold per cell that follows the light across the
+/// marker: halfway between a plane fitted to the border cells (black ink)
+/// and one fitted to the ring of cells outside them (the quiet zone's
+/// paper), both in the marker's cell coordinates on the samples' scale
+/// (`tone`: on the log scale light that falls across the marker is a slope
+/// there). Threshold and contrast stay the whole payload's (the checks after
+/// decoding use them). Returns a contrast of 0 (not readable()) where the
+/// planes do not lie at least kMinContrast apart at every code cell, or too
+/// little of the ring is in the image.
+Binarised binariseInLight(const ImageView &image, const std::array<Point2f, 4> &corners, const WarpedMarker &w,
+			  int bits, Tone tone);
+
 /// Border cells that may read white before a candidate is rejected: blur
 /// and small cells brighten the frame next to the quiet zone, a corner may
 /// be occluded; a patch of code has more.
@@ -91,7 +103,8 @@ bool quietZoneIsLight(const QuietZone &q, Scrutiny scrutiny = Scrutiny::Strict);
 
 /// On the log scale (Tone), where a light grey beside black ink reads as
 /// white, the ring's lightest cell must also be at least half as light, in
-/// grey levels, as the code's lightest sample; always true on grey levels.
+/// grey levels, as the code's lightest sample (Binarised::lightest where
+/// sharpening overshot it); always true on grey levels.
 bool quietZoneIsPaper(const QuietZone &q, const Binarised &b, Tone tone);
 
 /// Few cells read on both sides of the threshold: one in eight of the
