@@ -381,15 +381,9 @@ bool detail::CandidateReader::readCandidate(const ImageView &image, Slot &slot, 
 	/* A blind's stripes across a black border make the probe's frame read
 	 * mixed against its one threshold: refined only if the border reads
 	 * black against thresholds that follow the light (binariseInLight()). */
-	if (mixed) {
-		if (logPolicy.tone.linear() ||
-		    !detail::warpMarker(r.block.view, r.outline, dict->bits, warped, logPolicy.tone))
-			return false;
-		const detail::Binarised b =
-			detail::binariseInLight(r.block.view, r.outline, warped, dict->bits, logPolicy.tone);
-		if (!detail::readable(b, dict->bits))
-			return false;
-	}
+	if (mixed &&
+	    (logPolicy.tone.linear() || !detail::readable(readInLight(r.block.view, r.outline, logPolicy), dict->bits)))
+		return false;
 	/* With at least the frame's search on a halved frame: blur spreads a
 	 * large marker's edges over as many of its pixels as a small one's
 	 * over the frame's. */
@@ -402,6 +396,17 @@ bool detail::CandidateReader::readCandidate(const ImageView &image, Slot &slot, 
 		return false;
 	toMarker(q, r.f, r.block, read, m);
 	return true;
+}
+
+/* The quad warped on pol's scale into `warped` and read with thresholds
+ * that follow the light across it (binariseInLight()); not readable() where
+ * the quad is degenerate. */
+detail::Binarised detail::CandidateReader::readInLight(const ImageView &view, const std::array<Point2f, 4> &corners,
+						       const DecodePolicy &pol)
+{
+	if (!detail::warpMarker(view, corners, dict->bits, warped, pol.tone, pol.memo))
+		return {};
+	return detail::binariseInLight(view, corners, warped, dict->bits, pol.tone);
 }
 
 /* Read on grey levels; where that fails, once more on the log scale
@@ -453,13 +458,10 @@ detail::MarkerRead detail::CandidateReader::readRefined(Reading &r, detail::Quad
 			r = refined;
 			q.corners = refinedCorners;
 			timer.lap(Stage::Warp);
-			if (detail::warpMarker(r.block.view, q.corners, dict->bits, warped, onLog.tone, onLog.memo)) {
-				timer.lap(Stage::Decode);
-				const detail::Binarised b = detail::binariseInLight(r.block.view, q.corners, warped,
-										    dict->bits, onLog.tone);
-				if (detail::readable(b, dict->bits))
-					read = detail::readMarker(r.block.view, q.corners, *codes, onLog, warped, b);
-			}
+			const detail::Binarised b = readInLight(r.block.view, q.corners, onLog);
+			timer.lap(Stage::Decode);
+			if (detail::readable(b, dict->bits))
+				read = detail::readMarker(r.block.view, q.corners, *codes, onLog, warped, b);
 		}
 	}
 	if (!read.ok() && clipped && !onClip.tone.linear()) {

@@ -171,6 +171,7 @@ private:
 	/* `mixed`: skipped for a mixed frame alone (an edge quad). */
 	bool skipCandidate(const Quad &q, const std::array<Point2f, 4> &tracedOutline, const Slot &slot,
 			   bool &mixed) const;
+	Binarised readInLight(const ImageView &view, const std::array<Point2f, 4> &corners, const DecodePolicy &pol);
 	Reading placeCandidate(const ImageView &image, Quad &q, const std::array<Point2f, 4> &tracedOutline);
 	void sampleRefined(Reading &r, const Quad &q, std::size_t k, const DecodePolicy &pol, StageTimer &timer);
 	void readInset(Reading &r, Quad &q, const DecodePolicy &pol, StageTimer &timer);

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
+#include <initializer_list>
 #include <random>
 #include <string>
 
@@ -104,6 +105,45 @@ const Dictionary &dictionary(const char *name)
 const float kDefault = Config{}.light_floor;
 constexpr float kAbsolute = 0.5f;
 
+/* Markers found over a sweep of rendered scenes, and the worst corner
+ * error as a fraction of the side. */
+struct Tally {
+	int found = 0, scenes = 0;
+	float worst = 0.0f;
+};
+
+/* The blinds' sweep: both 6x6 families, each value of `what` (`label`:
+ * a shade or a glow), three angles and each of `sides`; render(dict, value,
+ * angle, side) makes a scene. Nothing but the marker is found, and where it
+ * is, its corners lie within `tolerance` of the side; `also(scene, dict)`
+ * runs on every scene. */
+template<typename Render, typename Also>
+Tally blindsSweep(const char *label, std::initializer_list<float> what, std::initializer_list<float> sides,
+		  float tolerance, Render render, Also also)
+{
+	Tally t;
+	for (const char *name : { "aruco_mip_36h12", "apriltag_36h11" }) {
+		const Dictionary &dict = dictionary(name);
+		for (float value : what)
+			for (float angle : { 0.3f, 1.1f, 2.2f })
+				for (float side : sides) {
+					const Scene s = render(dict, value, angle, side);
+					const Outcome o = detectIn(s, dict, kDefault);
+					EXPECT_EQ(o.others, 0)
+						<< name << " " << label << " " << value << " angle " << angle;
+					if (o.marker) {
+						++t.found;
+						t.worst = std::max(t.worst, o.error / side);
+						EXPECT_LT(o.error, tolerance * side)
+							<< name << " " << label << " " << value << " angle " << angle;
+					}
+					also(s, dict);
+					++t.scenes;
+				}
+	}
+	return t;
+}
+
 } // namespace
 
 /* A dim room: 12% and 8% of the light, noise of 1.5 grey levels: black and
@@ -168,29 +208,21 @@ TEST(Lighting, TenGreyLevelsInANoisyFrame)
  * thresholds and grey-level reads, none. */
 TEST(Lighting, BlindStripesAcrossTheMarker)
 {
-	int found = 0, lostWhenAbsolute = 0, scenes = 0;
-	for (const char *name : { "aruco_mip_36h12", "apriltag_36h11" }) {
-		const Dictionary &dict = dictionary(name);
-		for (float shade : { 0.33f, 0.2f })
-			for (float angle : { 0.3f, 1.1f, 2.2f })
-				for (float side : { 90.0f, 140.0f }) {
-					const float cell = side / static_cast<float>(dict.bits + 2);
-					const Scene s = litScene(dict, 23, side, 15.0f, 25.0f, blinds(2.6f * cell, angle, shade),
-								 1.5f, static_cast<unsigned>(angle * 100));
-					const Outcome o = detectIn(s, dict, kDefault);
-					EXPECT_EQ(o.others, 0) << name << " shade " << shade << " angle " << angle;
-					if (o.marker) {
-						++found;
-						EXPECT_LT(o.error, 0.04f * side) << name << " shade " << shade << " angle " << angle;
-					}
-					lostWhenAbsolute += detectIn(s, dict, kAbsolute).marker == nullptr;
-					++scenes;
-				}
-	}
-	std::printf("blind stripes: %d of %d found (%d lost with absolute thresholds)\n", found, scenes,
+	int lostWhenAbsolute = 0;
+	const Tally t = blindsSweep(
+		"shade", { 0.33f, 0.2f }, { 90.0f, 140.0f }, 0.04f,
+		[](const Dictionary &dict, float shade, float angle, float side) {
+			const float cell = side / static_cast<float>(dict.bits + 2);
+			return litScene(dict, 23, side, 15.0f, 25.0f, blinds(2.6f * cell, angle, shade), 1.5f,
+					static_cast<unsigned>(angle * 100));
+		},
+		[&](const Scene &s, const Dictionary &dict) {
+			lostWhenAbsolute += detectIn(s, dict, kAbsolute).marker == nullptr;
+		});
+	std::printf("blind stripes: %d of %d found (%d lost with absolute thresholds)\n", t.found, t.scenes,
 		    lostWhenAbsolute);
-	EXPECT_GE(found, scenes / 2);
-	EXPECT_EQ(lostWhenAbsolute, scenes);
+	EXPECT_GE(t.found, t.scenes / 2);
+	EXPECT_EQ(lostWhenAbsolute, t.scenes);
 }
 
 /* Small markers under a blind (cells under 4 px: read at their centres,
@@ -203,28 +235,16 @@ TEST(Lighting, BlindStripesAcrossTheMarker)
  * lightest centre before sharpening. */
 TEST(Lighting, SmallMarkersUnderBlindsKeepTheirQuietZone)
 {
-	int found = 0, scenes = 0;
-	for (const char *name : { "aruco_mip_36h12", "apriltag_36h11" }) {
-		const Dictionary &dict = dictionary(name);
-		for (float shade : { 0.45f, 0.55f })
-			for (float angle : { 0.3f, 1.1f, 2.2f })
-				for (float side : { 29.0f, 31.0f }) {
-					const float cell = side / static_cast<float>(dict.bits + 2);
-					const Scene s = litScene(dict, 23, side, 15.0f, 25.0f,
-								 blinds(5.0f * cell, angle, shade), 1.5f,
-								 static_cast<unsigned>(angle * 100 + side));
-					const Outcome o = detectIn(s, dict, kDefault);
-					EXPECT_EQ(o.others, 0) << name << " shade " << shade << " angle " << angle;
-					if (o.marker) {
-						++found;
-						EXPECT_LT(o.error, 0.05f * side)
-							<< name << " shade " << shade << " angle " << angle;
-					}
-					++scenes;
-				}
-	}
-	std::printf("small markers under blinds: %d of %d found\n", found, scenes);
-	EXPECT_GE(found, 20); /* 11 with the sharpened white */
+	const Tally t = blindsSweep(
+		"shade", { 0.45f, 0.55f }, { 29.0f, 31.0f }, 0.05f,
+		[](const Dictionary &dict, float shade, float angle, float side) {
+			const float cell = side / static_cast<float>(dict.bits + 2);
+			return litScene(dict, 23, side, 15.0f, 25.0f, blinds(5.0f * cell, angle, shade), 1.5f,
+					static_cast<unsigned>(angle * 100 + side));
+		},
+		[](const Scene &, const Dictionary &) {});
+	std::printf("small markers under blinds: %d of %d found\n", t.found, t.scenes);
+	EXPECT_GE(t.found, 20); /* 11 with the sharpened white */
 }
 
 /* A blind's stripes and a broad glow over one corner of the marker (light
@@ -235,41 +255,28 @@ TEST(Lighting, SmallMarkersUnderBlindsKeepTheirQuietZone)
  * (binariseInLight()). */
 TEST(Lighting, StripesAndAGlowReadWithThresholdsThatFollowTheLight)
 {
-	int found = 0, scenes = 0;
-	float worst = 0.0f;
-	for (const char *name : { "aruco_mip_36h12", "apriltag_36h11" }) {
-		const Dictionary &dict = dictionary(name);
-		for (float glow : { 150.0f, 200.0f })
-			for (float angle : { 0.3f, 1.1f, 2.2f })
-				for (float side : { 90.0f, 120.0f }) {
-					const float cell = side / static_cast<float>(dict.bits + 2);
-					Scene s = litScene(dict, 23, side, 15.0f, 25.0f,
-							   blinds(2.0f * cell, angle, 0.45f, 3.0f), 2.0f,
-							   static_cast<unsigned>(angle * 100 + side), 1.2f);
-					const Point2f c = s.truth[1]; /* centred on a corner */
-					const float r = 0.35f * side;
-					for (int y = 0; y < s.img.height; ++y)
-						for (int x = 0; x < s.img.width; ++x) {
-							const float d2 = (x - c.x) * (x - c.x) + (y - c.y) * (y - c.y);
-							const float v =
-								s.img.at(x, y) + glow * std::exp(-0.5f * d2 / (r * r));
-							s.img.at(x, y) = static_cast<std::uint8_t>(std::min(v, 255.0f));
-						}
-					const Outcome o = detectIn(s, dict, kDefault);
-					EXPECT_EQ(o.others, 0) << name << " glow " << glow << " angle " << angle;
-					if (o.marker) {
-						++found;
-						worst = std::max(worst, o.error / side);
-						/* The glow lifts the border's black at one corner:
-						 * its sides are measured a little inside. */
-						EXPECT_LT(o.error, 0.05f * side)
-							<< name << " glow " << glow << " angle " << angle;
-					}
-					++scenes;
+	/* The glow lifts the border's black at one corner: its sides are
+	 * measured a little inside (within 5% of the side). */
+	const Tally t = blindsSweep(
+		"glow", { 150.0f, 200.0f }, { 90.0f, 120.0f }, 0.05f,
+		[](const Dictionary &dict, float glow, float angle, float side) {
+			const float cell = side / static_cast<float>(dict.bits + 2);
+			Scene s = litScene(dict, 23, side, 15.0f, 25.0f, blinds(2.0f * cell, angle, 0.45f, 3.0f), 2.0f,
+					   static_cast<unsigned>(angle * 100 + side), 1.2f);
+			const Point2f c = s.truth[1]; /* centred on a corner */
+			const float r = 0.35f * side;
+			for (int y = 0; y < s.img.height; ++y)
+				for (int x = 0; x < s.img.width; ++x) {
+					const float d2 = (x - c.x) * (x - c.x) + (y - c.y) * (y - c.y);
+					const float v = s.img.at(x, y) + glow * std::exp(-0.5f * d2 / (r * r));
+					s.img.at(x, y) = static_cast<std::uint8_t>(std::min(v, 255.0f));
 				}
-	}
-	std::printf("stripes and a glow: %d of %d found, worst corner error %.3f of the side\n", found, scenes, worst);
-	EXPECT_GE(found, 16); /* 2 with one threshold on the log scale */
+			return s;
+		},
+		[](const Scene &, const Dictionary &) {});
+	std::printf("stripes and a glow: %d of %d found, worst corner error %.3f of the side\n", t.found, t.scenes,
+		    t.worst);
+	EXPECT_GE(t.found, 16); /* 2 with one threshold on the log scale */
 }
 
 /* A cast shadow's edge through the marker: one side at a quarter of the
