@@ -381,8 +381,8 @@ bool detail::CandidateReader::readCandidate(const ImageView &image, Slot &slot, 
 	/* A blind's stripes across a black border make the probe's frame read
 	 * mixed against its one threshold: refined only if the border reads
 	 * black against thresholds that follow the light (binariseInLight()). */
-	if (mixed &&
-	    (logPolicy.tone.linear() || !detail::readable(readInLight(r.block.view, r.outline, logPolicy), dict->bits)))
+	if (mixed && (logPolicy.tone.linear() || !readsInLight() ||
+		      !detail::readable(readInLight(r.block.view, r.outline, logPolicy), dict->bits)))
 		return false;
 	/* With at least the frame's search on a halved frame: blur spreads a
 	 * large marker's edges over as many of its pixels as a small one's
@@ -453,7 +453,7 @@ detail::MarkerRead detail::CandidateReader::readRefined(Reading &r, detail::Quad
 		 * cell, between the border's black and the quiet zone's white
 		 * where the cell lies, follows it. Cells of 4 px or more (the
 		 * quarter-cell grid); the log read's policy. */
-		if (!read.ok() && refined.refined && bigEnough(refinedCorners, refined.minSide) &&
+		if (!read.ok() && readsInLight() && refined.refined && bigEnough(refinedCorners, refined.minSide) &&
 		    !smallCells(refinedCorners, dict->bits)) {
 			r = refined;
 			q.corners = refinedCorners;

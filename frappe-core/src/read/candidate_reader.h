@@ -171,6 +171,11 @@ private:
 	/* `mixed`: skipped for a mixed frame alone (an edge quad). */
 	bool skipCandidate(const Quad &q, const std::array<Point2f, 4> &tracedOutline, const Slot &slot,
 			   bool &mixed) const;
+	/* Thresholds that follow the light let clutter's cells fall either
+	 * way: only for dictionaries whose codes lie far enough apart to
+	 * correct a bit by default (not the 4x4 families, where they made
+	 * wrong ids on synth/images and blur). */
+	bool readsInLight() const { return dict->defaultMaxHamming() > 0; }
 	Binarised readInLight(const ImageView &view, const std::array<Point2f, 4> &corners, const DecodePolicy &pol);
 	Reading placeCandidate(const ImageView &image, Quad &q, const std::array<Point2f, 4> &tracedOutline);
 	void sampleRefined(Reading &r, const Quad &q, std::size_t k, const DecodePolicy &pol, StageTimer &timer);
